@@ -1,0 +1,259 @@
+//! SE(3), rigid motions `T = (R, t)` acting as `T p = R p + t`.
+//!
+//! Tangent `ξ = [v; ω] ∈ R⁶`, translation part first (the seed's twist `(v, ω)`); generators
+//! `Gⁱ` (i = 1..3) put `eᵢ` in the translation column, `Gⁱ⁺³` put SO(3)'s `Gⁱ` in the rotation block:
+//!
+//! ```text
+//! ξ^ = [ [ω]×  v ]
+//!      [  0    0 ]
+//! ```
+//!
+//! * `exp(ξ) = (exp(ω), J_l(ω) v)` with SO(3)'s left Jacobian `J_l(ω) = I + b[ω]× + c[ω]×²`.
+//! * `log(T) = [J_l(ω)⁻¹ t; ω]`, `ω = log(R)`.
+//! * `J_r(ξ) = [[J_r(ω), Q(−v, −ω)], [0, J_r(ω)]]`, and its inverse
+//!   `[[J_r⁻¹, −J_r⁻¹ Q J_r⁻¹], [0, J_r⁻¹]]`, where (Barfoot, *State Estimation for Robotics*,
+//!   eq. 7.86, with `V = [v]×`, `W = [ω]×`):
+//!   `Q(v, ω) = ½V + c(WV + VW + WVW) − e(W²V + VW² − 3WVW) − ½f(WVW² + W²VW)`.
+//! * `Ad_T = [[R, [t]×R], [0, R]]`.
+//! * `act_jac(p) = (R p + t, [R | −R[p]×], R)`: seed Theorem 5.1, `F = T [H(p) | I]`.
+
+use super::so3::So3;
+use super::trig::AngleCoeffs;
+use super::{skew, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use nalgebra::{Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
+
+/// A rigid motion `T = (R, t) ∈ SE(3)`; `a_from_b` maps `b` coordinates into `a`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Se3<T: Real> {
+    rotation: So3<T>,
+    translation: Vector3<T>,
+}
+
+/// Splits `ξ = [v; ω]`.
+#[inline]
+fn split<T: Real>(xi: &Vector6<T>) -> (Vector3<T>, Vector3<T>) {
+    (
+        Vector3::new(xi.x, xi.y, xi.z),
+        Vector3::new(xi.w, xi.a, xi.b),
+    )
+}
+
+#[inline]
+fn join<T: Real>(v: &Vector3<T>, w: &Vector3<T>) -> Vector6<T> {
+    Vector6::new(v.x, v.y, v.z, w.x, w.y, w.z)
+}
+
+/// `[[a, b], [0, a]]` from 3×3 blocks (the shape of every SE(3) Jacobian).
+#[inline]
+fn upper_block<T: Real>(diag: &Matrix3<T>, upper: &Matrix3<T>) -> Matrix6<T> {
+    let mut m = Matrix6::zeros();
+    m.fixed_view_mut::<3, 3>(0, 0).copy_from(diag);
+    m.fixed_view_mut::<3, 3>(0, 3).copy_from(upper);
+    m.fixed_view_mut::<3, 3>(3, 3).copy_from(diag);
+    m
+}
+
+/// Barfoot's `Q(v, ω)` (see the module docs) from the kernel of `ω`.
+fn q_block<T: Real>(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix3<T> {
+    let se = k.se();
+    let vx = skew(v);
+    let wx = skew(w);
+    let wv = wx * vx;
+    let vw = vx * wx;
+    let wvw = wv * wx;
+    let half = T::lit(0.5);
+    vx * half + (wv + vw + wvw) * k.c
+        - (wx * wv + vw * wx - wvw * T::lit(3.0)) * se.e
+        - (wvw * wx + wx * wvw) * (half * se.f)
+}
+
+impl<T: Real> Se3<T> {
+    /// `T = (R, t)`.
+    #[must_use]
+    pub fn from_parts(rotation: So3<T>, translation: Vector3<T>) -> Self {
+        Self {
+            rotation,
+            translation,
+        }
+    }
+
+    /// The same motion in another precision, stored numbers converted as they are.
+    #[must_use]
+    pub fn cast<U: Real>(&self) -> Se3<U> {
+        let c = |x: T| U::lit(x.to_f64());
+        let t = &self.translation;
+        Se3::from_parts(self.rotation.cast(), Vector3::new(c(t.x), c(t.y), c(t.z)))
+    }
+
+    /// The rotation `R`.
+    #[must_use]
+    pub fn rotation(&self) -> So3<T> {
+        self.rotation
+    }
+
+    /// The translation `t`.
+    #[must_use]
+    pub fn translation(&self) -> Vector3<T> {
+        self.translation
+    }
+
+    #[inline]
+    fn exp_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Self {
+        let wv = w.cross(v);
+        Self {
+            rotation: So3::exp_from(k, w),
+            translation: v + wv * k.b + w.cross(&wv) * k.c,
+        }
+    }
+
+    #[inline]
+    fn jr_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix6<T> {
+        upper_block(&So3::jr_from(k, w), &q_block(k, &-v, &-w))
+    }
+
+    #[inline]
+    fn jr_inv_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix6<T> {
+        let jinv = So3::jr_inv_from(k, w);
+        let q = q_block(k, &-v, &-w);
+        upper_block(&jinv, &-(jinv * q * jinv))
+    }
+
+    /// `log` and the kernel of its rotation angle.
+    #[inline]
+    fn log_with_coeffs(&self) -> (Vector6<T>, AngleCoeffs<T>) {
+        let (w, k) = self.rotation.log_with_coeffs();
+        // J_l⁻¹(ω) t = t − ½ ω×t + d ω×(ω×t).
+        let t = &self.translation;
+        let wt = w.cross(t);
+        let v = t - wt * T::lit(0.5) + w.cross(&wt) * k.d;
+        (join(&v, &w), k)
+    }
+}
+
+impl<T: Real> core::ops::Mul for Se3<T> {
+    type Output = Self;
+    fn mul(self, rhs: Self) -> Self {
+        self.compose(&rhs)
+    }
+}
+
+impl<T: Real> LieGroup<T> for Se3<T> {
+    const DOF: usize = 6;
+    const DIM: usize = 3;
+    type Tangent = Vector6<T>;
+    type Jacobian = Matrix6<T>;
+    type Point = Vector3<T>;
+    type Matrix = Matrix4<T>;
+    type ActJacobian = Matrix3x6<T>;
+    type PointJacobian = Matrix3<T>;
+
+    fn identity() -> Self {
+        Self::from_parts(So3::identity(), Vector3::zeros())
+    }
+
+    fn exp(xi: &Vector6<T>) -> Self {
+        let (v, w) = split(xi);
+        Self::exp_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), &v, &w)
+    }
+
+    fn log(&self) -> Vector6<T> {
+        self.log_with_coeffs().0
+    }
+
+    fn hat(xi: &Vector6<T>) -> Matrix4<T> {
+        let (v, w) = split(xi);
+        let mut m = Matrix4::zeros();
+        m.fixed_view_mut::<3, 3>(0, 0).copy_from(&skew(&w));
+        m.fixed_view_mut::<3, 1>(0, 3).copy_from(&v);
+        m
+    }
+
+    fn vee(m: &Matrix4<T>) -> Vector6<T> {
+        Vector6::new(m.m14, m.m24, m.m34, m.m32, m.m13, m.m21)
+    }
+
+    fn compose(&self, b: &Self) -> Self {
+        Self {
+            rotation: self.rotation.compose(&b.rotation),
+            translation: self.rotation.act(&b.translation) + self.translation,
+        }
+    }
+
+    fn inverse(&self) -> Self {
+        let r_inv = self.rotation.inverse();
+        Self {
+            rotation: r_inv,
+            translation: -r_inv.act(&self.translation),
+        }
+    }
+
+    fn act(&self, p: &Vector3<T>) -> Vector3<T> {
+        self.rotation.act(p) + self.translation
+    }
+
+    fn adjoint(&self) -> Matrix6<T> {
+        let r = self.rotation.rotation_matrix();
+        upper_block(&r, &(skew(&self.translation) * r))
+    }
+
+    fn right_jacobian(xi: &Vector6<T>) -> Matrix6<T> {
+        let (v, w) = split(xi);
+        Self::jr_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), &v, &w)
+    }
+
+    fn right_jacobian_inv(xi: &Vector6<T>) -> Matrix6<T> {
+        let (v, w) = split(xi);
+        Self::jr_inv_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), &v, &w)
+    }
+
+    fn matrix(&self) -> Matrix4<T> {
+        let mut m = Matrix4::identity();
+        m.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&self.rotation.rotation_matrix());
+        m.fixed_view_mut::<3, 1>(0, 3).copy_from(&self.translation);
+        m
+    }
+
+    fn normalize(&self) -> Self {
+        Self::from_parts(self.rotation.normalize(), self.translation)
+    }
+
+    fn try_from_matrix(m: &Matrix4<T>) -> Option<Self> {
+        let tol = T::lit(ORTHOGONALITY_TOLERANCE);
+        let bottom = m.m41.abs() + m.m42.abs() + m.m43.abs() + (m.m44 - T::one()).abs();
+        if !(bottom <= tol) {
+            return None;
+        }
+        let r = So3::try_from_matrix(&m.fixed_view::<3, 3>(0, 0).into_owned())?;
+        let t = Vector3::new(m.m14, m.m24, m.m34);
+        if !t.iter().all(|x| x.is_finite()) {
+            return None;
+        }
+        Some(Self::from_parts(r, t))
+    }
+
+    fn is_finite(&self) -> bool {
+        self.rotation.is_finite() && self.translation.iter().all(|x| x.is_finite())
+    }
+
+    fn exp_jac(xi: &Vector6<T>) -> (Self, Matrix6<T>) {
+        let (v, w) = split(xi);
+        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        (Self::exp_from(&k, &v, &w), Self::jr_from(&k, &v, &w))
+    }
+
+    fn log_jac(&self) -> (Vector6<T>, Matrix6<T>) {
+        let (xi, k) = self.log_with_coeffs();
+        let (v, w) = split(&xi);
+        (xi, Self::jr_inv_from(&k, &v, &w))
+    }
+
+    /// `(R p + t, [R | −R[p]×], R)`: seed Theorem 5.1.
+    fn act_jac(&self, p: &Vector3<T>) -> (Vector3<T>, Matrix3x6<T>, Matrix3<T>) {
+        let r = self.rotation.rotation_matrix();
+        let mut j = Matrix3x6::zeros();
+        j.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
+        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&-(r * skew(p)));
+        (r * p + self.translation, j, r)
+    }
+}

@@ -1,0 +1,320 @@
+//! SO(3), 3-D rotations, stored as a unit quaternion.
+//!
+//! Tangent `ω ∈ R³` (rotation vector, angle `θ = ‖ω‖` about `ω/θ`). Generators (seed Example 5.2):
+//!
+//! ```text
+//! G¹ = [0 0 0; 0 0 −1; 0 1 0],  G² = [0 0 1; 0 0 0; −1 0 0],  G³ = [0 −1 0; 1 0 0; 0 0 0]
+//! ω^ = ω₁G¹ + ω₂G² + ω₃G³ = [ω]×
+//! ```
+//!
+//! * `exp(ω)`: `q = [cos(θ/2), (sin(θ/2)/θ)·ω]`; as a matrix `R = I + a[ω]× + b[ω]×²`.
+//! * `log(q)`: with `q ← −q` when `w < 0`, `θ = 2·atan2(‖v‖, w)`, `ω = (θ/‖v‖)·v`.
+//! * `J_r(ω) = I − b[ω]× + c[ω]×²`, `J_r⁻¹(ω) = I + ½[ω]× + d[ω]×²`, `J_l(ω) = J_r(ω)ᵀ`.
+//! * `Ad_R = R`; `act_jac(p) = (R p, −R[p]×, R)` (seed Theorem 5.1 with `H(p) = [−p]×`,
+//!   Example 5.2).
+//!
+//! with `a, b, c, d` the coefficients of the crate's trigonometric kernel (`sin θ/θ`,
+//! `(1 − cos θ)/θ²`, `(θ − sin θ)/θ³`, `1/θ² − (1 + cos θ)/(2θ sin θ)`).
+
+use super::trig::{half_sinc, poly, AngleCoeffs, Cutoff};
+use super::{skew, skew_sq, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+
+/// A 3-D rotation `R ∈ SO(3)`, stored as a unit Hamilton quaternion.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct So3<T: Real> {
+    q: UnitQuaternion<T>,
+}
+
+impl<T: Real> So3<T> {
+    /// From a quaternion of any non-zero finite norm (it is normalized; `w < 0` is fine).
+    /// `None` for a zero or non-finite quaternion.
+    #[must_use]
+    pub fn from_quaternion(q: &Quaternion<T>) -> Option<Self> {
+        let n2 = q.coords.norm_squared();
+        if !(n2.is_finite() && n2 > T::zero()) {
+            return None;
+        }
+        Some(Self {
+            q: UnitQuaternion::new_unchecked(*q * (T::one() / n2.sqrt())),
+        })
+    }
+
+    /// From the components `w, x, y, z` of a Hamilton quaternion (see [`So3::from_quaternion`]).
+    #[must_use]
+    pub fn from_wxyz(w: T, x: T, y: T, z: T) -> Option<Self> {
+        Self::from_quaternion(&Quaternion::new(w, x, y, z))
+    }
+
+    /// From a nalgebra unit quaternion, trusted to be unit (use [`LieGroup::normalize`] if not).
+    #[must_use]
+    pub fn from_unit_quaternion(q: UnitQuaternion<T>) -> Self {
+        Self { q }
+    }
+
+    /// The unit quaternion (Hamilton; its sign is whatever the computation produced).
+    #[must_use]
+    pub fn quaternion(&self) -> UnitQuaternion<T> {
+        self.q
+    }
+
+    /// The same rotation in another precision, stored numbers converted as they are (no
+    /// re-normalization).
+    #[must_use]
+    pub fn cast<U: Real>(&self) -> So3<U> {
+        let q = self.q.quaternion();
+        let c = |x: T| U::lit(x.to_f64());
+        So3 {
+            q: UnitQuaternion::new_unchecked(Quaternion::new(c(q.w), c(q.i), c(q.j), c(q.k))),
+        }
+    }
+
+    /// From a rotation matrix: the same as [`LieGroup::try_from_matrix`].
+    #[must_use]
+    pub fn from_rotation_matrix(m: &Matrix3<T>) -> Option<Self> {
+        Self::try_from_matrix(m)
+    }
+
+    /// Shepperd's method: the largest of `w², x², y², z²` (from the trace and the diagonal) sets
+    /// which component is computed by a square root, the others by division, so no branch loses
+    /// precision near `θ = π`. The result is normalized.
+    fn quaternion_from_matrix(m: &Matrix3<T>) -> Option<Self> {
+        let one = T::one();
+        let quarter = T::lit(0.25);
+        let trace = m.m11 + m.m22 + m.m33;
+        let (w, x, y, z);
+        if trace > T::zero() {
+            let s = (trace + one).sqrt() * T::lit(2.0);
+            w = quarter * s;
+            x = (m.m32 - m.m23) / s;
+            y = (m.m13 - m.m31) / s;
+            z = (m.m21 - m.m12) / s;
+        } else if m.m11 > m.m22 && m.m11 > m.m33 {
+            let s = (one + m.m11 - m.m22 - m.m33).sqrt() * T::lit(2.0);
+            w = (m.m32 - m.m23) / s;
+            x = quarter * s;
+            y = (m.m12 + m.m21) / s;
+            z = (m.m13 + m.m31) / s;
+        } else if m.m22 > m.m33 {
+            let s = (one + m.m22 - m.m11 - m.m33).sqrt() * T::lit(2.0);
+            w = (m.m13 - m.m31) / s;
+            x = (m.m12 + m.m21) / s;
+            y = quarter * s;
+            z = (m.m23 + m.m32) / s;
+        } else {
+            let s = (one + m.m33 - m.m11 - m.m22).sqrt() * T::lit(2.0);
+            w = (m.m21 - m.m12) / s;
+            x = (m.m13 + m.m31) / s;
+            y = (m.m23 + m.m32) / s;
+            z = quarter * s;
+        }
+        Self::from_wxyz(w, x, y, z)
+    }
+
+    /// The quaternion with `w ≥ 0` as `(w, v)`, the principal representative for `log`.
+    #[inline]
+    fn principal(&self) -> (T, Vector3<T>) {
+        let q = self.q.quaternion();
+        if q.w < T::zero() {
+            (-q.w, -q.imag())
+        } else {
+            (q.w, q.imag())
+        }
+    }
+
+    /// `log` plus the half-angle sine and cosine it found, to build the kernel without trigonometry.
+    #[inline]
+    fn log_parts(&self) -> (Vector3<T>, T, T, T) {
+        let (w, v) = self.principal();
+        let n2 = v.norm_squared();
+        let n = n2.sqrt();
+        // θ = 2·atan2(n, w); below the cutoff (n/w small) use 2·atan(r)/r's series, r = n/w.
+        let scale = if n2 < T::lit(Cutoff::<T>::ATAN_RATIO) * w * w {
+            let r2 = n2 / (w * w);
+            T::lit(2.0) / w * poly(r2, [1.0, -1.0 / 3.0, 1.0 / 5.0])
+        } else {
+            T::lit(2.0) * n.atan2(w) / n
+        };
+        let omega = v * scale;
+        (omega, scale * n, n, w)
+    }
+
+    /// The SO(3) right Jacobian from precomputed coefficients: `I − b[ω]× + c[ω]×²`.
+    #[inline]
+    pub(crate) fn jr_from(k: &AngleCoeffs<T>, w: &Vector3<T>) -> Matrix3<T> {
+        Matrix3::identity() - skew(w) * k.b + skew_sq(w) * k.c
+    }
+
+    /// `J_r⁻¹ = I + ½[ω]× + d[ω]×²`.
+    #[inline]
+    pub(crate) fn jr_inv_from(k: &AngleCoeffs<T>, w: &Vector3<T>) -> Matrix3<T> {
+        Matrix3::identity() + skew(w) * T::lit(0.5) + skew_sq(w) * k.d
+    }
+
+    /// The unit quaternion `exp(ω)` from precomputed coefficients.
+    #[inline]
+    pub(crate) fn exp_from(k: &AngleCoeffs<T>, w: &Vector3<T>) -> Self {
+        let v = w * k.half_sinc();
+        Self {
+            q: UnitQuaternion::new_unchecked(Quaternion::new(k.cos_half, v.x, v.y, v.z)),
+        }
+    }
+
+    /// `log` and its kernel (for SE(3)'s log, which needs `J_l⁻¹` of the same angle).
+    #[inline]
+    pub(crate) fn log_with_coeffs(&self) -> (Vector3<T>, AngleCoeffs<T>) {
+        let (omega, theta, sin_half, cos_half) = self.log_parts();
+        let k = AngleCoeffs::from_half_angle(theta * theta, theta, sin_half, cos_half);
+        (omega, k)
+    }
+
+    /// Rotation matrix `R`.
+    #[must_use]
+    pub fn rotation_matrix(&self) -> Matrix3<T> {
+        *self.q.to_rotation_matrix().matrix()
+    }
+}
+
+impl<T: Real> From<UnitQuaternion<T>> for So3<T> {
+    fn from(q: UnitQuaternion<T>) -> Self {
+        Self::from_unit_quaternion(q)
+    }
+}
+
+impl<T: Real> core::ops::Mul for So3<T> {
+    type Output = Self;
+    fn mul(self, rhs: Self) -> Self {
+        self.compose(&rhs)
+    }
+}
+
+impl<T: Real> LieGroup<T> for So3<T> {
+    const DOF: usize = 3;
+    const DIM: usize = 3;
+    type Tangent = Vector3<T>;
+    type Jacobian = Matrix3<T>;
+    type Point = Vector3<T>;
+    type Matrix = Matrix3<T>;
+    type ActJacobian = Matrix3<T>;
+    type PointJacobian = Matrix3<T>;
+
+    fn identity() -> Self {
+        Self {
+            q: UnitQuaternion::identity(),
+        }
+    }
+
+    fn exp(w: &Vector3<T>) -> Self {
+        let theta_sq = w.norm_squared();
+        let theta = theta_sq.sqrt();
+        let (s, c) = (theta * T::lit(0.5)).sincos();
+        let v = w * half_sinc(theta_sq, theta, s);
+        Self {
+            q: UnitQuaternion::new_unchecked(Quaternion::new(c, v.x, v.y, v.z)),
+        }
+    }
+
+    fn log(&self) -> Vector3<T> {
+        self.log_parts().0
+    }
+
+    fn hat(w: &Vector3<T>) -> Matrix3<T> {
+        skew(w)
+    }
+
+    fn vee(m: &Matrix3<T>) -> Vector3<T> {
+        Vector3::new(m.m32, m.m13, m.m21)
+    }
+
+    fn compose(&self, b: &Self) -> Self {
+        Self { q: self.q * b.q }
+    }
+
+    fn inverse(&self) -> Self {
+        Self {
+            q: self.q.conjugate(),
+        }
+    }
+
+    fn act(&self, p: &Vector3<T>) -> Vector3<T> {
+        self.q.transform_vector(p)
+    }
+
+    fn adjoint(&self) -> Matrix3<T> {
+        self.rotation_matrix()
+    }
+
+    fn right_jacobian(w: &Vector3<T>) -> Matrix3<T> {
+        Self::jr_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), w)
+    }
+
+    fn right_jacobian_inv(w: &Vector3<T>) -> Matrix3<T> {
+        Self::jr_inv_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), w)
+    }
+
+    fn left_jacobian(w: &Vector3<T>) -> Matrix3<T> {
+        Self::right_jacobian(w).transpose()
+    }
+
+    fn left_jacobian_inv(w: &Vector3<T>) -> Matrix3<T> {
+        Self::right_jacobian_inv(w).transpose()
+    }
+
+    fn matrix(&self) -> Matrix3<T> {
+        self.rotation_matrix()
+    }
+
+    fn normalize(&self) -> Self {
+        match Self::from_quaternion(self.q.as_ref()) {
+            Some(r) => r,
+            None => *self,
+        }
+    }
+
+    fn try_from_matrix(m: &Matrix3<T>) -> Option<Self> {
+        if !m.iter().all(|x| x.is_finite()) {
+            return None;
+        }
+        let err = (m.transpose() * m - Matrix3::identity()).norm_squared();
+        let tol = T::lit(ORTHOGONALITY_TOLERANCE);
+        if !(err <= tol * tol) || m.determinant() <= T::zero() {
+            return None;
+        }
+        Self::quaternion_from_matrix(m)
+    }
+
+    fn is_finite(&self) -> bool {
+        self.q.coords.iter().all(|x| x.is_finite())
+    }
+
+    fn exp_jac(w: &Vector3<T>) -> (Self, Matrix3<T>) {
+        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        (Self::exp_from(&k, w), Self::jr_from(&k, w))
+    }
+
+    fn log_jac(&self) -> (Vector3<T>, Matrix3<T>) {
+        let (w, k) = self.log_with_coeffs();
+        (w, Self::jr_inv_from(&k, &w))
+    }
+
+    fn compose_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
+        (
+            self.compose(b),
+            b.rotation_matrix().transpose(),
+            Matrix3::identity(),
+        )
+    }
+
+    fn rminus_jac(&self, b: &Self) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {
+        let (tau, k) = b.between(self).log_with_coeffs();
+        let jr_inv = Self::jr_inv_from(&k, &tau);
+        // J_l⁻¹(τ) = J_r⁻¹(τ)ᵀ for SO(3).
+        (tau, jr_inv, -jr_inv.transpose())
+    }
+
+    /// `(R p, −R[p]×, R)`: seed Theorem 5.1 with `H(p) = [−p]×` (Example 5.2).
+    fn act_jac(&self, p: &Vector3<T>) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {
+        let r = self.rotation_matrix();
+        (r * p, -(r * skew(p)), r)
+    }
+}

@@ -1,0 +1,305 @@
+//! The trigonometric coefficients shared by the exponential maps and Jacobians of SO(3), SE(2)
+//! and SE(3), computed once per call from one half-angle `sincos` and reused (the idea of GTSAM's
+//! `SO3` kernel).
+//!
+//! With `θ ≥ 0`, `s = sin(θ/2)`, `c = cos(θ/2)` (so `sin θ = 2sc` and `1 − cos θ = 2s²`, which
+//! avoids the cancellation of `1 − cos θ`):
+//!
+//! | field | closed form | series in `θ²` near 0 |
+//! |---|---|---|
+//! | `a` | `sin θ / θ` | `1 − θ²/6 + θ⁴/120` |
+//! | `b` | `(1 − cos θ)/θ² = 2s²/θ²` | `1/2 − θ²/24 + θ⁴/720` |
+//! | `c` | `(θ − sin θ)/θ³ = (1 − a)/θ²` | `1/6 − θ²/120 + θ⁴/5040 − θ⁶/362880` |
+//! | `d` | `1/θ² − (1 + cos θ)/(2θ sin θ) = (1 − (θ/2)·c/s)/θ²` | `1/12 + θ²/720 + θ⁴/30240 + θ⁶/1209600 + θ⁸/47900160` |
+//!
+//! and for SE(3)'s `Q` block ([`SeCoeffs`]):
+//!
+//! | field | closed form | series |
+//! |---|---|---|
+//! | `e` | `(1 − θ²/2 − cos θ)/θ⁴ = (b − 1/2)/θ²` | `−1/24 + θ²/720 − θ⁴/40320 + θ⁶/3628800` |
+//! | `f` | `e − 3(c − 1/6)/θ²` | `−1/60 + θ²/1260 − θ⁴/60480 + θ⁶/4989600` |
+//!
+//! Each coefficient switches to its series below its own cutoff `θ² < x*`, with
+//! `x* = `[`taylor_cutoff`]`(ε, t₀, t_omitted, terms)`: the series is then exact to `ε/2`. The
+//! cancelling closed forms (`c`, `d`, `e`, `f`) carry more series terms so that their cutoff sits
+//! where the cancellation has cost little; their error is relative to a term that is multiplied by
+//! `θ²` or `θ⁴` in every use, so the products stay accurate to a few ulps absolutely.
+
+use crate::scalar::{taylor_cutoff, Real};
+use core::marker::PhantomData;
+
+/// Small-angle cutoffs (in `θ²`), one per series, derived from `T::EPSILON`.
+pub(crate) struct Cutoff<T>(PhantomData<T>);
+
+impl<T: Real> Cutoff<T> {
+    pub(crate) const A: f64 = taylor_cutoff(T::EPSILON_F64, 1.0, 1.0 / 5040.0, 3);
+    pub(crate) const B: f64 = taylor_cutoff(T::EPSILON_F64, 0.5, 1.0 / 40320.0, 3);
+    pub(crate) const C: f64 = taylor_cutoff(T::EPSILON_F64, 1.0 / 6.0, 1.0 / 39_916_800.0, 4);
+    pub(crate) const D: f64 = taylor_cutoff(T::EPSILON_F64, 1.0 / 12.0, 1.0 / 1_892_437_580.0, 5);
+    pub(crate) const E: f64 = taylor_cutoff(T::EPSILON_F64, 1.0 / 24.0, 1.0 / 479_001_600.0, 4);
+    pub(crate) const F: f64 = taylor_cutoff(T::EPSILON_F64, 1.0 / 60.0, 1.0 / 622_702_080.0, 4);
+    /// `sin(θ/2)/θ`: `1/2 − θ²/48 + θ⁴/3840`, omitted `θ⁶/645120`.
+    pub(crate) const HALF_SINC: f64 = taylor_cutoff(T::EPSILON_F64, 0.5, 1.0 / 645_120.0, 3);
+    /// `(θ/2)·cot(θ/2)`: `1 − θ²/12 − θ⁴/720`, omitted `θ⁶/30240`.
+    pub(crate) const HALF_COT: f64 = taylor_cutoff(T::EPSILON_F64, 1.0, 1.0 / 30240.0, 3);
+    /// `2·atan(n/w)/n` for the SO(3) log: `(2/w)(1 − n²/(3w²) + n⁴/(5w⁴))`, omitted `n⁶/(7w⁶)`.
+    pub(crate) const ATAN_RATIO: f64 = taylor_cutoff(T::EPSILON_F64, 1.0, 1.0 / 7.0, 3);
+}
+
+/// Evaluates `p₀ + p₁x + p₂x² + …` (Horner).
+#[inline(always)]
+pub(crate) fn poly<T: Real, const N: usize>(x: T, coeffs: [f64; N]) -> T {
+    let mut acc = T::zero();
+    let mut i = N;
+    while i > 0 {
+        i -= 1;
+        let k = match coeffs.get(i) {
+            Some(k) => *k,
+            None => 0.0,
+        };
+        acc = acc * x + T::lit(k);
+    }
+    acc
+}
+
+/// Coefficients of one rotation angle, shared by exp, the Jacobians and their inverses.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct AngleCoeffs<T> {
+    /// `θ²`.
+    pub theta_sq: T,
+    /// `θ`.
+    pub theta: T,
+    /// `sin(θ/2)`.
+    pub sin_half: T,
+    /// `cos(θ/2)`.
+    pub cos_half: T,
+    /// `sin θ / θ`.
+    pub a: T,
+    /// `(1 − cos θ)/θ²`.
+    pub b: T,
+    /// `(θ − sin θ)/θ³`.
+    pub c: T,
+    /// `1/θ² − (1 + cos θ)/(2θ sin θ)`, the coefficient of `[θ]×²` in `J_r⁻¹`.
+    pub d: T,
+}
+
+impl<T: Real> AngleCoeffs<T> {
+    /// From `θ²` alone (one `sqrt` and one `sincos` of `θ/2`).
+    #[inline]
+    pub fn from_theta_sq(theta_sq: T) -> Self {
+        let theta = theta_sq.sqrt();
+        let (sin_half, cos_half) = (theta * T::lit(0.5)).sincos();
+        Self::from_half_angle(theta_sq, theta, sin_half, cos_half)
+    }
+
+    /// From `θ` and the sine and cosine of `θ/2`, already known (for example the vector norm and
+    /// scalar part of a unit quaternion): no trigonometric call at all.
+    #[inline]
+    pub fn from_half_angle(theta_sq: T, theta: T, sin_half: T, cos_half: T) -> Self {
+        let two = T::lit(2.0);
+        let a = if theta_sq < T::lit(Cutoff::<T>::A) {
+            poly(theta_sq, [1.0, -1.0 / 6.0, 1.0 / 120.0])
+        } else {
+            two * sin_half * cos_half / theta
+        };
+        let b = if theta_sq < T::lit(Cutoff::<T>::B) {
+            poly(theta_sq, [0.5, -1.0 / 24.0, 1.0 / 720.0])
+        } else {
+            two * sin_half * sin_half / theta_sq
+        };
+        let c = if theta_sq < T::lit(Cutoff::<T>::C) {
+            poly(
+                theta_sq,
+                [1.0 / 6.0, -1.0 / 120.0, 1.0 / 5040.0, -1.0 / 362_880.0],
+            )
+        } else {
+            (T::one() - a) / theta_sq
+        };
+        let d = if theta_sq < T::lit(Cutoff::<T>::D) {
+            poly(
+                theta_sq,
+                [
+                    1.0 / 12.0,
+                    1.0 / 720.0,
+                    1.0 / 30240.0,
+                    1.0 / 1_209_600.0,
+                    1.0 / 47_900_160.0,
+                ],
+            )
+        } else {
+            (T::one() - half_cot(theta_sq, theta, sin_half, cos_half)) / theta_sq
+        };
+        Self {
+            theta_sq,
+            theta,
+            sin_half,
+            cos_half,
+            a,
+            b,
+            c,
+            d,
+        }
+    }
+
+    /// `1 − cos θ`, as `2 sin²(θ/2)`.
+    #[inline]
+    pub fn one_minus_cos(&self) -> T {
+        self.b * self.theta_sq
+    }
+
+    /// `cos θ = 1 − 2 sin²(θ/2)`.
+    #[inline]
+    pub fn cos(&self) -> T {
+        T::one() - self.one_minus_cos()
+    }
+
+    /// `sin(θ/2)/θ`, the vector coefficient of the unit quaternion `exp(θ)`.
+    #[inline]
+    pub fn half_sinc(&self) -> T {
+        half_sinc(self.theta_sq, self.theta, self.sin_half)
+    }
+
+    /// The SE(3) coefficients `e`, `f` of the `Q` block.
+    #[inline]
+    pub fn se(&self) -> SeCoeffs<T> {
+        let x = self.theta_sq;
+        let e = if x < T::lit(Cutoff::<T>::E) {
+            poly(
+                x,
+                [-1.0 / 24.0, 1.0 / 720.0, -1.0 / 40320.0, 1.0 / 3_628_800.0],
+            )
+        } else {
+            (self.b - T::lit(0.5)) / x
+        };
+        let f = if x < T::lit(Cutoff::<T>::F) {
+            poly(
+                x,
+                [-1.0 / 60.0, 1.0 / 1260.0, -1.0 / 60480.0, 1.0 / 4_989_600.0],
+            )
+        } else {
+            e - T::lit(3.0) * (self.c - T::lit(1.0 / 6.0)) / x
+        };
+        SeCoeffs { e, f }
+    }
+}
+
+/// SE(3) `Q`-block coefficients (see the module table).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SeCoeffs<T> {
+    pub e: T,
+    pub f: T,
+}
+
+/// `sin(θ/2)/θ` with its series below its cutoff.
+#[inline]
+pub(crate) fn half_sinc<T: Real>(theta_sq: T, theta: T, sin_half: T) -> T {
+    if theta_sq < T::lit(Cutoff::<T>::HALF_SINC) {
+        poly(theta_sq, [0.5, -1.0 / 48.0, 1.0 / 3840.0])
+    } else {
+        sin_half / theta
+    }
+}
+
+/// `(θ/2)·cot(θ/2) = (θ/2)·cos(θ/2)/sin(θ/2)`, with its series below its cutoff.
+#[inline]
+pub(crate) fn half_cot<T: Real>(theta_sq: T, theta: T, sin_half: T, cos_half: T) -> T {
+    if theta_sq < T::lit(Cutoff::<T>::HALF_COT) {
+        poly(theta_sq, [1.0, -1.0 / 12.0, -1.0 / 720.0])
+    } else {
+        T::lit(0.5) * theta * cos_half / sin_half
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every coefficient is continuous across its cutoff: the series and the closed form agree there
+    /// to a few ulps of the quantity each is multiplied into.
+    #[test]
+    fn series_and_closed_forms_agree_at_their_cutoffs() {
+        fn exact(theta: f64) -> [f64; 6] {
+            // Reference values by long series in extended steps (θ ≤ 0.7 here): sum many terms.
+            let x = theta * theta;
+            let mut sin_t = 0.0; // Σ (−1)^k θ^{2k}/(2k+1)!  = sin θ/θ
+            let mut omc = 0.0; // Σ (−1)^k θ^{2k}/(2k+2)!  = (1−cos θ)/θ²
+            let mut tms = 0.0; // Σ (−1)^k θ^{2k}/(2k+3)!  = (θ−sin θ)/θ³
+            let mut term_a = 1.0;
+            let mut term_b = 0.5;
+            let mut term_c = 1.0 / 6.0;
+            for k in 0..30 {
+                sin_t += term_a;
+                omc += term_b;
+                tms += term_c;
+                let k = k as f64;
+                term_a *= -x / ((2.0 * k + 2.0) * (2.0 * k + 3.0));
+                term_b *= -x / ((2.0 * k + 3.0) * (2.0 * k + 4.0));
+                term_c *= -x / ((2.0 * k + 4.0) * (2.0 * k + 5.0));
+            }
+            // e = (b − 1/2)/θ² = Σ_{k≥1} (−1)^k θ^{2k-2}/(2k+2)!, f = e − 3(c − 1/6)/θ².
+            let mut e = 0.0;
+            let mut f_tail = 0.0;
+            let mut te = -1.0 / 24.0;
+            let mut tc = -1.0 / 120.0;
+            for k in 1..30 {
+                e += te;
+                f_tail += tc;
+                let k = k as f64;
+                te *= -x / ((2.0 * k + 3.0) * (2.0 * k + 4.0));
+                tc *= -x / ((2.0 * k + 4.0) * (2.0 * k + 5.0));
+            }
+            let f = e - 3.0 * f_tail;
+            // d = (1 − (θ/2)cot(θ/2))/θ²: from (1 − cos θ) and sin θ: (θ/2)cot(θ/2) = θ sinθ/(2(1−cosθ)).
+            let d = (1.0 - sin_t / (2.0 * omc)) / x;
+            [sin_t, omc, tms, d, e, f]
+        }
+        for theta in [1e-3, 5e-3, 0.01, 0.02, 0.05, 0.1, 0.2, 0.4, 0.6, 0.7] {
+            let k = AngleCoeffs::<f64>::from_theta_sq(theta * theta);
+            let se = k.se();
+            let r = exact(theta);
+            let got = [k.a, k.b, k.c, k.d, se.e, se.f];
+            // The cancelling coefficients multiply θ² (c, d) or θ⁴ (e, f) wherever they are used.
+            let weight = [
+                1.0,
+                1.0,
+                theta * theta,
+                theta * theta,
+                theta.powi(4),
+                theta.powi(4),
+            ];
+            for i in 0..6 {
+                if i == 3 && theta < 0.2 {
+                    // d's reference above is itself a cancelling closed form; compare with its series.
+                    let x = theta * theta;
+                    let series = 1.0 / 12.0 + x / 720.0 + x * x / 30240.0 + x.powi(3) / 1_209_600.0;
+                    assert!((got[3] - series).abs() * x <= 4.0 * f64::EPSILON);
+                    continue;
+                }
+                let err = (got[i] - r[i]).abs() * weight[i];
+                assert!(
+                    err <= 8.0 * f64::EPSILON,
+                    "coef {i} θ={theta}: {} vs {}",
+                    got[i],
+                    r[i]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn cutoffs_are_ordered_sensibly() {
+        // f32 cutoffs are wider than f64's; all are positive and inside every series' radius of
+        // convergence (the smallest is d's: θ < 2π).
+        for (c32, c64) in [
+            (Cutoff::<f32>::A, Cutoff::<f64>::A),
+            (Cutoff::<f32>::C, Cutoff::<f64>::C),
+            (Cutoff::<f32>::D, Cutoff::<f64>::D),
+            (Cutoff::<f32>::F, Cutoff::<f64>::F),
+        ] {
+            assert!(
+                c64 > 0.0 && c32 > c64 && c32 < 4.0 * core::f64::consts::PI.powi(2),
+                "{c32} {c64}"
+            );
+        }
+    }
+}

@@ -1,0 +1,224 @@
+//! The scalar type every estimator type is generic over: `f32` or `f64`.
+//!
+//! [`Real`] is nalgebra's [`RealField`] plus the few things this crate needs that nalgebra does not
+//! give in the right form:
+//!
+//! * [`Real::EPSILON_F64`], the machine epsilon as an `f64`, from which every small-angle threshold
+//!   in [`crate::lie`] is derived at compile time ([`taylor_cutoff`]); there is no global epsilon.
+//! * [`Real::lit`], an `#[inline(always)]` literal conversion so that `f32` code never performs an
+//!   `f64` operation at run time (on a Cortex-M4F that would be software floating point).
+//! * [`Real::sincos`], sine and cosine of one angle. For `f64` it is `libm::sincos`. For `f32` it
+//!   is [`sincos_f32`], computed entirely in `f32`: `libm::sinf`/`cosf` reduce and evaluate in
+//!   `f64` internally, which a Cortex-M4F emulates in software.
+
+use nalgebra::RealField;
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for f32 {}
+    impl Sealed for f64 {}
+}
+
+/// A real scalar: `f32` or `f64` (sealed).
+pub trait Real: RealField + Copy + sealed::Sealed {
+    /// Machine epsilon of `Self` (`2⁻²³` for `f32`, `2⁻⁵²` for `f64`), widened to `f64` so that
+    /// thresholds can be computed in `const` context.
+    const EPSILON_F64: f64;
+
+    /// Converts a literal. Always inlined, so `T::lit(1.0 / 6.0)` folds to a constant of type `T`.
+    fn lit(x: f64) -> Self;
+
+    /// `(sin x, cos x)` computed in `Self`'s own precision.
+    fn sincos(self) -> (Self, Self);
+
+    /// Widens to `f64` (for casts between precisions, tests and host tools; never on an `f32`
+    /// hot path).
+    fn to_f64(self) -> f64;
+}
+
+impl Real for f64 {
+    const EPSILON_F64: f64 = f64::EPSILON;
+
+    #[inline(always)]
+    fn lit(x: f64) -> Self {
+        x
+    }
+
+    #[inline]
+    fn sincos(self) -> (Self, Self) {
+        libm::sincos(self)
+    }
+
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self
+    }
+}
+
+impl Real for f32 {
+    const EPSILON_F64: f64 = f32::EPSILON as f64;
+
+    #[inline(always)]
+    fn lit(x: f64) -> Self {
+        x as f32
+    }
+
+    #[inline]
+    fn sincos(self) -> (Self, Self) {
+        sincos_f32(self)
+    }
+
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+}
+
+/// `(sin x, cos x)` in pure `f32` arithmetic (no `f64` operation at all).
+///
+/// Method (Cody–Waite reduction, as in Cephes `sinf`/`cosf`): `j` = `|x|·4/π` rounded up to
+/// even, so that `z = |x| − j·π/4 ∈ [−π/4, π/4]`, with `π/4` split in three parts whose products
+/// with `j` are exact for `|x| < 8192`; then the minimax polynomials
+/// `sin z ≈ z + z³·P(z²)` and `cos z ≈ 1 − z²/2 + z⁴·Q(z²)` and the quadrant `j/2 mod 4`.
+///
+/// Accuracy, measured against `f64` in the tests of this module: absolute error at most `2⁻²³`
+/// (one `f32` epsilon) for `|x| ≤ 8192`, and a relative error under one epsilon for
+/// `|x| < π/4`. Beyond `|x| = 8192` the argument is first reduced modulo the `f32` value of `2π`
+/// (an exact `fmod`, but that `2π` is off by `1.7e-7`), so the phase error grows like
+/// `|x|·2.8e-8`; the result stays finite with `sin² + cos² ≈ 1`. Non-finite input gives
+/// `(NaN, NaN)`.
+#[must_use]
+pub fn sincos_f32(x: f32) -> (f32, f32) {
+    const FOUR_OVER_PI: f32 = 1.273_239_5;
+    // π/4 = DP1 + DP2 + DP3, DP1 and DP2 with few significant bits so that j·DP1, j·DP2 are exact.
+    const DP1: f32 = 0.785_156_25;
+    const DP2: f32 = 2.418_756_5e-4;
+    const DP3: f32 = 3.774_895e-8;
+
+    let ax = libm::fabsf(x);
+    let ax = if ax > 8192.0 {
+        ax % core::f32::consts::TAU
+    } else {
+        ax
+    };
+    // Saturating float-to-int conversion: NaN gives 0, huge values give u32::MAX (then masked).
+    let j = (ax * FOUR_OVER_PI) as u32;
+    let j = j.wrapping_add(j & 1);
+    let y = j as f32;
+    let z = ((ax - y * DP1) - y * DP2) - y * DP3;
+    let zz = z * z;
+    let s = z + z * zz * ((-1.951_529_6e-4 * zz + 8.332_161e-3) * zz - 1.666_665_5e-1);
+    let c =
+        1.0 - 0.5 * zz + zz * zz * ((2.443_315_7e-5 * zz - 1.388_731_6e-3) * zz + 4.166_664_6e-2);
+    let (sin_ax, cos_ax) = match (j >> 1) & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    };
+    let sin_x = if x < 0.0 { -sin_ax } else { sin_ax };
+    if x.is_finite() {
+        (sin_x, cos_ax)
+    } else {
+        (f32::NAN, f32::NAN)
+    }
+}
+
+/// The largest `x = θ²` at which a truncated Taylor series is exact to half an epsilon.
+///
+/// A coefficient `f(θ) = Σ_k t_k θ^{2k}` evaluated with its first `terms` terms errs by about the
+/// first omitted term `t_terms · x^terms`. Requiring `|t_terms| x^terms ≤ (ε/2)|t_0|` gives
+/// `x ≤ (ε |t_0| / (2 |t_terms|))^{1/terms}`. Each small-angle branch in [`crate::lie`] calls this
+/// with its own series, so every threshold follows from `T::EPSILON` and from that series.
+#[must_use]
+pub const fn taylor_cutoff(epsilon: f64, leading: f64, omitted: f64, terms: u32) -> f64 {
+    let leading = if leading < 0.0 { -leading } else { leading };
+    let omitted = if omitted < 0.0 { -omitted } else { omitted };
+    const_root(0.5 * epsilon * leading / omitted, terms)
+}
+
+/// `x^{1/n}` for `x > 0`, `n ≥ 1`, by Newton's iteration in `const` context (start above the root
+/// so the iteration decreases monotonically; it stops when it no longer decreases).
+const fn const_root(x: f64, n: u32) -> f64 {
+    if n <= 1 || x <= 0.0 {
+        return x;
+    }
+    let mut y = if x > 1.0 { x } else { 1.0 };
+    let nf = n as f64;
+    let mut i = 0;
+    while i < 10_000 {
+        let mut p = 1.0; // y^{n-1}
+        let mut k = 1;
+        while k < n {
+            p *= y;
+            k += 1;
+        }
+        let next = ((nf - 1.0) * y + x / p) / nf;
+        if next >= y {
+            break;
+        }
+        y = next;
+        i += 1;
+    }
+    y
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn const_root_inverts_power() {
+        for &(x, n) in &[(2.0, 2), (1e-16, 6), (3.5e-7, 3), (8.0, 3), (1e-300, 4)] {
+            let r = const_root(x, n);
+            let back = (0..n).fold(1.0, |acc, _| acc * r);
+            assert!(
+                (back - x).abs() <= 4.0 * f64::EPSILON * x,
+                "{x} {n} {r} {back}"
+            );
+        }
+    }
+
+    #[test]
+    fn taylor_cutoff_bounds_the_omitted_term() {
+        // sin θ/θ with three terms: omitted −θ⁶/5040 must be ≤ ε/2 at the cutoff.
+        let x = taylor_cutoff(f64::EPSILON, 1.0, 1.0 / 5040.0, 3);
+        assert!((x * x * x / 5040.0 - 0.5 * f64::EPSILON).abs() < 1e-3 * f64::EPSILON);
+    }
+
+    /// Error of `sincos_f32` against `f64`, sampled densely; also the relative error near zero.
+    #[test]
+    fn sincos_f32_matches_f64() {
+        let mut worst_abs = 0.0f64;
+        let n = 400_000;
+        for i in 0..=n {
+            let x = -8192.0 + 16384.0 * (i as f64) / (n as f64);
+            let xf = x as f32;
+            let (s, c) = sincos_f32(xf);
+            let xe = xf as f64;
+            worst_abs = worst_abs.max((s as f64 - xe.sin()).abs());
+            worst_abs = worst_abs.max((c as f64 - xe.cos()).abs());
+        }
+        assert!(worst_abs <= f32::EPSILON as f64, "abs {worst_abs}");
+        let mut worst_rel = 0.0f64;
+        for i in 1..=100_000 {
+            let xf = (i as f32) * (core::f32::consts::FRAC_PI_4 / 100_000.0);
+            for x in [xf, -xf, xf * 1e-6, xf * 1e-30] {
+                let (s, _) = sincos_f32(x);
+                let e = (x as f64).sin();
+                worst_rel = worst_rel.max(((s as f64 - e) / e).abs());
+            }
+        }
+        assert!(worst_rel <= f32::EPSILON as f64, "rel {worst_rel}");
+    }
+
+    #[test]
+    fn sincos_f32_non_finite_is_nan() {
+        for x in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            let (s, c) = sincos_f32(x);
+            assert!(s.is_nan() && c.is_nan());
+        }
+        let (s, c) = sincos_f32(3.0e38);
+        assert!(s.is_finite() && c.is_finite());
+    }
+}

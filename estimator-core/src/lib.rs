@@ -11,6 +11,8 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod eskf;
+pub mod gn;
 pub mod lie;
 pub mod scalar;
 

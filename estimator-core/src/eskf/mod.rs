@@ -1,0 +1,1 @@
+//! On-manifold error-state Kalman filter (work in progress).

@@ -1,0 +1,1 @@
+//! Fixed-size Gauss-Newton / Levenberg-Marquardt on manifolds (work in progress).

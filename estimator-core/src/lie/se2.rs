@@ -213,7 +213,9 @@ impl<T: Real> LieGroup<T> for Se2<T> {
     fn try_from_matrix(m: &Matrix3<T>) -> Option<Self> {
         let tol = T::lit(ORTHOGONALITY_TOLERANCE);
         let bottom = m.m31.abs() + m.m32.abs() + (m.m33 - T::one()).abs();
-        if !(bottom <= tol) {
+        // Written so that NaN (which compares false) is rejected too.
+        let bottom_ok = bottom <= tol;
+        if !bottom_ok {
             return None;
         }
         let r = So2::try_from_matrix(&m.fixed_view::<2, 2>(0, 0).into_owned())?;

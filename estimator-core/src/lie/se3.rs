@@ -221,7 +221,9 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     fn try_from_matrix(m: &Matrix4<T>) -> Option<Self> {
         let tol = T::lit(ORTHOGONALITY_TOLERANCE);
         let bottom = m.m41.abs() + m.m42.abs() + m.m43.abs() + (m.m44 - T::one()).abs();
-        if !(bottom <= tol) {
+        // Written so that NaN (which compares false) is rejected too.
+        let bottom_ok = bottom <= tol;
+        if !bottom_ok {
             return None;
         }
         let r = So3::try_from_matrix(&m.fixed_view::<3, 3>(0, 0).into_owned())?;

@@ -161,7 +161,10 @@ impl<T: Real> LieGroup<T> for So2<T> {
         }
         let err = (m.transpose() * m - Matrix2::identity()).norm_squared();
         let tol = T::lit(ORTHOGONALITY_TOLERANCE);
-        if !(err <= tol * tol) || m.determinant() <= T::zero() {
+        // Written so that NaN (which compares false) is rejected too.
+        let orthogonal = err <= tol * tol;
+        let proper = m.determinant() > T::zero();
+        if !(orthogonal && proper) {
             return None;
         }
         Self::from_cos_sin(m.m11 + m.m22, m.m21 - m.m12)

@@ -277,7 +277,10 @@ impl<T: Real> LieGroup<T> for So3<T> {
         }
         let err = (m.transpose() * m - Matrix3::identity()).norm_squared();
         let tol = T::lit(ORTHOGONALITY_TOLERANCE);
-        if !(err <= tol * tol) || m.determinant() <= T::zero() {
+        // Written so that NaN (which compares false) is rejected too.
+        let orthogonal = err <= tol * tol;
+        let proper = m.determinant() > T::zero();
+        if !(orthogonal && proper) {
             return None;
         }
         Self::quaternion_from_matrix(m)

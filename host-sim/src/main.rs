@@ -1,8 +1,54 @@
-//! The `host-sim` command line. The simulator itself is not written yet; until it is, this
-//! binary says so and exits with a non-zero status rather than pretending to run.
-fn main() {
-    eprintln!(
-        "host-sim: the simulator is not implemented yet; run `cargo run --release --example lie_tour` for a tour of the Lie-group core"
-    );
-    std::process::exit(2);
+//! The `host-sim` binary: see `host_sim::cli`.
+
+mod cli;
+
+use clap::Parser;
+use cli::{Cli, Command};
+use host_sim::dataset::write::simulate;
+use host_sim::scenario::{builtin_scenarios, Scenario};
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let command = cli.command.unwrap_or(Command::Run {
+        scenario: "default".into(),
+        seed: 1,
+        out: "out".into(),
+    });
+    match execute(command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("host-sim: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
+    match command {
+        Command::Scenarios => {
+            for s in builtin_scenarios() {
+                println!("{:<14} {}", s.name, s.description);
+            }
+            Ok(())
+        }
+        Command::Simulate {
+            scenario,
+            seed,
+            out,
+        } => {
+            let sc = Scenario::load(&scenario)?;
+            simulate(&sc, seed, &out)?;
+            println!(
+                "wrote {} ({} s of '{}', seed {seed})",
+                out.display(),
+                sc.duration_s,
+                sc.name
+            );
+            Ok(())
+        }
+        Command::Run { .. } | Command::Replay { .. } | Command::Montecarlo { .. } => {
+            Err("the filter replay is not wired in yet".into())
+        }
+    }
 }

@@ -1,0 +1,530 @@
+//! Reading a dataset folder as one time-ordered stream of sensor events, holding one row of
+//! look-ahead per file (memory does not grow with the run).
+
+use super::yaml::SensorYaml;
+use super::DatasetError;
+use estimator_core::lie::{LieGroup, Se3, So3};
+use nalgebra::{Matrix4, Vector2, Vector3};
+use std::collections::HashMap;
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+/// IMU noise parameters from `imu0/sensor.yaml` (continuous time, Kalibr units).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImuParams {
+    /// Rate, Hz.
+    pub rate_hz: f64,
+    /// rad/s/√Hz.
+    pub gyroscope_noise_density: f64,
+    /// rad/s²/√Hz.
+    pub gyroscope_random_walk: f64,
+    /// m/s²/√Hz.
+    pub accelerometer_noise_density: f64,
+    /// m/s³/√Hz.
+    pub accelerometer_random_walk: f64,
+}
+
+/// Magnetometer parameters from `mag0/sensor.yaml`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MagParams {
+    /// Rate, Hz.
+    pub rate_hz: f64,
+    /// White noise per sample and axis, µT.
+    pub sigma: f64,
+    /// World-frame reference field, µT.
+    pub reference_field: Vector3<f64>,
+}
+
+/// GNSS parameters from `gnss0/sensor.yaml` (optional file: defaults to no lever arm).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GnssParams {
+    /// Antenna lever arm in the body frame, m.
+    pub lever_arm: Vector3<f64>,
+}
+
+/// Camera parameters from `cam0/sensor.yaml` and the landmark map from `cam0/landmarks.csv`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraParams {
+    /// `[fu, fv, cu, cv]`.
+    pub intrinsics: [f64; 4],
+    /// Body-from-camera.
+    pub body_from_camera: Se3<f64>,
+    /// Pixel noise, px.
+    pub sigma_px: f64,
+    /// Landmarks by id, world frame.
+    pub landmarks: HashMap<u64, Vector3<f64>>,
+}
+
+/// Barometer parameters from `baro0/sensor.yaml`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BaroParams {
+    /// White noise per sample, m.
+    pub sigma: f64,
+}
+
+/// What a dataset folder holds.
+#[derive(Clone, Debug)]
+pub struct Dataset {
+    /// The folder.
+    pub dir: PathBuf,
+    /// IMU parameters.
+    pub imu: ImuParams,
+    /// Magnetometer, if present.
+    pub mag: Option<MagParams>,
+    /// GNSS, if present.
+    pub gnss: Option<GnssParams>,
+    /// Camera, if present.
+    pub camera: Option<CameraParams>,
+    /// Barometer, if present.
+    pub baro: Option<BaroParams>,
+    /// Whether ground truth is present.
+    pub has_groundtruth: bool,
+}
+
+/// One sensor event.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Event {
+    /// An IMU sample.
+    Imu {
+        /// ns.
+        t_ns: u64,
+        /// rad/s.
+        gyro: Vector3<f64>,
+        /// m/s².
+        accel: Vector3<f64>,
+    },
+    /// A magnetometer sample, µT.
+    Mag {
+        /// ns.
+        t_ns: u64,
+        /// µT, body frame.
+        field: Vector3<f64>,
+    },
+    /// A GNSS fix.
+    Gnss {
+        /// ns.
+        t_ns: u64,
+        /// m, world.
+        position: Vector3<f64>,
+        /// m/s, world.
+        velocity: Vector3<f64>,
+        /// m.
+        sigma_p: f64,
+        /// m/s.
+        sigma_v: f64,
+    },
+    /// The observations of one camera frame.
+    Camera {
+        /// ns.
+        t_ns: u64,
+        /// `(landmark id, pixel)`.
+        observations: Vec<(u64, Vector2<f64>)>,
+    },
+    /// A barometric altitude, m.
+    Baro {
+        /// ns.
+        t_ns: u64,
+        /// m.
+        altitude: f64,
+    },
+}
+
+impl Event {
+    /// The event's timestamp, ns.
+    #[must_use]
+    pub fn t_ns(&self) -> u64 {
+        match self {
+            Event::Imu { t_ns, .. }
+            | Event::Mag { t_ns, .. }
+            | Event::Gnss { t_ns, .. }
+            | Event::Camera { t_ns, .. }
+            | Event::Baro { t_ns, .. } => *t_ns,
+        }
+    }
+}
+
+/// A CSV file read row by row, with its header skipped and every row checked for its column
+/// count, numbers and strictly (or, for camera frames, weakly) increasing timestamps.
+pub struct Rows {
+    path: PathBuf,
+    reader: csv::Reader<File>,
+    record: csv::StringRecord,
+    columns: usize,
+    last_t: Option<u64>,
+    allow_equal: bool,
+}
+
+impl Rows {
+    /// Opens `path`, expecting `columns` columns.
+    pub fn open(path: &Path, columns: usize, allow_equal: bool) -> Result<Self, DatasetError> {
+        let file = File::open(path).map_err(|e| DatasetError::file(path, e))?;
+        let reader = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .trim(csv::Trim::All)
+            .from_reader(file);
+        Ok(Self {
+            path: path.to_path_buf(),
+            reader,
+            record: csv::StringRecord::new(),
+            columns,
+            last_t: None,
+            allow_equal,
+        })
+    }
+
+    /// The next data row as `(line, timestamp, values)`; `None` at the end.
+    pub fn next_row(&mut self) -> Result<Option<(u64, u64, Vec<f64>)>, DatasetError> {
+        loop {
+            let more = self.reader.read_record(&mut self.record).map_err(|e| {
+                let line = e.position().map_or(0, |p| p.line());
+                DatasetError::at(&self.path, line, e.to_string())
+            })?;
+            if !more {
+                return Ok(None);
+            }
+            let line = self.record.position().map_or(0, |p| p.line());
+            let first = self.record.get(0).unwrap_or("");
+            // The header: the first line, starting with '#' or not a number.
+            if line == 1 && (first.starts_with('#') || first.parse::<u64>().is_err()) {
+                continue;
+            }
+            if first.is_empty() && self.record.len() <= 1 {
+                continue; // blank line
+            }
+            if self.record.len() != self.columns {
+                return Err(DatasetError::at(
+                    &self.path,
+                    line,
+                    format!(
+                        "expected {} columns, got {}",
+                        self.columns,
+                        self.record.len()
+                    ),
+                ));
+            }
+            let t: u64 = first.parse().map_err(|_| {
+                DatasetError::at(
+                    &self.path,
+                    line,
+                    format!("timestamp '{first}' is not an integer number of ns"),
+                )
+            })?;
+            if let Some(last) = self.last_t {
+                if t < last || (t == last && !self.allow_equal) {
+                    let what = if t == last {
+                        "duplicated"
+                    } else {
+                        "non-monotonic"
+                    };
+                    return Err(DatasetError::at(
+                        &self.path,
+                        line,
+                        format!("{what} timestamp {t} (previous {last})"),
+                    ));
+                }
+            }
+            self.last_t = Some(t);
+            let mut values = Vec::with_capacity(self.columns - 1);
+            for (i, field) in self.record.iter().enumerate().skip(1) {
+                let v: f64 = field.parse().map_err(|_| {
+                    DatasetError::at(
+                        &self.path,
+                        line,
+                        format!("column {}: '{field}' is not a number", i + 1),
+                    )
+                })?;
+                if !v.is_finite() {
+                    return Err(DatasetError::at(
+                        &self.path,
+                        line,
+                        format!("column {}: '{field}' is not finite", i + 1),
+                    ));
+                }
+                values.push(v);
+            }
+            return Ok(Some((line, t, values)));
+        }
+    }
+}
+
+fn v3(v: &[f64], i: usize) -> Vector3<f64> {
+    Vector3::new(v[i], v[i + 1], v[i + 2])
+}
+
+impl Dataset {
+    /// Reads the folder's `sensor.yaml` files and the landmark map.
+    pub fn open(dir: &Path) -> Result<Self, DatasetError> {
+        let imu_yaml = dir.join("imu0/sensor.yaml");
+        if !dir.join("imu0/data.csv").is_file() {
+            return Err(DatasetError::file(
+                &dir.join("imu0/data.csv"),
+                "missing (every dataset needs imu0)",
+            ));
+        }
+        let y = SensorYaml::read(&imu_yaml)?;
+        let imu = ImuParams {
+            rate_hz: y.f64("rate_hz")?,
+            gyroscope_noise_density: y.f64("gyroscope_noise_density")?,
+            gyroscope_random_walk: y.f64("gyroscope_random_walk")?,
+            accelerometer_noise_density: y.f64("accelerometer_noise_density")?,
+            accelerometer_random_walk: y.f64("accelerometer_random_walk")?,
+        };
+        let mag = if dir.join("mag0/data.csv").is_file() {
+            let y = SensorYaml::read(&dir.join("mag0/sensor.yaml"))?;
+            let r = y.list("reference_field", 3)?;
+            Some(MagParams {
+                rate_hz: y.f64("rate_hz")?,
+                sigma: y.f64("sigma")?,
+                reference_field: Vector3::new(r[0], r[1], r[2]),
+            })
+        } else {
+            None
+        };
+        let gnss = if dir.join("gnss0/data.csv").is_file() {
+            let path = dir.join("gnss0/sensor.yaml");
+            let lever_arm = if path.is_file() {
+                let y = SensorYaml::read(&path)?;
+                match y.list("lever_arm", 3) {
+                    Ok(l) => Vector3::new(l[0], l[1], l[2]),
+                    Err(_) => Vector3::zeros(),
+                }
+            } else {
+                Vector3::zeros()
+            };
+            Some(GnssParams { lever_arm })
+        } else {
+            None
+        };
+        let camera = if dir.join("cam0/observations.csv").is_file() {
+            let ypath = dir.join("cam0/sensor.yaml");
+            let y = SensorYaml::read(&ypath)?;
+            let k = y.list("intrinsics", 4)?;
+            let t = y.list("T_BS", 16)?;
+            let body_from_camera = Se3::try_from_matrix(&Matrix4::from_row_slice(&t))
+                .ok_or_else(|| DatasetError::file(&ypath, "T_BS is not a rigid motion"))?;
+            let lpath = dir.join("cam0/landmarks.csv");
+            let mut rows = Rows::open(&lpath, 4, false)?;
+            let mut landmarks = HashMap::new();
+            while let Some((line, id, v)) = rows.next_row()? {
+                if landmarks.insert(id, v3(&v, 0)).is_some() {
+                    return Err(DatasetError::at(
+                        &lpath,
+                        line,
+                        format!("duplicated landmark id {id}"),
+                    ));
+                }
+            }
+            Some(CameraParams {
+                intrinsics: [k[0], k[1], k[2], k[3]],
+                body_from_camera,
+                sigma_px: y.f64_or("sigma_px", 1.0)?,
+                landmarks,
+            })
+        } else {
+            None
+        };
+        let baro = if dir.join("baro0/data.csv").is_file() {
+            let y = SensorYaml::read(&dir.join("baro0/sensor.yaml"))?;
+            Some(BaroParams {
+                sigma: y.f64("sigma")?,
+            })
+        } else {
+            None
+        };
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            imu,
+            mag,
+            gnss,
+            camera,
+            baro,
+            has_groundtruth: dir.join("state_groundtruth_estimate0/data.csv").is_file(),
+        })
+    }
+
+    /// The merged, time-ordered event stream.
+    pub fn events(&self) -> Result<EventStream, DatasetError> {
+        let open = |rel: &str, cols: usize, eq: bool| -> Result<Option<Source>, DatasetError> {
+            let p = self.dir.join(rel);
+            if p.is_file() {
+                Ok(Some(Source {
+                    rows: Rows::open(&p, cols, eq)?,
+                    ahead: None,
+                }))
+            } else {
+                Ok(None)
+            }
+        };
+        Ok(EventStream {
+            imu: open("imu0/data.csv", 7, false)?,
+            mag: if self.mag.is_some() {
+                open("mag0/data.csv", 4, false)?
+            } else {
+                None
+            },
+            gnss: if self.gnss.is_some() {
+                open("gnss0/data.csv", 9, false)?
+            } else {
+                None
+            },
+            cam: if self.camera.is_some() {
+                open("cam0/observations.csv", 4, true)?
+            } else {
+                None
+            },
+            baro: if self.baro.is_some() {
+                open("baro0/data.csv", 2, false)?
+            } else {
+                None
+            },
+        })
+    }
+}
+
+struct Source {
+    rows: Rows,
+    ahead: Option<(u64, u64, Vec<f64>)>,
+}
+
+impl Source {
+    fn peek(&mut self) -> Result<Option<u64>, DatasetError> {
+        if self.ahead.is_none() {
+            self.ahead = self.rows.next_row()?;
+        }
+        Ok(self.ahead.as_ref().map(|(_, t, _)| *t))
+    }
+}
+
+/// The merged stream: at equal timestamps the IMU comes first (the filter predicts to the
+/// measurement time, then updates).
+pub struct EventStream {
+    imu: Option<Source>,
+    mag: Option<Source>,
+    gnss: Option<Source>,
+    cam: Option<Source>,
+    baro: Option<Source>,
+}
+
+impl EventStream {
+    fn step(&mut self) -> Result<Option<Event>, DatasetError> {
+        let mut best: Option<(u64, usize)> = None;
+        for (i, src) in [
+            &mut self.imu,
+            &mut self.mag,
+            &mut self.gnss,
+            &mut self.cam,
+            &mut self.baro,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            if let Some(s) = src {
+                if let Some(t) = s.peek()? {
+                    if best.is_none_or(|(bt, _)| t < bt) {
+                        best = Some((t, i));
+                    }
+                }
+            }
+        }
+        let Some((_, which)) = best else {
+            return Ok(None);
+        };
+        let take = |s: &mut Option<Source>| s.as_mut().and_then(|s| s.ahead.take());
+        Ok(match which {
+            0 => take(&mut self.imu).map(|(_, t, v)| Event::Imu {
+                t_ns: t,
+                gyro: v3(&v, 0),
+                accel: v3(&v, 3),
+            }),
+            1 => take(&mut self.mag).map(|(_, t, v)| Event::Mag {
+                t_ns: t,
+                field: v3(&v, 0),
+            }),
+            2 => take(&mut self.gnss).map(|(_, t, v)| Event::Gnss {
+                t_ns: t,
+                position: v3(&v, 0),
+                velocity: v3(&v, 3),
+                sigma_p: v[6],
+                sigma_v: v[7],
+            }),
+            3 => {
+                let Some(src) = self.cam.as_mut() else {
+                    return Ok(None);
+                };
+                let Some((_, t, v)) = src.ahead.take() else {
+                    return Ok(None);
+                };
+                let mut observations = vec![(v[0] as u64, Vector2::new(v[1], v[2]))];
+                while src.peek()? == Some(t) {
+                    if let Some((_, _, v)) = src.ahead.take() {
+                        observations.push((v[0] as u64, Vector2::new(v[1], v[2])));
+                    }
+                }
+                Some(Event::Camera {
+                    t_ns: t,
+                    observations,
+                })
+            }
+            _ => take(&mut self.baro).map(|(_, t, v)| Event::Baro {
+                t_ns: t,
+                altitude: v[0],
+            }),
+        })
+    }
+}
+
+impl Iterator for EventStream {
+    type Item = Result<Event, DatasetError>;
+    fn next(&mut self) -> Option<Self::Item> {
+        self.step().transpose()
+    }
+}
+
+/// One ground-truth row.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Truth {
+    /// ns.
+    pub t_ns: u64,
+    /// Position, m.
+    pub position: Vector3<f64>,
+    /// `world_from_body`.
+    pub attitude: So3<f64>,
+    /// Velocity, m/s.
+    pub velocity: Vector3<f64>,
+    /// Gyro bias, rad/s.
+    pub gyro_bias: Vector3<f64>,
+    /// Accelerometer bias, m/s².
+    pub accel_bias: Vector3<f64>,
+}
+
+/// The ground truth, streamed.
+pub struct TruthStream {
+    rows: Rows,
+}
+
+impl TruthStream {
+    /// Opens `state_groundtruth_estimate0/data.csv`.
+    pub fn open(dir: &Path) -> Result<Self, DatasetError> {
+        Ok(Self {
+            rows: Rows::open(&dir.join("state_groundtruth_estimate0/data.csv"), 17, false)?,
+        })
+    }
+
+    /// The next row.
+    pub fn next_truth(&mut self) -> Result<Option<Truth>, DatasetError> {
+        let Some((line, t, v)) = self.rows.next_row()? else {
+            return Ok(None);
+        };
+        let attitude = So3::from_wxyz(v[3], v[4], v[5], v[6])
+            .ok_or_else(|| DatasetError::at(&self.rows.path, line, "quaternion of zero norm"))?;
+        Ok(Some(Truth {
+            t_ns: t,
+            position: v3(&v, 0),
+            attitude: attitude.normalize(),
+            velocity: v3(&v, 7),
+            gyro_bias: v3(&v, 10),
+            accel_bias: v3(&v, 13),
+        }))
+    }
+}

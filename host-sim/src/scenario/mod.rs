@@ -1,0 +1,264 @@
+//! Scenarios: a trajectory, the sensors that watch it, and the accuracy a filter must reach on it.
+//!
+//! Built-in scenarios are listed by `host-sim scenarios`; a scenario can also be read from a TOML
+//! file with the same fields (`host-sim run --scenario path/to/file.toml`), every sensor table
+//! optional, every field defaulted.
+
+use crate::sensors::baro::BaroConfig;
+use crate::sensors::camera::CameraConfig;
+use crate::sensors::gnss::GnssConfig;
+use crate::sensors::imu::ImuConfig;
+use crate::sensors::mag::MagConfig;
+use crate::trajectory::{builtin, Trajectory};
+use serde::{Deserialize, Serialize};
+
+/// Accuracy ceilings the end-to-end tests hold a filter to on this scenario.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Ceilings {
+    /// Position RMSE (ATE), m.
+    pub ate_m: f64,
+    /// Attitude RMSE, degrees.
+    pub attitude_deg: f64,
+}
+
+impl Default for Ceilings {
+    fn default() -> Self {
+        Self {
+            ate_m: f64::INFINITY,
+            attitude_deg: f64::INFINITY,
+        }
+    }
+}
+
+/// A complete scenario.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Scenario {
+    /// Name.
+    pub name: String,
+    /// One line for `host-sim scenarios`.
+    pub description: String,
+    /// Duration, s.
+    pub duration_s: f64,
+    /// Static period at the start, s.
+    pub static_s: f64,
+    /// A built-in trajectory shape (see `trajectory::SHAPES`), used when `trajectory` is absent.
+    pub shape: String,
+    /// An explicit trajectory, overriding `shape`.
+    pub trajectory: Option<Trajectory>,
+    /// Gravity in the world frame, m/s².
+    pub gravity: [f64; 3],
+    /// First timestamp, ns.
+    pub start_ns: u64,
+    /// The IMU (always present).
+    pub imu: ImuConfig,
+    /// Magnetometer, if any.
+    pub mag: Option<MagConfig>,
+    /// GNSS, if any.
+    pub gnss: Option<GnssConfig>,
+    /// Camera, if any.
+    pub camera: Option<CameraConfig>,
+    /// Barometer, if any.
+    pub baro: Option<BaroConfig>,
+    /// Accuracy ceilings.
+    pub ceilings: Ceilings,
+}
+
+impl Default for Scenario {
+    fn default() -> Self {
+        Self {
+            name: "custom".into(),
+            description: String::new(),
+            duration_s: 60.0,
+            static_s: 5.0,
+            shape: "figure8".into(),
+            trajectory: None,
+            gravity: [0.0, 0.0, -9.81],
+            start_ns: 1_000_000_000,
+            imu: ImuConfig::default(),
+            mag: None,
+            gnss: None,
+            camera: None,
+            baro: None,
+            ceilings: Ceilings::default(),
+        }
+    }
+}
+
+/// Errors of scenario lookup.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    /// No built-in scenario has that name and no such file exists.
+    #[error("unknown scenario '{0}' (see `host-sim scenarios`, or give a .toml file)")]
+    Unknown(String),
+    /// The TOML file could not be read or parsed.
+    #[error("{path}: {message}")]
+    File {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl Scenario {
+    /// The trajectory (explicit, or the built-in shape).
+    pub fn trajectory(&self) -> Result<Trajectory, ScenarioError> {
+        match &self.trajectory {
+            Some(t) => Ok(t.clone()),
+            None => builtin(&self.shape, self.static_s)
+                .ok_or_else(|| ScenarioError::Unknown(format!("shape {}", self.shape))),
+        }
+    }
+
+    /// A built-in scenario by name, or a TOML file by path.
+    pub fn load(name: &str) -> Result<Self, ScenarioError> {
+        if let Some(s) = builtin_scenarios().into_iter().find(|s| s.name == name) {
+            return Ok(s);
+        }
+        if name.ends_with(".toml") || std::path::Path::new(name).is_file() {
+            let text = std::fs::read_to_string(name).map_err(|e| ScenarioError::File {
+                path: name.into(),
+                message: e.to_string(),
+            })?;
+            let mut s: Scenario = toml::from_str(&text).map_err(|e| ScenarioError::File {
+                path: name.into(),
+                message: e.to_string().replace('\n', " "),
+            })?;
+            if s.name == "custom" {
+                s.name = name.into();
+            }
+            s.trajectory()?;
+            return Ok(s);
+        }
+        Err(ScenarioError::Unknown(name.into()))
+    }
+}
+
+/// The built-in scenarios. `default` is what `host-sim run` runs with no arguments.
+#[must_use]
+pub fn builtin_scenarios() -> Vec<Scenario> {
+    let deg = std::f64::consts::PI / 180.0;
+    let base = Scenario::default();
+    // Sensors exactly as the filter models them (no quantization, scale error or turn-on bias
+    // beyond the filter's prior), for the Monte-Carlo consistency checks.
+    let matched_imu = ImuConfig {
+        gyro_lsb: 0.0,
+        accel_lsb: 0.0,
+        gyro_range: 0.0,
+        accel_range: 0.0,
+        ..ImuConfig::default()
+    };
+    vec![
+        Scenario {
+            name: "default".into(),
+            description: "60 s figure-eight flight; IMU 200 Hz, magnetometer 50 Hz, GNSS 1 m at 5 Hz".into(),
+            mag: Some(MagConfig::default()),
+            gnss: Some(GnssConfig::default()),
+            ceilings: Ceilings { ate_m: 0.6, attitude_deg: 1.0 },
+            ..base.clone()
+        },
+        Scenario {
+            name: "static".into(),
+            description: "60 s at rest; IMU, magnetometer, GNSS".into(),
+            shape: "static".into(),
+            mag: Some(MagConfig::default()),
+            gnss: Some(GnssConfig::default()),
+            ceilings: Ceilings { ate_m: 0.6, attitude_deg: 1.0 },
+            ..base.clone()
+        },
+        Scenario {
+            name: "hover".into(),
+            description: "60 s hover with 25 Hz vibration; IMU, magnetometer, GNSS, barometer".into(),
+            shape: "hover".into(),
+            mag: Some(MagConfig::default()),
+            gnss: Some(GnssConfig::default()),
+            baro: Some(BaroConfig::default()),
+            ceilings: Ceilings { ate_m: 0.6, attitude_deg: 1.0 },
+            ..base.clone()
+        },
+        Scenario {
+            name: "car".into(),
+            description: "60 s planar drive on a 15 m circle at 2.5 m/s; IMU, GNSS with 0.3 m lever arm, magnetometer".into(),
+            shape: "car".into(),
+            mag: Some(MagConfig::default()),
+            gnss: Some(GnssConfig { lever_arm: [0.3, 0.0, 0.5], ..GnssConfig::default() }),
+            ceilings: Ceilings { ate_m: 0.6, attitude_deg: 1.5 },
+            ..base.clone()
+        },
+        Scenario {
+            name: "coning".into(),
+            description: "60 s aggressive 2 Hz coning at 0.3 rad; IMU, magnetometer (attitude only)".into(),
+            shape: "coning".into(),
+            mag: Some(MagConfig::default()),
+            ceilings: Ceilings { ate_m: f64::INFINITY, attitude_deg: 1.5 },
+            ..base.clone()
+        },
+        Scenario {
+            name: "pitch90".into(),
+            description: "60 s pitching through ±90°; IMU, magnetometer, GNSS".into(),
+            shape: "pitch90".into(),
+            mag: Some(MagConfig::default()),
+            gnss: Some(GnssConfig::default()),
+            ceilings: Ceilings { ate_m: 0.6, attitude_deg: 1.5 },
+            ..base.clone()
+        },
+        Scenario {
+            name: "handheld_ahrs".into(),
+            description: "60 s hand-held motion, 0.5°/s gyro turn-on bias; IMU 200 Hz, magnetometer 50 Hz (attitude only)".into(),
+            shape: "handheld".into(),
+            imu: ImuConfig { gyro_turn_on_bias: 0.5 * deg, ..ImuConfig::default() },
+            mag: Some(MagConfig::default()),
+            ceilings: Ceilings { ate_m: f64::INFINITY, attitude_deg: 1.2 },
+            ..base.clone()
+        },
+        Scenario {
+            name: "handheld_ins".into(),
+            description: "60 s hand-held motion; IMU 200 Hz, magnetometer 50 Hz, GNSS 1 m at 5 Hz".into(),
+            shape: "handheld".into(),
+            mag: Some(MagConfig::default()),
+            gnss: Some(GnssConfig::default()),
+            ceilings: Ceilings { ate_m: 0.5, attitude_deg: 1.0 },
+            ..base.clone()
+        },
+        Scenario {
+            name: "gnss_faults".into(),
+            description: "figure-eight with a 10 s GNSS outage, 5 % gross outliers and a magnetic disturbance".into(),
+            mag: Some(MagConfig { disturbances: vec![[30.0, 36.0, 25.0]], ..MagConfig::default() }),
+            gnss: Some(GnssConfig {
+                outages: vec![[20.0, 30.0]],
+                outlier_probability: 0.05,
+                ..GnssConfig::default()
+            }),
+            ceilings: Ceilings { ate_m: 1.5, attitude_deg: 2.0 },
+            ..base.clone()
+        },
+        Scenario {
+            name: "camera".into(),
+            description: "hover in front of 300 known landmarks; IMU and a 10 Hz camera".into(),
+            shape: "hover".into(),
+            camera: Some(CameraConfig::default()),
+            ceilings: Ceilings { ate_m: 0.3, attitude_deg: 1.0 },
+            ..base.clone()
+        },
+        Scenario {
+            name: "matched_ins".into(),
+            description: "noise exactly as the filter models it (Monte-Carlo consistency); figure-eight, IMU, magnetometer, GNSS".into(),
+            imu: matched_imu.clone(),
+            mag: Some(MagConfig::default()),
+            gnss: Some(GnssConfig { sigma_vertical: 1.0, ..GnssConfig::default() }),
+            ceilings: Ceilings { ate_m: 0.6, attitude_deg: 1.0 },
+            ..base.clone()
+        },
+        Scenario {
+            name: "matched_ahrs".into(),
+            description: "noise exactly as the filter models it (Monte-Carlo consistency); hand-held, IMU, magnetometer".into(),
+            shape: "handheld".into(),
+            imu: matched_imu,
+            mag: Some(MagConfig::default()),
+            ceilings: Ceilings { ate_m: f64::INFINITY, attitude_deg: 1.2 },
+            ..base
+        },
+    ]
+}

@@ -1,0 +1,50 @@
+//! A barometric altimeter: `h̃ = p_z + b + σ n`, with a constant bias `b` drawn at start.
+//! Defaults: a BMP388 class sensor (about 0.1 m rms at 25 Hz after its filter, ±0.5 m offset).
+
+use super::Noise;
+use crate::trajectory::Kinematics;
+use serde::{Deserialize, Serialize};
+
+/// Barometer parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct BaroConfig {
+    /// Sample rate, Hz.
+    pub rate_hz: f64,
+    /// White noise per sample, m.
+    pub sigma: f64,
+    /// 1σ of the constant offset, m.
+    pub bias_sigma: f64,
+}
+
+impl Default for BaroConfig {
+    fn default() -> Self {
+        Self {
+            rate_hz: 25.0,
+            sigma: 0.1,
+            bias_sigma: 0.5,
+        }
+    }
+}
+
+/// The barometer model.
+#[derive(Clone, Debug)]
+pub struct Baro {
+    cfg: BaroConfig,
+    noise: Noise,
+    bias: f64,
+}
+
+impl Baro {
+    /// A new barometer.
+    #[must_use]
+    pub fn new(cfg: BaroConfig, mut noise: Noise) -> Self {
+        let bias = noise.normal() * cfg.bias_sigma;
+        Self { cfg, noise, bias }
+    }
+
+    /// Altitude, m.
+    pub fn sample(&mut self, k: &Kinematics) -> f64 {
+        k.position.z + self.bias + self.noise.normal() * self.cfg.sigma
+    }
+}

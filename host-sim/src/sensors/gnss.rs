@@ -1,0 +1,119 @@
+//! A GNSS receiver: position and velocity fixes with noise, latency, outages and gross outliers.
+//!
+//! The antenna sits at the body-frame lever arm `l`: `p_ant = p + R l`, `v_ant = v + R(ω_b × l)`.
+//! A fix stamped `t` describes the state at `t − latency`. During an outage no fix is produced; a
+//! gross outlier adds `outlier_m` metres in a random horizontal direction. The reported
+//! `sigma_p`, `sigma_v` are the configured 1-σ (what a receiver would report), whatever the
+//! outliers. Defaults: a u-blox M8/M9 class receiver at 5 Hz, 1 m horizontal and 1.5 m vertical.
+
+use super::Noise;
+use crate::trajectory::Kinematics;
+use estimator_core::lie::LieGroup;
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// GNSS parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct GnssConfig {
+    /// Fix rate, Hz.
+    pub rate_hz: f64,
+    /// Horizontal position noise, m (1σ).
+    pub sigma_horizontal: f64,
+    /// Vertical position noise, m (1σ).
+    pub sigma_vertical: f64,
+    /// Velocity noise, m/s (1σ per axis).
+    pub sigma_velocity: f64,
+    /// Latency of the fix, s.
+    pub latency_s: f64,
+    /// Antenna lever arm in the body frame, m.
+    pub lever_arm: [f64; 3],
+    /// Outages `[start_s, end_s]`.
+    pub outages: Vec<[f64; 2]>,
+    /// Probability that a fix is a gross outlier.
+    pub outlier_probability: f64,
+    /// Size of a gross outlier, m.
+    pub outlier_m: f64,
+}
+
+impl Default for GnssConfig {
+    fn default() -> Self {
+        Self {
+            rate_hz: 5.0,
+            sigma_horizontal: 1.0,
+            sigma_vertical: 1.5,
+            sigma_velocity: 0.1,
+            latency_s: 0.0,
+            lever_arm: [0.0; 3],
+            outages: Vec::new(),
+            outlier_probability: 0.0,
+            outlier_m: 20.0,
+        }
+    }
+}
+
+/// One GNSS fix (world frame).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GnssFix {
+    /// Antenna position, m.
+    pub position: Vector3<f64>,
+    /// Antenna velocity, m/s.
+    pub velocity: Vector3<f64>,
+    /// Reported position 1σ, m (the larger of horizontal and vertical).
+    pub sigma_p: f64,
+    /// Reported velocity 1σ, m/s.
+    pub sigma_v: f64,
+}
+
+/// The receiver model.
+#[derive(Clone, Debug)]
+pub struct Gnss {
+    cfg: GnssConfig,
+    noise: Noise,
+}
+
+impl Gnss {
+    /// A new receiver.
+    #[must_use]
+    pub fn new(cfg: GnssConfig, noise: Noise) -> Self {
+        Self { cfg, noise }
+    }
+
+    /// The configuration.
+    #[must_use]
+    pub fn config(&self) -> &GnssConfig {
+        &self.cfg
+    }
+
+    /// A fix of the (already delayed) true state `k`, or `None` during an outage.
+    pub fn sample(&mut self, k: &Kinematics, stamp_s: f64) -> Option<GnssFix> {
+        let c = &self.cfg;
+        // Draw every random number first, so the stream does not depend on outages.
+        let n_p = self.noise.normal3();
+        let n_v = self.noise.normal3();
+        let outlier = self.noise.uniform() < c.outlier_probability;
+        let dir = self.noise.uniform() * std::f64::consts::TAU;
+        if c.outages.iter().any(|o| stamp_s >= o[0] && stamp_s < o[1]) {
+            return None;
+        }
+        let l = Vector3::from(c.lever_arm);
+        let mut position = k.position
+            + k.attitude.act(&l)
+            + Vector3::new(
+                n_p.x * c.sigma_horizontal,
+                n_p.y * c.sigma_horizontal,
+                n_p.z * c.sigma_vertical,
+            );
+        if outlier {
+            position += Vector3::new(dir.cos(), dir.sin(), 0.0) * c.outlier_m;
+        }
+        let velocity =
+            k.velocity + k.attitude.act(&k.omega_body.cross(&l)) + n_v * c.sigma_velocity;
+        Some(GnssFix {
+            position,
+            velocity,
+            sigma_p: c.sigma_horizontal.max(c.sigma_vertical),
+            sigma_v: c.sigma_velocity,
+        })
+    }
+}

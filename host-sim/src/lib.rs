@@ -4,11 +4,16 @@
 //! * [`sensors`]: IMU, magnetometer, GNSS, camera and barometer models.
 //! * [`scenario`]: named and TOML scenarios.
 //! * [`dataset`]: the EuRoC / ASL dataset folder, written and streamed.
+//! * [`metrics`]: streaming scores against ground truth; [`stats`]: chi-square quantiles.
+//! * [`plot`]: the PNG plots.
 #![warn(missing_docs)]
 
 pub mod dataset;
+pub mod metrics;
+pub mod plot;
 pub mod scenario;
 pub mod sensors;
+pub mod stats;
 pub mod trajectory;
 
 pub use estimator_core;

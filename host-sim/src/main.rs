@@ -5,7 +5,10 @@ mod cli;
 use clap::Parser;
 use cli::{Cli, Command};
 use host_sim::dataset::write::simulate;
+use host_sim::metrics::Metrics;
+use host_sim::replay::{replay, ReplayConfig};
 use host_sim::scenario::{builtin_scenarios, Scenario};
+use std::path::Path;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -47,8 +50,90 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             );
             Ok(())
         }
-        Command::Run { .. } | Command::Replay { .. } | Command::Montecarlo { .. } => {
-            Err("the filter replay is not wired in yet".into())
+        Command::Run {
+            scenario,
+            seed,
+            out,
+        } => {
+            let sc = Scenario::load(&scenario)?;
+            let dataset = out.join("dataset");
+            simulate(&sc, seed, &dataset)?;
+            let cfg = ReplayConfig::default();
+            let m = replay(&dataset, &out, &cfg, &sc.name)?;
+            print_summary(&sc.name, seed, &cfg, &m, &out);
+            Ok(())
         }
+        Command::Replay {
+            dataset,
+            out,
+            config,
+        } => {
+            let cfg = match config {
+                Some(path) => {
+                    let text = std::fs::read_to_string(&path)
+                        .map_err(|e| format!("{}: {e}", path.display()))?;
+                    toml::from_str(&text).map_err(|e| {
+                        format!("{}: {}", path.display(), e.to_string().replace('\n', " "))
+                    })?
+                }
+                None => ReplayConfig::default(),
+            };
+            let title = dataset
+                .file_name()
+                .map_or("dataset".into(), |n| n.to_string_lossy().into_owned());
+            let m = replay(&dataset, &out, &cfg, &title)?;
+            print_summary(&title, 0, &cfg, &m, &out);
+            Ok(())
+        }
+        Command::Montecarlo { .. } => Err("montecarlo is not implemented yet".into()),
+    }
+}
+
+fn print_summary(name: &str, seed: u64, cfg: &ReplayConfig, m: &Metrics, out: &Path) {
+    println!("scenario {name}  seed {seed}  precision {}", cfg.precision);
+    println!(
+        "  {:<28} {:>12}",
+        "position RMSE (ATE) [m]",
+        fmt(m.ate_position_rmse_m)
+    );
+    println!(
+        "  {:<28} {:>12}",
+        "attitude RMSE [deg]",
+        fmt(m.attitude_rmse_deg)
+    );
+    println!(
+        "  {:<28} {:>12}",
+        "velocity RMSE [m/s]",
+        fmt(m.velocity_rmse_mps)
+    );
+    for (block, v) in &m.nees_mean {
+        println!(
+            "  {:<28} {:>12}",
+            format!("ANEES {block} (expect 3)"),
+            fmt(*v)
+        );
+    }
+    for (sensor, nis) in &m.nis_mean {
+        let a = m.updates_accepted.get(sensor).copied().unwrap_or(0);
+        let r = m.updates_rejected.get(sensor).copied().unwrap_or(0);
+        println!(
+            "  {:<28} {:>12}   accepted {a}, rejected {r}",
+            format!("mean NIS {sensor}"),
+            fmt(*nis)
+        );
+    }
+    println!(
+        "  {:<28} {:>12}",
+        "filter ns per IMU sample",
+        fmt(m.filter_ns_per_imu_sample)
+    );
+    println!("  outputs in {}", out.display());
+}
+
+fn fmt(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.3}")
+    } else {
+        "-".into()
     }
 }

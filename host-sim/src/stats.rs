@@ -27,7 +27,10 @@ mod tests {
             (0.025, 75.0, 52.942),
         ] {
             let got = chi2_quantile(p, k);
-            assert!(((got - want) / want).abs() < 1e-3, "p={p} k={k}: {got} vs {want}");
+            assert!(
+                ((got - want) / want).abs() < 1e-3,
+                "p={p} k={k}: {got} vs {want}"
+            );
         }
     }
 }

@@ -13,7 +13,13 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 
 /// The blocks of the 15-dimensional error state, in order.
-pub const BLOCKS: [&str; 5] = ["attitude", "velocity", "position", "gyro_bias", "accel_bias"];
+pub const BLOCKS: [&str; 5] = [
+    "attitude",
+    "velocity",
+    "position",
+    "gyro_bias",
+    "accel_bias",
+];
 
 /// The filter's estimate at one instant, in `f64`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -259,7 +265,8 @@ impl Scorer {
                 }
                 s.nis_sum += nis;
                 s.dof_sum += dof as f64;
-                s.history.push(((t_ns.saturating_sub(t0)) as f64 * 1e-9, nis, dof));
+                s.history
+                    .push(((t_ns.saturating_sub(t0)) as f64 * 1e-9, nis, dof));
             }
             Outcome::Refused => s.refused += 1,
         }
@@ -273,18 +280,36 @@ impl Scorer {
         let mut nees_mean = BTreeMap::new();
         for (b, name) in BLOCKS.iter().enumerate() {
             if self.nees_n[b] > 0 {
-                nees_mean.insert((*name).to_string(), self.nees_sum[b] / self.nees_n[b] as f64);
+                nees_mean.insert(
+                    (*name).to_string(),
+                    self.nees_sum[b] / self.nees_n[b] as f64,
+                );
             }
         }
         let map = |f: &dyn Fn(&SensorStats) -> u64| {
-            self.sensors.iter().map(|(k, v)| (k.clone(), f(v))).collect()
+            self.sensors
+                .iter()
+                .map(|(k, v)| (k.clone(), f(v)))
+                .collect()
         };
         Metrics {
-            ate_position_rmse_m: if self.nees_n[2] > 0 { rmse(2) } else { f64::NAN },
+            ate_position_rmse_m: if self.nees_n[2] > 0 {
+                rmse(2)
+            } else {
+                f64::NAN
+            },
             attitude_rmse_deg: rmse(0).to_degrees(),
-            velocity_rmse_mps: if self.nees_n[1] > 0 { rmse(1) } else { f64::NAN },
+            velocity_rmse_mps: if self.nees_n[1] > 0 {
+                rmse(1)
+            } else {
+                f64::NAN
+            },
             nees_mean,
-            nis_mean: self.sensors.iter().map(|(k, v)| (k.clone(), v.nis_mean())).collect(),
+            nis_mean: self
+                .sensors
+                .iter()
+                .map(|(k, v)| (k.clone(), v.nis_mean()))
+                .collect(),
             updates_accepted: map(&|s| s.accepted),
             updates_rejected: map(&|s| s.rejected),
             updates_refused: map(&|s| s.refused),

@@ -1,0 +1,510 @@
+//! `host-sim replay`: runs the error-state filter over a dataset folder and writes the outputs of
+//! the contract (`estimate.tum`, `estimate.csv`, `groundtruth.tum`, `metrics.json`, plots).
+//!
+//! The filter configures itself from the dataset's `sensor.yaml` files and starts itself from the
+//! data: it averages the first `align_window_s` of IMU (and magnetometer) samples, at rest, for
+//! tilt, heading and the gyro bias (`eskf::align_at_rest`), and takes its position from the first
+//! GNSS fix. It never reads the ground truth to start or to run; the truth is only scored against.
+//! With a GNSS stream it runs the 15-state INS, otherwise the attitude-only filter.
+
+use crate::dataset::read::{Dataset, Event, Truth, TruthStream};
+use crate::dataset::DatasetError;
+use crate::metrics::{interpolate_truth, Estimate, Metrics, Outcome, Scorer};
+use estimator_core::eskf::{
+    align_at_rest, Ahrs, BaroAltitude, EskfError, FilterConfig, GnssPosition, GnssVelocity,
+    GravityDirection, ImuNoise, ImuSample, InitialSigmas, Ins, Magnetometer, MagnetometerWindow,
+    UpdateOptions, UpdateOutcome,
+};
+use estimator_core::lie::{LieGroup, So3};
+use estimator_core::Real;
+use nalgebra::{Matrix3, SMatrix, Vector3};
+use serde::{Deserialize, Serialize};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Replay options (a TOML file given with `--config`; every field optional).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ReplayConfig {
+    /// `"f32"` (the firmware's precision) or `"f64"`.
+    pub precision: String,
+    /// Length of the at-rest window used for alignment, s.
+    pub align_window_s: f64,
+    /// Gravity, world frame, m/s².
+    pub gravity: [f64; 3],
+    /// Largest accepted IMU interval, s.
+    pub max_dt: f64,
+    /// Accelerometer tilt aiding of the attitude-only filter: 1σ of the direction, rad.
+    pub gravity_sigma: f64,
+    /// Tilt aiding only while `|‖f‖ − g|` is below this, m/s².
+    pub gravity_gate: f64,
+    /// Write the plots.
+    pub plots: bool,
+}
+
+impl Default for ReplayConfig {
+    fn default() -> Self {
+        Self {
+            precision: "f32".into(),
+            align_window_s: 1.0,
+            gravity: [0.0, 0.0, -9.81],
+            max_dt: 0.1,
+            gravity_sigma: 0.05,
+            gravity_gate: 0.5,
+            plots: true,
+        }
+    }
+}
+
+/// Errors of a replay.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    /// The dataset is malformed.
+    #[error(transparent)]
+    Dataset(#[from] DatasetError),
+    /// An output could not be written.
+    #[error("{}: {message}", path.display())]
+    Output {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// The filter could not be started.
+    #[error("cannot start the filter: {0}")]
+    Start(String),
+    /// Bad configuration.
+    #[error("configuration: {0}")]
+    Config(String),
+}
+
+fn out_err(path: &Path) -> impl Fn(std::io::Error) -> ReplayError + '_ {
+    move |e| ReplayError::Output {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+/// Either filter.
+#[derive(Clone, Debug)]
+enum Filter<T: Real> {
+    Ins(Box<Ins<T>>),
+    Ahrs(Box<Ahrs<T>>),
+}
+
+fn lit3<T: Real>(v: &Vector3<f64>) -> Vector3<T> {
+    v.map(T::lit)
+}
+
+fn up3<T: Real>(v: &Vector3<T>) -> Vector3<f64> {
+    v.map(|x| x.to_f64())
+}
+
+fn block<T: Real, const N: usize>(p: &SMatrix<T, N, N>, b: usize) -> Matrix3<f64> {
+    Matrix3::from_fn(|i, j| p[(3 * b + i, 3 * b + j)].to_f64())
+}
+
+impl<T: Real> Filter<T> {
+    fn estimate(&self, t_ns: u64) -> Estimate {
+        match self {
+            Filter::Ins(f) => {
+                let s = f.state();
+                let p = f.covariance();
+                Estimate {
+                    t_ns,
+                    position: up3(&s.position),
+                    attitude: s.attitude.cast(),
+                    velocity: up3(&s.velocity),
+                    gyro_bias: up3(&s.gyro_bias),
+                    accel_bias: up3(&s.accel_bias),
+                    cov: [
+                        Some(block(p, 0)),
+                        Some(block(p, 1)),
+                        Some(block(p, 2)),
+                        Some(block(p, 3)),
+                        Some(block(p, 4)),
+                    ],
+                }
+            }
+            Filter::Ahrs(f) => {
+                let s = f.state();
+                let p = f.covariance();
+                Estimate {
+                    t_ns,
+                    position: Vector3::zeros(),
+                    attitude: s.attitude.cast(),
+                    velocity: Vector3::zeros(),
+                    gyro_bias: up3(&s.gyro_bias),
+                    accel_bias: Vector3::zeros(),
+                    cov: [Some(block(p, 0)), None, None, Some(block(p, 1)), None],
+                }
+            }
+        }
+    }
+
+    fn predict(
+        &mut self,
+        gyro: &Vector3<f64>,
+        accel: &Vector3<f64>,
+        dt: f64,
+    ) -> Result<(), EskfError> {
+        match self {
+            Filter::Ins(f) => f.predict(&ImuSample {
+                gyro: lit3(gyro),
+                accel: lit3(accel),
+                dt: T::lit(dt),
+            }),
+            Filter::Ahrs(f) => f.predict(&lit3(gyro), T::lit(dt)),
+        }
+    }
+}
+
+fn outcome<T: Real>(r: Result<UpdateOutcome<T>, EskfError>, dof: usize) -> Outcome {
+    match r {
+        Ok(UpdateOutcome::Accepted { nis, .. }) => Outcome::Accepted {
+            nis: nis.to_f64(),
+            dof,
+        },
+        Ok(UpdateOutcome::Rejected { nis, .. }) => Outcome::Rejected {
+            nis: nis.to_f64(),
+            dof,
+        },
+        Err(_) => Outcome::Refused,
+    }
+}
+
+/// Runs the replay in the configured precision.
+pub fn replay(
+    dataset_dir: &Path,
+    out: &Path,
+    cfg: &ReplayConfig,
+    title: &str,
+) -> Result<Metrics, ReplayError> {
+    match cfg.precision.as_str() {
+        "f32" => replay_in::<f32>(dataset_dir, out, cfg, title),
+        "f64" => replay_in::<f64>(dataset_dir, out, cfg, title),
+        other => Err(ReplayError::Config(format!(
+            "precision '{other}' (use f32 or f64)"
+        ))),
+    }
+}
+
+/// The truth at arbitrary times, streamed: keeps the two rows around the requested time.
+struct TruthCursor {
+    stream: TruthStream,
+    prev: Option<Truth>,
+    next: Option<Truth>,
+    tum: BufWriter<File>,
+    tum_path: PathBuf,
+}
+
+impl TruthCursor {
+    /// Reads one more row into `next`, copying it to `groundtruth.tum`.
+    fn advance(&mut self) -> Result<(), ReplayError> {
+        self.prev = self.next.take();
+        self.next = self.stream.next_truth()?;
+        if let Some(n) = &self.next {
+            write_tum(&mut self.tum, n.t_ns, &n.position, &n.attitude)
+                .map_err(out_err(&self.tum_path))?;
+        }
+        Ok(())
+    }
+
+    /// The truth at `t_ns`, interpolated between the rows around it; `None` outside the truth.
+    fn at(&mut self, t_ns: u64) -> Result<Option<Truth>, ReplayError> {
+        if self.prev.is_none() && self.next.is_none() {
+            self.advance()?;
+            self.prev = None;
+        }
+        while self.next.is_some_and(|n| n.t_ns < t_ns) {
+            self.advance()?;
+        }
+        Ok(match (self.prev, self.next) {
+            (_, Some(b)) if b.t_ns == t_ns => Some(b),
+            (Some(a), Some(b)) if a.t_ns <= t_ns => Some(interpolate_truth(&a, &b, t_ns)),
+            _ => None,
+        })
+    }
+
+    /// Copies the remaining rows to `groundtruth.tum`.
+    fn finish(&mut self) -> Result<(), ReplayError> {
+        while self.next.is_some() || self.prev.is_none() {
+            self.advance()?;
+            if self.next.is_none() {
+                break;
+            }
+        }
+        self.tum.flush().map_err(out_err(&self.tum_path))
+    }
+}
+
+fn write_tum(f: &mut impl Write, t_ns: u64, p: &Vector3<f64>, r: &So3<f64>) -> std::io::Result<()> {
+    let q = r.quaternion();
+    writeln!(
+        f,
+        "{}.{:09} {:.6} {:.6} {:.6} {:.9} {:.9} {:.9} {:.9}",
+        t_ns / 1_000_000_000,
+        t_ns % 1_000_000_000,
+        p.x,
+        p.y,
+        p.z,
+        q.i,
+        q.j,
+        q.k,
+        q.w
+    )
+}
+
+fn replay_in<T: Real>(
+    dir: &Path,
+    out: &Path,
+    cfg: &ReplayConfig,
+    title: &str,
+) -> Result<Metrics, ReplayError> {
+    let ds = Dataset::open(dir)?;
+    std::fs::create_dir_all(out).map_err(out_err(out))?;
+    let gravity = Vector3::from(cfg.gravity);
+    let config = FilterConfig::<T> {
+        imu_noise: ImuNoise {
+            gyroscope_noise_density: T::lit(ds.imu.gyroscope_noise_density),
+            gyroscope_random_walk: T::lit(ds.imu.gyroscope_random_walk),
+            accelerometer_noise_density: T::lit(ds.imu.accelerometer_noise_density),
+            accelerometer_random_walk: T::lit(ds.imu.accelerometer_random_walk),
+        },
+        gravity: lit3(&gravity),
+        max_dt: T::lit(cfg.max_dt),
+    };
+    let mut events = ds.events()?.peekable();
+
+    // --- Start-up: a window at rest, then the first GNSS fix for the position. ---
+    let window_ns = (cfg.align_window_s * 1e9) as u64;
+    let (mut accel, mut gyro, mut mags) = (Vec::new(), Vec::new(), Vec::new());
+    let mut t_first: Option<u64> = None;
+    let mut last_imu: Option<u64> = None;
+    let mut first_fix: Option<Vector3<f64>> = None;
+    while let Some(ev) = events.peek() {
+        let ev = match ev {
+            Ok(e) => e.clone(),
+            Err(_) => {
+                return Err(events.next().and_then(Result::err).map_or_else(
+                    || ReplayError::Start("read error".into()),
+                    ReplayError::from,
+                ))
+            }
+        };
+        let t0 = *t_first.get_or_insert(ev.t_ns());
+        let in_window = ev.t_ns() < t0 + window_ns;
+        let need_fix = ds.gnss.is_some() && first_fix.is_none();
+        if !in_window && !need_fix {
+            break;
+        }
+        match &ev {
+            Event::Imu {
+                t_ns,
+                gyro: g,
+                accel: a,
+            } if in_window => {
+                accel.push(lit3::<T>(a));
+                gyro.push(lit3::<T>(g));
+                last_imu = Some(*t_ns);
+            }
+            Event::Imu { t_ns, .. } => last_imu = Some(*t_ns),
+            Event::Mag { field, .. } if in_window => mags.push(lit3::<T>(field)),
+            Event::Gnss { position, .. } => first_fix = Some(*position),
+            _ => {}
+        }
+        events.next();
+        if !in_window && first_fix.is_some() {
+            break;
+        }
+    }
+    let mag_window = ds.mag.as_ref().map(|m| MagnetometerWindow {
+        samples: &mags,
+        reference: lit3::<T>(&m.reference_field),
+    });
+    let alignment = align_at_rest(
+        &accel,
+        &gyro,
+        &lit3(&gravity),
+        mag_window.as_ref().filter(|w| !w.samples.is_empty()),
+        T::lit(0.5),
+    )
+    .map_err(|e| {
+        ReplayError::Start(format!(
+            "alignment over the first {} s: {e}",
+            cfg.align_window_s
+        ))
+    })?;
+    let sigmas = InitialSigmas::<T>::default();
+    let mut filter = match (first_fix, &ds.gnss) {
+        (Some(p), Some(g)) => {
+            let p0 = p - alignment.attitude.cast::<f64>().act(&g.lever_arm);
+            let ins = Ins::from_alignment(
+                &alignment,
+                lit3(&p0),
+                &InitialSigmas {
+                    position: T::lit(2.0),
+                    ..sigmas
+                },
+                config,
+            )
+            .map_err(|e| ReplayError::Start(e.to_string()))?;
+            Filter::Ins(Box::new(ins))
+        }
+        _ => {
+            let ahrs = Ahrs::from_alignment(&alignment, &sigmas, config)
+                .map_err(|e| ReplayError::Start(e.to_string()))?;
+            Filter::Ahrs(Box::new(ahrs))
+        }
+    };
+
+    // --- Outputs. ---
+    let open = |name: &str| -> Result<(BufWriter<File>, PathBuf), ReplayError> {
+        let p = out.join(name);
+        File::create(&p)
+            .map(|f| (BufWriter::new(f), p.clone()))
+            .map_err(|e| ReplayError::Output {
+                path: p,
+                message: e.to_string(),
+            })
+    };
+    let (mut tum, tum_path) = open("estimate.tum")?;
+    let (mut csv, csv_path) = open("estimate.csv")?;
+    writeln!(
+        csv,
+        "t_ns,p_x,p_y,p_z,q_w,q_x,q_y,q_z,v_x,v_y,v_z,bg_x,bg_y,bg_z,ba_x,ba_y,ba_z,\
+         sigma_att_x,sigma_att_y,sigma_att_z,sigma_v_x,sigma_v_y,sigma_v_z,sigma_p_x,sigma_p_y,sigma_p_z,\
+         sigma_bg_x,sigma_bg_y,sigma_bg_z,sigma_ba_x,sigma_ba_y,sigma_ba_z"
+    )
+    .map_err(out_err(&csv_path))?;
+    let mut truth = if ds.has_groundtruth {
+        let (gt_tum, gt_path) = open("groundtruth.tum")?;
+        Some(TruthCursor {
+            stream: TruthStream::open(dir)?,
+            prev: None,
+            next: None,
+            tum: gt_tum,
+            tum_path: gt_path,
+        })
+    } else {
+        None
+    };
+
+    // --- The run. ---
+    let mut scorer = Scorer::default();
+    let ekf = UpdateOptions::<T>::default();
+    let g_norm = gravity.norm();
+    let mut imu_count: u64 = 0;
+    for ev in events {
+        let ev = ev?;
+        let started = Instant::now();
+        match ev {
+            Event::Imu { t_ns, gyro, accel } => {
+                let dt = last_imu.map_or(1.0 / ds.imu.rate_hz, |t| {
+                    (t_ns.saturating_sub(t)) as f64 * 1e-9
+                });
+                last_imu = Some(t_ns);
+                if filter.predict(&gyro, &accel, dt).is_err() {
+                    scorer.measurement("imu", t_ns, Outcome::Refused);
+                }
+                imu_count += 1;
+                if let Filter::Ahrs(f) = &mut filter {
+                    // Tilt aiding while the specific force is close to gravity.
+                    if imu_count % 4 == 0 && (accel.norm() - g_norm).abs() < cfg.gravity_gate {
+                        let r = f.update(
+                            &GravityDirection::new(lit3(&accel), T::lit(cfg.gravity_sigma)),
+                            &ekf,
+                        );
+                        scorer.measurement("gravity", t_ns, outcome(r, 2));
+                    }
+                }
+                scorer.filter_ns += started.elapsed().as_nanos();
+                scorer.imu_samples += 1;
+                let e = filter.estimate(t_ns);
+                write_tum(&mut tum, t_ns, &e.position, &e.attitude).map_err(out_err(&tum_path))?;
+                write_estimate_csv(&mut csv, &e).map_err(out_err(&csv_path))?;
+                if let Some(tr) = truth.as_mut() {
+                    if let Some(t) = tr.at(t_ns)? {
+                        scorer.add(&e, &t);
+                    }
+                }
+                continue;
+            }
+            Event::Mag { t_ns, field } => {
+                if let Some(m) = &ds.mag {
+                    let model =
+                        Magnetometer::new(lit3(&field), lit3(&m.reference_field), T::lit(m.sigma));
+                    let r = match &mut filter {
+                        Filter::Ins(f) => f.update(&model, &ekf),
+                        Filter::Ahrs(f) => f.update(&model, &ekf),
+                    };
+                    scorer.measurement("mag", t_ns, outcome(r, 3));
+                }
+            }
+            Event::Gnss {
+                t_ns,
+                position,
+                velocity,
+                sigma_p,
+                sigma_v,
+            } => {
+                if let (Filter::Ins(f), Some(g)) = (&mut filter, &ds.gnss) {
+                    let r = f.update(
+                        &GnssPosition::new(lit3(&position), lit3(&g.lever_arm), T::lit(sigma_p)),
+                        &ekf,
+                    );
+                    scorer.measurement("gnss_position", t_ns, outcome(r, 3));
+                    let r = f.update(&GnssVelocity::new(lit3(&velocity), T::lit(sigma_v)), &ekf);
+                    scorer.measurement("gnss_velocity", t_ns, outcome(r, 3));
+                }
+            }
+            Event::Baro { t_ns, altitude } => {
+                if let (Filter::Ins(f), Some(b)) = (&mut filter, &ds.baro) {
+                    let r = f.update(&BaroAltitude::new(T::lit(altitude), T::lit(b.sigma)), &ekf);
+                    scorer.measurement("baro", t_ns, outcome(r, 1));
+                }
+            }
+            Event::Camera { .. } => {}
+        }
+        scorer.filter_ns += started.elapsed().as_nanos();
+    }
+    tum.flush().map_err(out_err(&tum_path))?;
+    csv.flush().map_err(out_err(&csv_path))?;
+    if let Some(tr) = truth.as_mut() {
+        tr.finish()?;
+    }
+    let metrics = scorer.metrics();
+    let mpath = out.join("metrics.json");
+    let json = serde_json::to_string_pretty(&metrics).map_err(|e| ReplayError::Output {
+        path: mpath.clone(),
+        message: e.to_string(),
+    })?;
+    std::fs::write(&mpath, json).map_err(out_err(&mpath))?;
+    if cfg.plots && ds.has_groundtruth {
+        crate::plot::write_all(out, &scorer, title).map_err(|e| ReplayError::Output {
+            path: out.to_path_buf(),
+            message: e.to_string(),
+        })?;
+    }
+    Ok(metrics)
+}
+
+fn write_estimate_csv(f: &mut impl Write, e: &Estimate) -> std::io::Result<()> {
+    let q = e.attitude.quaternion();
+    let (p, v, bg, ba) = (e.position, e.velocity, e.gyro_bias, e.accel_bias);
+    write!(
+        f,
+        "{},{:.6},{:.6},{:.6},{:.9},{:.9},{:.9},{:.9},{:.6},{:.6},{:.6},{:.9},{:.9},{:.9},{:.6},{:.6},{:.6}",
+        e.t_ns, p.x, p.y, p.z, q.w, q.i, q.j, q.k, v.x, v.y, v.z, bg.x, bg.y, bg.z, ba.x, ba.y, ba.z
+    )?;
+    for s in e.sigmas() {
+        if s.is_finite() {
+            write!(f, ",{s:.6e}")?;
+        } else {
+            write!(f, ",")?;
+        }
+    }
+    writeln!(f)
+}

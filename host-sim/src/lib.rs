@@ -6,11 +6,13 @@
 //! * [`dataset`]: the EuRoC / ASL dataset folder, written and streamed.
 //! * [`metrics`]: streaming scores against ground truth; [`stats`]: chi-square quantiles.
 //! * [`plot`]: the PNG plots.
+//! * [`montecarlo`]: consistency over seeds against chi-square bands.
 //! * [`replay`]: the filter over a dataset folder, with every output of the contract.
 #![warn(missing_docs)]
 
 pub mod dataset;
 pub mod metrics;
+pub mod montecarlo;
 pub mod plot;
 pub mod replay;
 pub mod scenario;

@@ -85,7 +85,46 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             print_summary(&title, 0, &cfg, &m, &out);
             Ok(())
         }
-        Command::Montecarlo { .. } => Err("montecarlo is not implemented yet".into()),
+        Command::Montecarlo {
+            scenario,
+            runs,
+            check,
+        } => {
+            let sc = Scenario::load(&scenario)?;
+            let report =
+                host_sim::montecarlo::run(&sc, runs, &ReplayConfig::default(), 10.0, true)?;
+            println!(
+                "scenario {}: {} runs; 95 % chi-square bands",
+                sc.name, report.runs
+            );
+            println!(
+                "  {:<22} {:>8} {:>8} {:>17} {:>8} {:>7}",
+                "statistic", "value", "expect", "band", "inside", "holds"
+            );
+            for r in report.nees.iter().chain(&report.nis) {
+                let label = if r.fraction_inside.is_some() {
+                    format!("ANEES {}", r.name)
+                } else {
+                    format!("NIS {}", r.name)
+                };
+                let inside = r
+                    .fraction_inside
+                    .map_or("-".into(), |f| format!("{:.0} %", 100.0 * f));
+                println!(
+                    "  {:<22} {:>8.3} {:>8.3} {:>17} {:>8} {:>7}",
+                    label,
+                    r.value,
+                    r.expected,
+                    format!("[{:.3}, {:.3}]", r.lower, r.upper),
+                    inside,
+                    if r.holds() { "yes" } else { "NO" }
+                );
+            }
+            if check && !report.holds() {
+                return Err("a consistency band is missed".into());
+            }
+            Ok(())
+        }
     }
 }
 

@@ -192,6 +192,10 @@ pub struct Scorer {
     pub filter_ns: u128,
     /// IMU samples processed.
     pub imu_samples: u64,
+    /// When `true`, the NEES of every scored sample is kept in `nees_steps` (Monte Carlo).
+    pub keep_nees: bool,
+    /// Per-sample NEES per block (NaN where not estimated), when `keep_nees`.
+    pub nees_steps: Vec<[f64; 5]>,
 }
 
 /// The figures of one run (`metrics.json`).
@@ -225,11 +229,14 @@ impl Scorer {
         let t0 = *self.t0_ns.get_or_insert(e.t_ns);
         let errs = errors(e, truth);
         let mut error = [0.0; 15];
+        let mut step = [f64::NAN; 5];
         for (b, d) in errs.iter().enumerate() {
             if let Some(p) = &e.cov[b] {
                 self.sq[b] += d.norm_squared();
                 if let Some(inv) = p.try_inverse() {
-                    self.nees_sum[b] += (d.transpose() * inv * d)[(0, 0)];
+                    let nees = (d.transpose() * inv * d)[(0, 0)];
+                    step[b] = nees;
+                    self.nees_sum[b] += nees;
                     self.nees_n[b] += 1;
                 }
             }
@@ -238,6 +245,9 @@ impl Scorer {
             }
         }
         self.n += 1;
+        if self.keep_nees {
+            self.nees_steps.push(step);
+        }
         let eb = [e.gyro_bias, e.accel_bias];
         let tb = [truth.gyro_bias, truth.accel_bias];
         let six = |v: [Vector3<f64>; 2]| [v[0].x, v[0].y, v[0].z, v[1].x, v[1].y, v[1].z];

@@ -182,9 +182,21 @@ pub fn replay(
     cfg: &ReplayConfig,
     title: &str,
 ) -> Result<Metrics, ReplayError> {
+    replay_scored(dataset_dir, out, cfg, title, Scorer::default()).map(|s| s.metrics())
+}
+
+/// As [`replay`], starting from (and returning) a given scorer, for callers that need more than
+/// the summary (Monte Carlo keeps the per-sample NEES).
+pub fn replay_scored(
+    dataset_dir: &Path,
+    out: &Path,
+    cfg: &ReplayConfig,
+    title: &str,
+    scorer: Scorer,
+) -> Result<Scorer, ReplayError> {
     match cfg.precision.as_str() {
-        "f32" => replay_in::<f32>(dataset_dir, out, cfg, title),
-        "f64" => replay_in::<f64>(dataset_dir, out, cfg, title),
+        "f32" => replay_in::<f32>(dataset_dir, out, cfg, title, scorer),
+        "f64" => replay_in::<f64>(dataset_dir, out, cfg, title, scorer),
         other => Err(ReplayError::Config(format!(
             "precision '{other}' (use f32 or f64)"
         ))),
@@ -262,7 +274,8 @@ fn replay_in<T: Real>(
     out: &Path,
     cfg: &ReplayConfig,
     title: &str,
-) -> Result<Metrics, ReplayError> {
+    mut scorer: Scorer,
+) -> Result<Scorer, ReplayError> {
     let ds = Dataset::open(dir)?;
     std::fs::create_dir_all(out).map_err(out_err(out))?;
     let gravity = Vector3::from(cfg.gravity);
@@ -393,7 +406,6 @@ fn replay_in<T: Real>(
     };
 
     // --- The run. ---
-    let mut scorer = Scorer::default();
     let ekf = UpdateOptions::<T>::default();
     let g_norm = gravity.norm();
     let mut imu_count: u64 = 0;
@@ -488,7 +500,7 @@ fn replay_in<T: Real>(
             message: e.to_string(),
         })?;
     }
-    Ok(metrics)
+    Ok(scorer)
 }
 
 fn write_estimate_csv(f: &mut impl Write, e: &Estimate) -> std::io::Result<()> {

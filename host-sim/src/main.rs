@@ -58,7 +58,7 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             let sc = Scenario::load(&scenario)?;
             let dataset = out.join("dataset");
             simulate(&sc, seed, &dataset)?;
-            let cfg = ReplayConfig::default();
+            let cfg = sc.replay.clone();
             let m = replay(&dataset, &out, &cfg, &sc.name)?;
             print_summary(&sc.name, seed, &cfg, &m, &out);
             Ok(())
@@ -76,7 +76,15 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                         format!("{}: {}", path.display(), e.to_string().replace('\n', " "))
                     })?
                 }
-                None => ReplayConfig::default(),
+                None => {
+                    let path = dataset.join("replay.toml");
+                    match std::fs::read_to_string(&path) {
+                        Ok(text) => toml::from_str(&text).map_err(|e| {
+                            format!("{}: {}", path.display(), e.to_string().replace('\n', " "))
+                        })?,
+                        Err(_) => ReplayConfig::default(),
+                    }
+                }
             };
             let title = dataset
                 .file_name()
@@ -91,8 +99,7 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             check,
         } => {
             let sc = Scenario::load(&scenario)?;
-            let report =
-                host_sim::montecarlo::run(&sc, runs, &ReplayConfig::default(), 10.0, true)?;
+            let report = host_sim::montecarlo::run(&sc, runs, 20.0, true)?;
             println!(
                 "scenario {}: {} runs; 95 % chi-square bands",
                 sc.name, report.runs

@@ -74,6 +74,8 @@ pub fn simulate(scenario: &Scenario, seed: u64, dir: &Path) -> Result<(), Datase
     std::fs::create_dir_all(&tmp).map_err(io(&tmp))?;
     let out = Out { dir: tmp.clone() };
     write_all(scenario, &traj, seed, &out)?;
+    let replay = toml::to_string(&scenario.replay).map_err(|e| DatasetError::file(dir, e))?;
+    out.write("replay.toml", &format!("# How host-sim runs the filter on this dataset (host-sim replay reads it when no --config is given).\n{replay}"))?;
     if dir.exists() {
         std::fs::remove_dir_all(dir).map_err(io(dir))?;
     }

@@ -12,6 +12,9 @@ use plotters::style::{register_font, FontStyle};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+/// The plot files a run may write.
+pub const FILES: [&str; 4] = ["trajectory.png", "errors.png", "biases.png", "nis.png"];
+
 type PlotResult = Result<(), Box<dyn std::error::Error>>;
 
 const FONT_PATHS: [&str; 3] = [

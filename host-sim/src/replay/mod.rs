@@ -36,10 +36,23 @@ pub struct ReplayConfig {
     pub gravity: [f64; 3],
     /// Largest accepted IMU interval, s.
     pub max_dt: f64,
-    /// Accelerometer tilt aiding of the attitude-only filter: 1σ of the direction, rad.
-    pub gravity_sigma: f64,
+    /// Tilt aiding of the attitude-only filter: the unmodelled linear acceleration, as a floor
+    /// on the 1σ of the measured gravity direction, rad. The full 1σ is
+    /// `√(σ_w² + (k e/g)² + floor²)`, with `σ_w = accelerometer_noise_density·√rate / g` the white
+    /// noise of one sample and `e = max(0, |‖f‖ − g| − 3σ_w g)` the magnitude mismatch beyond the
+    /// noise, which reveals a linear acceleration along gravity; the floor stands for the part
+    /// across it, which the magnitude cannot show. Set it to 0 only where the body does not
+    /// accelerate (pure rotation).
+    pub gravity_floor: f64,
+    /// The factor `k` on `e` above (0 where the body is known not to accelerate).
+    pub gravity_mismatch_gain: f64,
     /// Tilt aiding only while `|‖f‖ − g|` is below this, m/s².
     pub gravity_gate: f64,
+    /// Tilt aiding every this many IMU samples.
+    pub gravity_every: u64,
+    /// The IMU samples are instantaneous values (integrate with the trapezoidal rule) rather
+    /// than means over the period ending at their timestamp.
+    pub instantaneous_imu: bool,
     /// Write the plots.
     pub plots: bool,
 }
@@ -51,8 +64,11 @@ impl Default for ReplayConfig {
             align_window_s: 1.0,
             gravity: [0.0, 0.0, -9.81],
             max_dt: 0.1,
-            gravity_sigma: 0.05,
-            gravity_gate: 0.5,
+            gravity_floor: 0.02,
+            gravity_mismatch_gain: 2.0,
+            gravity_gate: 1.0,
+            gravity_every: 4,
+            instantaneous_imu: true,
             plots: true,
         }
     }
@@ -373,9 +389,11 @@ fn replay_in<T: Real>(
         }
     };
 
-    // --- Outputs. ---
+    // --- Outputs: written as `*.partial`, renamed only when the whole run succeeded. ---
+    let mut partials = Partials::new(out);
+    partials.clear_previous();
     let open = |name: &str| -> Result<(BufWriter<File>, PathBuf), ReplayError> {
-        let p = out.join(name);
+        let p = out.join(format!("{name}.partial"));
         File::create(&p)
             .map(|f| (BufWriter::new(f), p.clone()))
             .map_err(|e| ReplayError::Output {
@@ -408,6 +426,11 @@ fn replay_in<T: Real>(
     // --- The run. ---
     let ekf = UpdateOptions::<T>::default();
     let g_norm = gravity.norm();
+    // The white noise of one accelerometer sample, as a direction: σ_a √rate / g.
+    let white_dir_sq =
+        (ds.imu.accelerometer_noise_density * ds.imu.rate_hz.sqrt() / g_norm).powi(2);
+    let mut last_gyro = Vector3::zeros();
+    let mut last_sample: Option<(Vector3<f64>, Vector3<f64>)> = None;
     let mut imu_count: u64 = 0;
     for ev in events {
         let ev = ev?;
@@ -418,20 +441,33 @@ fn replay_in<T: Real>(
                     (t_ns.saturating_sub(t)) as f64 * 1e-9
                 });
                 last_imu = Some(t_ns);
-                if filter.predict(&gyro, &accel, dt).is_err() {
+                // Instantaneous samples (the simulator's) are integrated over the interval with
+                // the average of its two ends (trapezoidal rule, second order); samples that
+                // are already means over their period are used as they are.
+                let (g_mid, a_mid) = match (cfg.instantaneous_imu, last_sample) {
+                    (true, Some((g0, a0))) => ((g0 + gyro) * 0.5, (a0 + accel) * 0.5),
+                    _ => (gyro, accel),
+                };
+                last_sample = Some((gyro, accel));
+                if filter.predict(&g_mid, &a_mid, dt).is_err() {
                     scorer.measurement("imu", t_ns, Outcome::Refused);
                 }
                 imu_count += 1;
                 if let Filter::Ahrs(f) = &mut filter {
                     // Tilt aiding while the specific force is close to gravity.
-                    if imu_count % 4 == 0 && (accel.norm() - g_norm).abs() < cfg.gravity_gate {
-                        let r = f.update(
-                            &GravityDirection::new(lit3(&accel), T::lit(cfg.gravity_sigma)),
-                            &ekf,
-                        );
+                    let mismatch = (accel.norm() - g_norm).abs();
+                    if imu_count % cfg.gravity_every.max(1) == 0 && mismatch < cfg.gravity_gate {
+                        // Only the mismatch beyond three sigmas of the white noise reveals motion.
+                        let excess = (mismatch - 3.0 * white_dir_sq.sqrt() * g_norm).max(0.0);
+                        let sigma = (white_dir_sq
+                            + (cfg.gravity_mismatch_gain * excess / g_norm).powi(2)
+                            + cfg.gravity_floor.powi(2))
+                        .sqrt();
+                        let r = f.update(&GravityDirection::new(lit3(&accel), T::lit(sigma)), &ekf);
                         scorer.measurement("gravity", t_ns, outcome(r, 2));
                     }
                 }
+                last_gyro = gyro;
                 scorer.filter_ns += started.elapsed().as_nanos();
                 scorer.imu_samples += 1;
                 let e = filter.estimate(t_ns);
@@ -468,7 +504,15 @@ fn replay_in<T: Real>(
                         &ekf,
                     );
                     scorer.measurement("gnss_position", t_ns, outcome(r, 3));
-                    let r = f.update(&GnssVelocity::new(lit3(&velocity), T::lit(sigma_v)), &ekf);
+                    // The antenna moves with the body's rotation: v_ant = v + R (ω × l). The model
+                    // measures v, so remove the lever-arm term with the current estimate.
+                    let s = f.state();
+                    let omega = last_gyro - up3(&s.gyro_bias);
+                    let lever = s.attitude.cast::<f64>().act(&omega.cross(&g.lever_arm));
+                    let r = f.update(
+                        &GnssVelocity::new(lit3(&(velocity - lever)), T::lit(sigma_v)),
+                        &ekf,
+                    );
                     scorer.measurement("gnss_velocity", t_ns, outcome(r, 3));
                 }
             }
@@ -488,7 +532,7 @@ fn replay_in<T: Real>(
         tr.finish()?;
     }
     let metrics = scorer.metrics();
-    let mpath = out.join("metrics.json");
+    let mpath = out.join("metrics.json.partial");
     let json = serde_json::to_string_pretty(&metrics).map_err(|e| ReplayError::Output {
         path: mpath.clone(),
         message: e.to_string(),
@@ -500,7 +544,60 @@ fn replay_in<T: Real>(
             message: e.to_string(),
         })?;
     }
+    partials.commit()?;
     Ok(scorer)
+}
+
+/// The outputs of the contract. They are written as `NAME.partial` and renamed together at the
+/// end; on any error (the guard drops uncommitted) the partial files are removed, so a failed
+/// run never leaves outputs that look complete.
+const OUTPUTS: [&str; 4] = [
+    "estimate.tum",
+    "estimate.csv",
+    "groundtruth.tum",
+    "metrics.json",
+];
+
+struct Partials<'a> {
+    out: &'a Path,
+    committed: bool,
+}
+
+impl<'a> Partials<'a> {
+    fn new(out: &'a Path) -> Self {
+        Self {
+            out,
+            committed: false,
+        }
+    }
+
+    /// Removes the outputs (and plots) of an earlier run in the same folder.
+    fn clear_previous(&mut self) {
+        for name in OUTPUTS.iter().chain(crate::plot::FILES.iter()) {
+            let _ = std::fs::remove_file(self.out.join(name));
+        }
+    }
+
+    fn commit(&mut self) -> Result<(), ReplayError> {
+        for name in OUTPUTS {
+            let from = self.out.join(format!("{name}.partial"));
+            if from.exists() {
+                std::fs::rename(&from, self.out.join(name)).map_err(out_err(&from))?;
+            }
+        }
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Partials<'_> {
+    fn drop(&mut self) {
+        if !self.committed {
+            for name in OUTPUTS {
+                let _ = std::fs::remove_file(self.out.join(format!("{name}.partial")));
+            }
+        }
+    }
 }
 
 fn write_estimate_csv(f: &mut impl Write, e: &Estimate) -> std::io::Result<()> {

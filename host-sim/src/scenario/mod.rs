@@ -4,6 +4,7 @@
 //! file with the same fields (`host-sim run --scenario path/to/file.toml`), every sensor table
 //! optional, every field defaulted.
 
+use crate::replay::ReplayConfig;
 use crate::sensors::baro::BaroConfig;
 use crate::sensors::camera::CameraConfig;
 use crate::sensors::gnss::GnssConfig;
@@ -63,6 +64,9 @@ pub struct Scenario {
     pub baro: Option<BaroConfig>,
     /// Accuracy ceilings.
     pub ceilings: Ceilings,
+    /// How the filter is run on this scenario; `simulate` writes it to the dataset's
+    /// `replay.toml`, which `replay` reads when no `--config` is given.
+    pub replay: ReplayConfig,
 }
 
 impl Default for Scenario {
@@ -82,6 +86,7 @@ impl Default for Scenario {
             camera: None,
             baro: None,
             ceilings: Ceilings::default(),
+            replay: ReplayConfig::default(),
         }
     }
 }
@@ -253,9 +258,12 @@ pub fn builtin_scenarios() -> Vec<Scenario> {
         },
         Scenario {
             name: "matched_ahrs".into(),
-            description: "noise exactly as the filter models it (Monte-Carlo consistency); hand-held, IMU, magnetometer".into(),
-            shape: "handheld".into(),
-            imu: matched_imu,
+            description: "noise exactly as the filter models it (Monte-Carlo consistency); hand-held rotation in place, IMU, magnetometer".into(),
+            shape: "rotate".into(),
+            // In place, the accelerometer sees gravity and white noise only.
+            replay: ReplayConfig { gravity_floor: 0.0, gravity_mismatch_gain: 0.0, ..ReplayConfig::default() },
+            // The attitude-only filter has no accelerometer-bias state: none is simulated.
+            imu: ImuConfig { accel_turn_on_bias: 0.0, accelerometer_random_walk: 0.0, ..matched_imu },
             mag: Some(MagConfig::default()),
             ceilings: Ceilings { ate_m: f64::INFINITY, attitude_deg: 1.2 },
             ..base

@@ -1,5 +1,7 @@
 //! A barometric altimeter: `h̃ = p_z + b + σ n`, with a constant bias `b` drawn at start.
-//! Defaults: a BMP388 class sensor (about 0.1 m rms at 25 Hz after its filter, ±0.5 m offset).
+//! Defaults: a BMP388 class sensor, about 0.1 m rms at 25 Hz after its filter, referenced to the
+//! local pressure (offset 0 by default: the 15-state filter has no barometer-bias state, so an
+//! offset would go straight into its altitude; set `bias_sigma` to study that).
 
 use super::Noise;
 use crate::trajectory::Kinematics;
@@ -22,7 +24,7 @@ impl Default for BaroConfig {
         Self {
             rate_hz: 25.0,
             sigma: 0.1,
-            bias_sigma: 0.5,
+            bias_sigma: 0.0,
         }
     }
 }

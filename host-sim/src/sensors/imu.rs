@@ -120,7 +120,8 @@ impl Imu {
         }
     }
 
-    /// Samples the IMU at the true state `k`, then advances the biases by one period.
+    /// Samples the IMU at the true state `k` (instantaneous values, as a sensor without a
+    /// decimation filter gives them), then advances the biases by one period.
     pub fn sample(&mut self, k: &Kinematics) -> ImuSample {
         let c = &self.cfg;
         let sqrt_rate = c.rate_hz.sqrt();

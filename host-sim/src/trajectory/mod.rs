@@ -187,16 +187,16 @@ pub fn builtin(shape: &str, static_s: f64) -> Option<Trajectory> {
                 Signal::constant(0.5),
             ],
         },
-        // Hover with small attitude oscillations and a 25 Hz vibration on position.
+        // Hover with small attitude oscillations and a 23–27 Hz vibration of 0.1 mm (about 0.25 g).
         "hover" => Trajectory {
             static_s,
             ramp_s,
             position: [
-                zero().with(0.3, 0.05, 0.0).with(0.002, 25.0, 0.0),
-                zero().with(0.3, 0.07, 1.0).with(0.002, 27.0, 0.5),
+                zero().with(0.3, 0.05, 0.0).with(0.0001, 25.0, 0.0),
+                zero().with(0.3, 0.07, 1.0).with(0.0001, 27.0, 0.5),
                 Signal::constant(1.5)
                     .with(0.2, 0.04, 0.0)
-                    .with(0.003, 23.0, 0.2),
+                    .with(0.00015, 23.0, 0.2),
             ],
             euler: [
                 zero().with(0.05, 0.3, 0.0),
@@ -299,14 +299,20 @@ pub fn builtin(shape: &str, static_s: f64) -> Option<Trajectory> {
                     .with(0.2, 0.6, 0.7),
             ],
         },
+        // The hand-held rotations, in place (no linear acceleration).
+        "rotate" => {
+            let mut t = builtin("handheld", static_s)?;
+            t.position = [zero(), zero(), Signal::constant(1.2)];
+            t
+        }
         _ => return None,
     };
     Some(t)
 }
 
 /// Names of the built-in shapes.
-pub const SHAPES: [&str; 7] = [
-    "static", "hover", "figure8", "car", "coning", "pitch90", "handheld",
+pub const SHAPES: [&str; 8] = [
+    "static", "hover", "figure8", "car", "coning", "pitch90", "handheld", "rotate",
 ];
 
 #[cfg(test)]

@@ -1,0 +1,284 @@
+//! The `host-sim` command line as a user runs it: listing, simulate → replay against run,
+//! reproducibility, TOML scenarios, and malformed datasets (one-line error naming file and
+//! line, non-zero exit, no outputs left looking complete).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn host_sim(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(args)
+        .output()
+        .expect("host-sim runs")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("host-sim-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn read(p: &Path) -> Vec<u8> {
+    std::fs::read(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+fn metrics_without_timing(p: &Path) -> serde_json::Value {
+    let mut v: serde_json::Value = serde_json::from_slice(&read(p)).expect("json");
+    v.as_object_mut()
+        .expect("object")
+        .remove("filter_ns_per_imu_sample");
+    v
+}
+
+#[test]
+fn scenarios_lists_the_builtins() {
+    let o = host_sim(&["scenarios"]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    for name in [
+        "default",
+        "static",
+        "hover",
+        "car",
+        "coning",
+        "pitch90",
+        "matched_ins",
+        "matched_ahrs",
+    ] {
+        assert!(
+            text.lines().any(|l| l.starts_with(name)),
+            "{name} missing from:\n{text}"
+        );
+    }
+}
+
+/// `simulate` then `replay` reproduces `run` exactly, and the same seed gives the same bytes.
+#[test]
+fn simulate_then_replay_reproduces_run() {
+    let run_dir = tmp("run");
+    let o = host_sim(&[
+        "run",
+        "--scenario",
+        "default",
+        "--seed",
+        "7",
+        "--out",
+        run_dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("position RMSE"), "summary table:\n{text}");
+
+    let ds = tmp("ds");
+    let o = host_sim(&[
+        "simulate",
+        "--scenario",
+        "default",
+        "--seed",
+        "7",
+        "--out",
+        ds.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rep = tmp("replay");
+    let o = host_sim(&[
+        "replay",
+        ds.to_str().unwrap(),
+        "--out",
+        rep.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    for f in ["estimate.tum", "estimate.csv", "groundtruth.tum"] {
+        assert!(
+            read(&run_dir.join(f)) == read(&rep.join(f)),
+            "{f} differs between run and simulate+replay"
+        );
+    }
+    assert_eq!(
+        metrics_without_timing(&run_dir.join("metrics.json")),
+        metrics_without_timing(&rep.join("metrics.json"))
+    );
+    for f in [
+        "imu0/data.csv",
+        "mag0/data.csv",
+        "gnss0/data.csv",
+        "state_groundtruth_estimate0/data.csv",
+    ] {
+        assert!(
+            read(&run_dir.join("dataset").join(f)) == read(&ds.join(f)),
+            "{f}: same seed, different bytes"
+        );
+    }
+    for png in ["trajectory.png", "errors.png", "biases.png", "nis.png"] {
+        assert!(run_dir.join(png).is_file(), "{png} missing");
+    }
+    // A different seed gives different noise.
+    let ds2 = tmp("ds2");
+    assert!(host_sim(&[
+        "simulate",
+        "--scenario",
+        "default",
+        "--seed",
+        "8",
+        "--out",
+        ds2.to_str().unwrap()
+    ])
+    .status
+    .success());
+    assert!(read(&ds.join("imu0/data.csv")) != read(&ds2.join("imu0/data.csv")));
+    for d in [run_dir, ds, rep, ds2] {
+        let _ = std::fs::remove_dir_all(d);
+    }
+}
+
+#[test]
+fn toml_scenario_file() {
+    let dir = tmp("toml");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("short.toml");
+    std::fs::write(
+        &file,
+        "name = \"short\"\nduration_s = 12.0\nstatic_s = 3.0\nshape = \"car\"\n[mag]\nrate_hz = 25.0\n[gnss]\nrate_hz = 2.0\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = host_sim(&[
+        "run",
+        "--scenario",
+        file.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let lines = std::fs::read_to_string(out.join("dataset/gnss0/data.csv"))
+        .unwrap()
+        .lines()
+        .count();
+    assert_eq!(lines, 1 + 25, "12 s at 2 Hz plus the header");
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, "duration_s = \"long\"\n").unwrap();
+    let o = host_sim(&[
+        "run",
+        "--scenario",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("bad.toml"));
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// Corrupts one line of one file of a fresh dataset and checks the error.
+fn corrupt(name: &str, file: &str, line: usize, replacement: Option<&str>, expect: &[&str]) {
+    let ds = tmp(&format!("bad-{name}"));
+    assert!(host_sim(&[
+        "simulate",
+        "--scenario",
+        "hover",
+        "--seed",
+        "2",
+        "--out",
+        ds.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let path = ds.join(file);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    match replacement {
+        Some(r) => lines[line - 1] = r.to_string(),
+        None => {
+            // Swap with the previous line: a non-monotonic timestamp at `line`.
+            lines.swap(line - 2, line - 1);
+        }
+    }
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+    let out = ds.join("out");
+    let o = host_sim(&[
+        "replay",
+        ds.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{name}: should fail");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "{name}: one line, got:\n{err}"
+    );
+    for e in expect {
+        assert!(err.contains(e), "{name}: '{e}' not in: {err}");
+    }
+    for f in [
+        "estimate.tum",
+        "estimate.csv",
+        "groundtruth.tum",
+        "metrics.json",
+    ] {
+        assert!(!out.join(f).exists(), "{name}: {f} left behind");
+    }
+    let _ = std::fs::remove_dir_all(ds);
+}
+
+#[test]
+fn malformed_datasets_name_file_and_line() {
+    corrupt(
+        "columns",
+        "imu0/data.csv",
+        600,
+        Some("1234,0.1,0.2"),
+        &["imu0/data.csv:600:", "expected 7 columns, got 3"],
+    );
+    corrupt(
+        "number",
+        "gnss0/data.csv",
+        40,
+        Some("9000000000,1,2,x3,0,0,0,1,0.1"),
+        &["gnss0/data.csv:40:", "'x3' is not a number"],
+    );
+    corrupt(
+        "order",
+        "mag0/data.csv",
+        1000,
+        None,
+        &["mag0/data.csv:1000:", "non-monotonic"],
+    );
+    corrupt(
+        "dup",
+        "baro0/data.csv",
+        300,
+        Some("12880000000,1.0"),
+        &["baro0/data.csv:300:", "duplicated"],
+    );
+    corrupt(
+        "units",
+        "imu0/data.csv",
+        3,
+        Some("1010000000,0.1,0.2,0.3,nan,9.8,0.0"),
+        &["imu0/data.csv:3:", "not finite"],
+    );
+    // A missing IMU file.
+    let ds = tmp("missing");
+    assert!(host_sim(&[
+        "simulate",
+        "--scenario",
+        "static",
+        "--out",
+        ds.to_str().unwrap()
+    ])
+    .status
+    .success());
+    std::fs::remove_file(ds.join("imu0/data.csv")).unwrap();
+    let o = host_sim(&[
+        "replay",
+        ds.to_str().unwrap(),
+        "--out",
+        ds.join("out").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("imu0/data.csv"));
+    let _ = std::fs::remove_dir_all(ds);
+}

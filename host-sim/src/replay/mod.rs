@@ -7,7 +7,7 @@
 //! GNSS fix. It never reads the ground truth to start or to run; the truth is only scored against.
 //! With a GNSS stream it runs the 15-state INS, otherwise the attitude-only filter.
 
-use crate::dataset::read::{Dataset, Event, Truth, TruthStream};
+use crate::dataset::read::{CameraParams, Dataset, Event, Truth, TruthStream};
 use crate::dataset::DatasetError;
 use crate::metrics::{interpolate_truth, Estimate, Metrics, Outcome, Scorer};
 use estimator_core::eskf::{
@@ -15,9 +15,11 @@ use estimator_core::eskf::{
     GravityDirection, ImuNoise, ImuSample, InitialSigmas, Ins, Magnetometer, MagnetometerWindow,
     UpdateOptions, UpdateOutcome,
 };
-use estimator_core::lie::{LieGroup, So3};
+use estimator_core::eskf::{Alignment, CameraLandmark, PinholeIntrinsics};
+use estimator_core::gn::{solve_pnp, Loss, PinholeCamera, PnpOptions};
+use estimator_core::lie::{LieGroup, Se3, So3};
 use estimator_core::Real;
-use nalgebra::{Matrix3, SMatrix, Vector3};
+use nalgebra::{Matrix3, SMatrix, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -307,12 +309,15 @@ fn replay_in<T: Real>(
     };
     let mut events = ds.events()?.peekable();
 
-    // --- Start-up: a window at rest, then the first GNSS fix for the position. ---
+    // --- Start-up: a window at rest, then the first GNSS fix (or, without GNSS, the first
+    // camera frame, solved for the pose) for the position. ---
     let window_ns = (cfg.align_window_s * 1e9) as u64;
     let (mut accel, mut gyro, mut mags) = (Vec::new(), Vec::new(), Vec::new());
     let mut t_first: Option<u64> = None;
     let mut last_imu: Option<u64> = None;
     let mut first_fix: Option<Vector3<f64>> = None;
+    let mut first_frame: Option<Vec<(u64, Vector2<f64>)>> = None;
+    let pnp_start = ds.gnss.is_none() && ds.camera.is_some();
     while let Some(ev) = events.peek() {
         let ev = match ev {
             Ok(e) => e.clone(),
@@ -325,7 +330,8 @@ fn replay_in<T: Real>(
         };
         let t0 = *t_first.get_or_insert(ev.t_ns());
         let in_window = ev.t_ns() < t0 + window_ns;
-        let need_fix = ds.gnss.is_some() && first_fix.is_none();
+        let need_fix = (ds.gnss.is_some() && first_fix.is_none())
+            || (pnp_start && first_frame.is_none());
         if !in_window && !need_fix {
             break;
         }
@@ -342,10 +348,13 @@ fn replay_in<T: Real>(
             Event::Imu { t_ns, .. } => last_imu = Some(*t_ns),
             Event::Mag { field, .. } if in_window => mags.push(lit3::<T>(field)),
             Event::Gnss { position, .. } => first_fix = Some(*position),
+            Event::Camera { observations, .. } if pnp_start && !in_window && observations.len() >= 6 => {
+                first_frame = Some(observations.clone());
+            }
             _ => {}
         }
         events.next();
-        if !in_window && first_fix.is_some() {
+        if !in_window && (first_fix.is_some() || first_frame.is_some()) {
             break;
         }
     }
@@ -367,14 +376,32 @@ fn replay_in<T: Real>(
         ))
     })?;
     let sigmas = InitialSigmas::<T>::default();
-    let mut filter = match (first_fix, &ds.gnss) {
-        (Some(p), Some(g)) => {
+    let mut filter = match (first_fix, &ds.gnss, first_frame, &ds.camera) {
+        (Some(p), Some(g), _, _) => {
             let p0 = p - alignment.attitude.cast::<f64>().act(&g.lever_arm);
             let ins = Ins::from_alignment(
                 &alignment,
                 lit3(&p0),
                 &InitialSigmas {
                     position: T::lit(2.0),
+                    ..sigmas
+                },
+                config,
+            )
+            .map_err(|e| ReplayError::Start(e.to_string()))?;
+            Filter::Ins(Box::new(ins))
+        }
+        (_, _, Some(frame), Some(cam)) => {
+            let world_from_body = pnp_pose(&frame, cam, &alignment.attitude.cast())?;
+            let start = Alignment {
+                attitude: world_from_body.rotation().cast(),
+                ..alignment
+            };
+            let ins = Ins::from_alignment(
+                &start,
+                lit3(&world_from_body.translation()),
+                &InitialSigmas {
+                    position: T::lit(0.2),
                     ..sigmas
                 },
                 config,
@@ -425,6 +452,8 @@ fn replay_in<T: Real>(
 
     // --- The run. ---
     let ekf = UpdateOptions::<T>::default();
+    // Projections are strongly nonlinear near the camera: re-linearize (iterated update).
+    let camera_options = UpdateOptions::<T>::iterated(ekf.gate, 3, T::lit(1e-6));
     let g_norm = gravity.norm();
     // The white noise of one accelerometer sample, as a direction: σ_a √rate / g.
     let white_dir_sq =
@@ -522,7 +551,28 @@ fn replay_in<T: Real>(
                     scorer.measurement("baro", t_ns, outcome(r, 1));
                 }
             }
-            Event::Camera { .. } => {}
+            Event::Camera { t_ns, observations } => {
+                if let (Filter::Ins(f), Some(cam)) = (&mut filter, &ds.camera) {
+                    let [fx, fy, cx, cy] = cam.intrinsics;
+                    let intrinsics = PinholeIntrinsics { fx: T::lit(fx), fy: T::lit(fy), cx: T::lit(cx), cy: T::lit(cy) };
+                    let body_from_camera = cam.body_from_camera.cast::<T>();
+                    for (id, pixel) in &observations {
+                        let Some(landmark) = cam.landmarks.get(id) else {
+                            scorer.measurement("camera", t_ns, Outcome::Refused);
+                            continue;
+                        };
+                        let model = CameraLandmark::new(
+                            lit2(pixel),
+                            lit3(landmark),
+                            intrinsics,
+                            body_from_camera,
+                            T::lit(cam.sigma_px),
+                        );
+                        let r = f.update(&model, &camera_options);
+                        scorer.measurement("camera", t_ns, outcome(r, 2));
+                    }
+                }
+            }
         }
         scorer.filter_ns += started.elapsed().as_nanos();
     }
@@ -598,6 +648,40 @@ impl Drop for Partials<'_> {
             }
         }
     }
+}
+
+fn lit2<T: Real>(v: &Vector2<f64>) -> Vector2<T> {
+    v.map(T::lit)
+}
+
+/// `world_from_body` from one camera frame: `solve_pnp` (Cauchy loss, 2 px scale) from a guess
+/// with the aligned attitude at the origin, then `T_wb = T_cw⁻¹ T_BS⁻¹`.
+fn pnp_pose(
+    frame: &[(u64, Vector2<f64>)],
+    cam: &CameraParams,
+    attitude: &So3<f64>,
+) -> Result<Se3<f64>, ReplayError> {
+    let (mut world, mut pixels) = (Vec::new(), Vec::new());
+    for (id, px) in frame {
+        if let Some(p) = cam.landmarks.get(id) {
+            world.push(*p);
+            pixels.push(*px);
+        }
+    }
+    let [fx, fy, cx, cy] = cam.intrinsics;
+    let camera = PinholeCamera { fx, fy, cx, cy };
+    let world_from_camera_guess = Se3::from_parts(*attitude, Vector3::zeros()).compose(&cam.body_from_camera);
+    let options = PnpOptions {
+        loss: Loss::Cauchy(2.0),
+        sigma_px: cam.sigma_px,
+        ..PnpOptions::default()
+    };
+    let sol = solve_pnp(&world, &pixels, &camera, &world_from_camera_guess.inverse(), &options)
+        .map_err(|e| ReplayError::Start(format!("camera pose from the first frame: {e}")))?;
+    Ok(sol
+        .camera_from_world
+        .inverse()
+        .compose(&cam.body_from_camera.inverse()))
 }
 
 fn write_estimate_csv(f: &mut impl Write, e: &Estimate) -> std::io::Result<()> {

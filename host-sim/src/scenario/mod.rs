@@ -241,8 +241,9 @@ pub fn builtin_scenarios() -> Vec<Scenario> {
         },
         Scenario {
             name: "camera".into(),
-            description: "hover in front of 300 known landmarks; IMU and a 10 Hz camera".into(),
+            description: "hover in front of 300 known landmarks; IMU, magnetometer and a 10 Hz camera (pose from PnP at start)".into(),
             shape: "hover".into(),
+            mag: Some(MagConfig::default()),
             camera: Some(CameraConfig::default()),
             ceilings: Ceilings { ate_m: 0.3, attitude_deg: 1.0 },
             ..base.clone()

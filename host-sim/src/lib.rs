@@ -1,5 +1,6 @@
 //! `host-sim`: the host-side simulator, dataset replay and scoring for `estimator-core`.
 //!
+//! * [`baseline`]: Madgwick and Mahony, measured on the same data as the filter.
 //! * [`trajectory`]: smooth analytic SE(3) motions with exact derivatives.
 //! * [`sensors`]: IMU, magnetometer, GNSS, camera and barometer models.
 //! * [`scenario`]: named and TOML scenarios.
@@ -10,6 +11,7 @@
 //! * [`replay`]: the filter over a dataset folder, with every output of the contract.
 #![warn(missing_docs)]
 
+pub mod baseline;
 pub mod dataset;
 pub mod metrics;
 pub mod montecarlo;

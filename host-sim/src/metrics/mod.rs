@@ -196,6 +196,8 @@ pub struct Scorer {
     pub keep_nees: bool,
     /// Per-sample NEES per block (NaN where not estimated), when `keep_nees`.
     pub nees_steps: Vec<[f64; 5]>,
+    /// Sum of squared attitude errors and count, per reference filter (`baseline`).
+    pub baselines: BTreeMap<String, (f64, u64)>,
 }
 
 /// The figures of one run (`metrics.json`).
@@ -221,6 +223,8 @@ pub struct Metrics {
     pub filter_ns_per_imu_sample: f64,
     /// Samples scored.
     pub samples_scored: u64,
+    /// Attitude RMSE of the reference filters run on the same data (Madgwick, Mahony), degrees.
+    pub baseline_attitude_rmse_deg: BTreeMap<String, f64>,
 }
 
 impl Scorer {
@@ -260,6 +264,14 @@ impl Scorer {
             est_bias: six(eb),
             true_bias: six(tb),
         });
+    }
+
+    /// Scores a reference filter's attitude against the truth.
+    pub fn add_baseline(&mut self, name: &str, attitude: &So3<f64>, truth: &Truth) {
+        let e = attitude.inverse().compose(&truth.attitude).log().norm_squared();
+        let entry = self.baselines.entry(name.to_string()).or_insert((0.0, 0));
+        entry.0 += e;
+        entry.1 += 1;
     }
 
     /// Records the outcome of one measurement.
@@ -329,6 +341,11 @@ impl Scorer {
                 f64::NAN
             },
             samples_scored: self.n,
+            baseline_attitude_rmse_deg: self
+                .baselines
+                .iter()
+                .map(|(k, (sq, n))| (k.clone(), (sq / (*n).max(1) as f64).sqrt().to_degrees()))
+                .collect(),
         }
     }
 }

@@ -7,6 +7,7 @@
 //! GNSS fix. It never reads the ground truth to start or to run; the truth is only scored against.
 //! With a GNSS stream it runs the 15-state INS, otherwise the attitude-only filter.
 
+use crate::baseline::{Madgwick, Mahony};
 use crate::dataset::read::{CameraParams, Dataset, Event, Truth, TruthStream};
 use crate::dataset::DatasetError;
 use crate::metrics::{interpolate_truth, Estimate, Metrics, Outcome, Scorer};
@@ -416,6 +417,12 @@ fn replay_in<T: Real>(
         }
     };
 
+    // Reference filters on the same data, from the same start (where a magnetometer exists).
+    let mut baselines = ds.mag.as_ref().map(|m| {
+        let start = filter.estimate(0).attitude;
+        (Madgwick::new(start, m.reference_field), Mahony::new(start, m.reference_field))
+    });
+
     // --- Outputs: written as `*.partial`, renamed only when the whole run succeeded. ---
     let mut partials = Partials::new(out);
     partials.clear_previous();
@@ -478,6 +485,10 @@ fn replay_in<T: Real>(
                     _ => (gyro, accel),
                 };
                 last_sample = Some((gyro, accel));
+                if let Some((mw, mh)) = baselines.as_mut() {
+                    mw.imu(&g_mid, &a_mid, dt);
+                    mh.imu(&g_mid, &a_mid, dt);
+                }
                 if filter.predict(&g_mid, &a_mid, dt).is_err() {
                     scorer.measurement("imu", t_ns, Outcome::Refused);
                 }
@@ -505,11 +516,19 @@ fn replay_in<T: Real>(
                 if let Some(tr) = truth.as_mut() {
                     if let Some(t) = tr.at(t_ns)? {
                         scorer.add(&e, &t);
+                        if let Some((mw, mh)) = &baselines {
+                            scorer.add_baseline("madgwick", &mw.attitude, &t);
+                            scorer.add_baseline("mahony", &mh.attitude, &t);
+                        }
                     }
                 }
                 continue;
             }
             Event::Mag { t_ns, field } => {
+                if let Some((mw, mh)) = baselines.as_mut() {
+                    mw.mag(&field);
+                    mh.mag(&field);
+                }
                 if let Some(m) = &ds.mag {
                     let model =
                         Magnetometer::new(lit3(&field), lit3(&m.reference_field), T::lit(m.sigma));

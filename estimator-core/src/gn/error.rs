@@ -45,10 +45,16 @@ impl core::fmt::Display for SolveError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             Self::TooFewObservations { needed, got } => {
-                write!(f, "too few observations: {got} given, at least {needed} needed")
+                write!(
+                    f,
+                    "too few observations: {got} given, at least {needed} needed"
+                )
             }
             Self::TooManyObservations { capacity, got } => {
-                write!(f, "too many observations: {got} given, capacity is {capacity}")
+                write!(
+                    f,
+                    "too many observations: {got} given, capacity is {capacity}"
+                )
             }
             Self::LengthMismatch => f.write_str("input slices have different lengths"),
             Self::NonFiniteInput => f.write_str("non-finite input"),
@@ -57,9 +63,7 @@ impl core::fmt::Display for SolveError {
             Self::InvalidOptions => f.write_str("invalid solver options"),
             Self::DegenerateGeometry => f.write_str("degenerate geometry"),
             Self::PointBehindCamera => f.write_str("a point is at or behind the camera"),
-            Self::NotPositiveDefinite => {
-                f.write_str("information matrix is not positive definite")
-            }
+            Self::NotPositiveDefinite => f.write_str("information matrix is not positive definite"),
             Self::NonFiniteResidual => f.write_str("non-finite residual, cost or step"),
         }
     }

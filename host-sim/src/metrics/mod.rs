@@ -111,7 +111,7 @@ impl<P> History<P> {
 
     /// Offers a point; it is kept if it falls on the current stride.
     pub fn push(&mut self, p: P) {
-        if self.seen % self.stride == 0 {
+        if self.seen.is_multiple_of(self.stride) {
             self.points.push(p);
             if self.points.len() >= Self::CAPACITY {
                 let mut i = 0;

@@ -496,7 +496,7 @@ fn replay_in<T: Real>(
                 if let Filter::Ahrs(f) = &mut filter {
                     // Tilt aiding while the specific force is close to gravity.
                     let mismatch = (accel.norm() - g_norm).abs();
-                    if imu_count % cfg.gravity_every.max(1) == 0 && mismatch < cfg.gravity_gate {
+                    if imu_count.is_multiple_of(cfg.gravity_every.max(1)) && mismatch < cfg.gravity_gate {
                         // Only the mismatch beyond three sigmas of the white noise reveals motion.
                         let excess = (mismatch - 3.0 * white_dir_sq.sqrt() * g_norm).max(0.0);
                         let sigma = (white_dir_sq

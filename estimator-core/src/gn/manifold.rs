@@ -1,0 +1,112 @@
+//! The state spaces the solver works on: any Lie group of [`crate::lie`], Euclidean vectors, and
+//! products of two of them (e.g. a pose and a point).
+
+use crate::lie::{LieGroup, Se2, Se3, So2, So3};
+use crate::Real;
+use nalgebra::SVector;
+
+/// A state with `N` degrees of freedom and the retraction `⊕` of seed eq. (4.5).
+///
+/// For a Lie group `a ⊕ ξ = a · exp(ξ^)` (the right perturbation of [`crate::lie`]); for `Rⁿ`,
+/// `a ⊕ ξ = a + ξ`; for a product, each factor takes its own slice of `ξ`.
+pub trait Manifold<T: Real, const N: usize>: Copy {
+    /// `a ⊕ ξ` (seed eq. 4.5).
+    #[must_use]
+    fn oplus(&self, xi: &SVector<T, N>) -> Self;
+
+    /// `true` when every stored number is finite.
+    #[must_use]
+    fn all_finite(&self) -> bool;
+}
+
+macro_rules! lie_manifold {
+    ($g:ident, $n:literal) => {
+        impl<T: Real> Manifold<T, $n> for $g<T> {
+            #[inline]
+            fn oplus(&self, xi: &SVector<T, $n>) -> Self {
+                self.rplus(xi)
+            }
+            #[inline]
+            fn all_finite(&self) -> bool {
+                self.is_finite()
+            }
+        }
+    };
+}
+
+lie_manifold!(So2, 1);
+lie_manifold!(Se2, 3);
+lie_manifold!(So3, 3);
+lie_manifold!(Se3, 6);
+
+impl<T: Real, const N: usize> Manifold<T, N> for SVector<T, N> {
+    #[inline]
+    fn oplus(&self, xi: &SVector<T, N>) -> Self {
+        self + xi
+    }
+    #[inline]
+    fn all_finite(&self) -> bool {
+        self.iter().all(|x| x.is_finite())
+    }
+}
+
+/// The product manifold `A × B` with `NA + NB` degrees of freedom; the tangent is `[ξ_a; ξ_b]`
+/// and `(a, b) ⊕ [ξ_a; ξ_b] = (a ⊕ ξ_a, b ⊕ ξ_b)`.
+///
+/// It implements [`Manifold<T, N>`] for `N = NA + NB` only: any other `N` is rejected at compile
+/// time (a `const` assertion evaluated when the impl is instantiated).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Product<A, B, const NA: usize, const NB: usize> {
+    /// The first factor.
+    pub a: A,
+    /// The second factor.
+    pub b: B,
+}
+
+impl<A, B, const NA: usize, const NB: usize> Product<A, B, NA, NB> {
+    /// `(a, b)`.
+    #[must_use]
+    pub fn new(a: A, b: B) -> Self {
+        Self { a, b }
+    }
+
+    /// Splits `[ξ_a; ξ_b]` (entries beyond `NA + NB` are ignored, missing ones are zero; the
+    /// `Manifold` impl guarantees `N = NA + NB` at compile time).
+    #[must_use]
+    pub fn split<T: Real, const N: usize>(xi: &SVector<T, N>) -> (SVector<T, NA>, SVector<T, NB>) {
+        let mut xa = SVector::<T, NA>::zeros();
+        let mut xb = SVector::<T, NB>::zeros();
+        xa.iter_mut().zip(xi.iter()).for_each(|(d, s)| *d = *s);
+        xb.iter_mut()
+            .zip(xi.iter().skip(NA))
+            .for_each(|(d, s)| *d = *s);
+        (xa, xb)
+    }
+}
+
+impl<T, A, B, const NA: usize, const NB: usize, const N: usize> Manifold<T, N>
+    for Product<A, B, NA, NB>
+where
+    T: Real,
+    A: Manifold<T, NA>,
+    B: Manifold<T, NB>,
+{
+    #[inline]
+    fn oplus(&self, xi: &SVector<T, N>) -> Self {
+        const {
+            assert!(
+                N == NA + NB,
+                "Product<A, B, NA, NB> has NA + NB degrees of freedom"
+            )
+        };
+        let (xa, xb) = Self::split(xi);
+        Self {
+            a: self.a.oplus(&xa),
+            b: self.b.oplus(&xb),
+        }
+    }
+    #[inline]
+    fn all_finite(&self) -> bool {
+        self.a.all_finite() && self.b.all_finite()
+    }
+}

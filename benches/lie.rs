@@ -25,26 +25,51 @@ fn so3_ops<T: Real>(c: &mut Criterion, name: &str) {
     g.bench_function("exp_jac", |bch| bch.iter(|| So3::exp_jac(black_box(&w))));
     g.bench_function("log", |bch| bch.iter(|| black_box(&a).log()));
     g.bench_function("log_jac", |bch| bch.iter(|| black_box(&a).log_jac()));
-    g.bench_function("compose", |bch| bch.iter(|| black_box(&a).compose(black_box(&b))));
-    g.bench_function("compose_jac", |bch| bch.iter(|| black_box(&a).compose_jac(black_box(&b))));
+    g.bench_function("compose", |bch| {
+        bch.iter(|| black_box(&a).compose(black_box(&b)))
+    });
+    g.bench_function("compose_jac", |bch| {
+        bch.iter(|| black_box(&a).compose_jac(black_box(&b)))
+    });
     g.bench_function("act", |bch| bch.iter(|| black_box(&a).act(black_box(&p))));
-    g.bench_function("act_jac", |bch| bch.iter(|| black_box(&a).act_jac(black_box(&p))));
-    g.bench_function("rplus", |bch| bch.iter(|| black_box(&a).rplus(black_box(&w2))));
-    g.bench_function("rminus", |bch| bch.iter(|| black_box(&a).rminus(black_box(&b))));
-    g.bench_function("right_jacobian_inv", |bch| bch.iter(|| So3::right_jacobian_inv(black_box(&w))));
+    g.bench_function("act_jac", |bch| {
+        bch.iter(|| black_box(&a).act_jac(black_box(&p)))
+    });
+    g.bench_function("rplus", |bch| {
+        bch.iter(|| black_box(&a).rplus(black_box(&w2)))
+    });
+    g.bench_function("rminus", |bch| {
+        bch.iter(|| black_box(&a).rminus(black_box(&b)))
+    });
+    g.bench_function("right_jacobian_inv", |bch| {
+        bch.iter(|| So3::right_jacobian_inv(black_box(&w)))
+    });
     g.bench_function("nalgebra_from_scaled_axis", |bch| {
         bch.iter(|| UnitQuaternion::from_scaled_axis(black_box(w)))
     });
-    g.bench_function("nalgebra_scaled_axis", |bch| bch.iter(|| black_box(&qa).scaled_axis()));
-    g.bench_function("nalgebra_quaternion_product", |bch| bch.iter(|| black_box(qa) * black_box(qb)));
-    g.bench_function("nalgebra_rotate_vector", |bch| bch.iter(|| black_box(qa) * black_box(p)));
+    g.bench_function("nalgebra_scaled_axis", |bch| {
+        bch.iter(|| black_box(&qa).scaled_axis())
+    });
+    g.bench_function("nalgebra_quaternion_product", |bch| {
+        bch.iter(|| black_box(qa) * black_box(qb))
+    });
+    g.bench_function("nalgebra_rotate_vector", |bch| {
+        bch.iter(|| black_box(qa) * black_box(p))
+    });
     g.finish();
 }
 
 fn se3_ops<T: Real>(c: &mut Criterion, name: &str) {
     let lit = |x: f64| T::lit(x);
     let xi = Vector6::new(lit(1.0), lit(-2.0), lit(0.5), lit(0.3), lit(-0.7), lit(1.1));
-    let xi2 = Vector6::new(lit(-0.3), lit(0.7), lit(2.0), lit(-1.2), lit(0.4), lit(0.25));
+    let xi2 = Vector6::new(
+        lit(-0.3),
+        lit(0.7),
+        lit(2.0),
+        lit(-1.2),
+        lit(0.4),
+        lit(0.25),
+    );
     let p = Vector3::new(lit(0.5), lit(-2.0), lit(1.5));
     let a = Se3::exp(&xi);
     let b = Se3::exp(&xi2);
@@ -53,10 +78,16 @@ fn se3_ops<T: Real>(c: &mut Criterion, name: &str) {
     g.bench_function("exp_jac", |bch| bch.iter(|| Se3::exp_jac(black_box(&xi))));
     g.bench_function("log", |bch| bch.iter(|| black_box(&a).log()));
     g.bench_function("log_jac", |bch| bch.iter(|| black_box(&a).log_jac()));
-    g.bench_function("compose", |bch| bch.iter(|| black_box(&a).compose(black_box(&b))));
-    g.bench_function("compose_jac", |bch| bch.iter(|| black_box(&a).compose_jac(black_box(&b))));
+    g.bench_function("compose", |bch| {
+        bch.iter(|| black_box(&a).compose(black_box(&b)))
+    });
+    g.bench_function("compose_jac", |bch| {
+        bch.iter(|| black_box(&a).compose_jac(black_box(&b)))
+    });
     g.bench_function("act", |bch| bch.iter(|| black_box(&a).act(black_box(&p))));
-    g.bench_function("act_jac", |bch| bch.iter(|| black_box(&a).act_jac(black_box(&p))));
+    g.bench_function("act_jac", |bch| {
+        bch.iter(|| black_box(&a).act_jac(black_box(&p)))
+    });
     g.finish();
 }
 

@@ -11,11 +11,19 @@ fn main() {
 
     // exp / log, near π included.
     let pi = core::f64::consts::PI;
-    println!("{:<28} {:>22} {:>12}", "rotation vector ω", "log(exp ω) − ω (max)", "angle");
+    println!(
+        "{:<28} {:>22} {:>12}",
+        "rotation vector ω", "log(exp ω) − ω (max)", "angle"
+    );
     for angle in [1e-9, 1e-4, 1.0, 3.0, pi - 1e-6] {
         let w = Vector3::new(0.6, 0.0, 0.8) * angle;
         let err = (So3::exp(&w).log() - w).amax();
-        println!("{:<28} {:>22.3e} {:>12.9}", format!("{:.3e}·[0.6,0,0.8]", angle), err, angle);
+        println!(
+            "{:<28} {:>22.3e} {:>12.9}",
+            format!("{:.3e}·[0.6,0,0.8]", angle),
+            err,
+            angle
+        );
     }
 
     // Seed Example 5.2: the Jacobian of f(R, p) = R p is R [[−p]× | I].
@@ -24,7 +32,11 @@ fn main() {
     let (rp, j_r, j_p) = r.act_jac(&p);
     let closed = r.matrix() * skew(&-p);
     println!("\nExample 5.2: R p = {:.4?}", rp.as_slice());
-    println!("  ‖∂(Rp)/∂R − R[−p]×‖ = {:.1e}, ∂(Rp)/∂p = R: {}", (j_r - closed).amax(), j_p == r.matrix());
+    println!(
+        "  ‖∂(Rp)/∂R − R[−p]×‖ = {:.1e}, ∂(Rp)/∂p = R: {}",
+        (j_r - closed).amax(),
+        j_p == r.matrix()
+    );
 
     // A Jacobian against a central difference through ⊕ / ⊖ (Def. 4.6).
     let a = Se3::exp(&Vector6::new(1.0, -2.0, 0.5, 0.3, -0.7, 1.1));
@@ -35,7 +47,8 @@ fn main() {
     for i in 0..6 {
         let mut d = Vector6::zeros();
         d[i] = h;
-        let col = (a.rplus(&d).compose(&b).rminus(&ab) - a.rplus(&-d).compose(&b).rminus(&ab)) / (2.0 * h);
+        let col = (a.rplus(&d).compose(&b).rminus(&ab) - a.rplus(&-d).compose(&b).rminus(&ab))
+            / (2.0 * h);
         worst = worst.max((col - j_a.column(i)).amax());
     }
     println!("\nSE(3) compose_jac ∂(ab)/∂a against a central difference: max error {worst:.1e}");
@@ -44,7 +57,14 @@ fn main() {
     let w32 = Vector3::new(0.3f32, -0.7, 1.1);
     let e32 = So3::exp(&w32).matrix().map(f64::from);
     let e64 = So3::exp(&w32.map(f64::from)).matrix();
-    println!("f32 exp against f64: max error {:.1e} (f32 ε = {:.1e})", (e32 - e64).amax(), f32::EPSILON);
+    println!(
+        "f32 exp against f64: max error {:.1e} (f32 ε = {:.1e})",
+        (e32 - e64).amax(),
+        f32::EPSILON
+    );
     let t = a.interpolate(&b, 0.5);
-    println!("\ninterpolate(a, b, 0.5) translation = {:.4?}", t.translation().as_slice());
+    println!(
+        "\ninterpolate(a, b, 0.5) translation = {:.4?}",
+        t.translation().as_slice()
+    );
 }

@@ -3,7 +3,10 @@
 //! `try_from_matrix` acceptance and rejection, and non-finite inputs.
 
 use estimator_core::lie::{skew, LieGroup, Se2, Se3, So2, So3, ORTHOGONALITY_TOLERANCE};
-use nalgebra::{Matrix2, Matrix3, Matrix4, Quaternion, Rotation3, UnitQuaternion, Vector1, Vector2, Vector3, Vector6};
+use nalgebra::{
+    Matrix2, Matrix3, Matrix4, Quaternion, Rotation3, UnitQuaternion, Vector1, Vector2, Vector3,
+    Vector6,
+};
 
 fn max_abs_diff<const R: usize, const C: usize>(
     a: &nalgebra::SMatrix<f64, R, C>,
@@ -51,7 +54,19 @@ fn so3_agrees_with_nalgebra() {
         Vector3::new(1.0, 1.0, 1.0),
     ];
     let pi = core::f64::consts::PI;
-    let angles = [0.0, 1e-9, 1e-6, 1e-4, 0.1, 1.0, 2.0, 3.0, pi - 1e-2, pi - 1e-4, pi - 1e-6];
+    let angles = [
+        0.0,
+        1e-9,
+        1e-6,
+        1e-4,
+        0.1,
+        1.0,
+        2.0,
+        3.0,
+        pi - 1e-2,
+        pi - 1e-4,
+        pi - 1e-6,
+    ];
     for axis in &axes {
         for &angle in &angles {
             let w = axis.normalize() * angle;
@@ -59,7 +74,10 @@ fn so3_agrees_with_nalgebra() {
             let theirs = UnitQuaternion::from_scaled_axis(w);
             assert!(max_abs_diff(&ours.matrix(), theirs.to_rotation_matrix().matrix()) < 1e-15);
             let log = ours.log();
-            assert!((log - w).amax() < 1e-14 * (1.0 + angle), "log {angle}: {log:?} vs {w:?}");
+            assert!(
+                (log - w).amax() < 1e-14 * (1.0 + angle),
+                "log {angle}: {log:?} vs {w:?}"
+            );
             let p = Vector3::new(0.5, -2.0, 1.5);
             assert!((ours.act(&p) - theirs * p).amax() < 1e-14);
             // Rotation3's own log is a different, matrix-based algorithm through
@@ -69,7 +87,11 @@ fn so3_agrees_with_nalgebra() {
             if (0.1..3.0).contains(&angle) {
                 let rot = Rotation3::from_scaled_axis(w);
                 let d = (rot.scaled_axis() - log).amax();
-                assert!(d < 1e-12, "angle {angle}: nalgebra {:?} ours {log:?}", rot.scaled_axis());
+                assert!(
+                    d < 1e-12,
+                    "angle {angle}: nalgebra {:?} ours {log:?}",
+                    rot.scaled_axis()
+                );
             }
         }
     }
@@ -86,7 +108,9 @@ fn products_agree_with_nalgebra() {
 
     let ta = Se3::exp(&Vector6::new(1.0, -2.0, 0.5, 0.3, 0.2, -0.9));
     let tb = Se3::exp(&Vector6::new(-0.3, 0.7, 2.0, -1.2, 0.4, 0.1));
-    let iso = |t: &Se3<f64>| nalgebra::Isometry3::from_parts(t.translation().into(), t.rotation().quaternion());
+    let iso = |t: &Se3<f64>| {
+        nalgebra::Isometry3::from_parts(t.translation().into(), t.rotation().quaternion())
+    };
     let prod = iso(&ta) * iso(&tb);
     assert!(max_abs_diff(&(ta * tb).matrix(), &prod.to_homogeneous()) < 1e-14);
 }

@@ -206,6 +206,10 @@ fn check_algebra<T, G, const N: usize, const D: usize, const M: usize>(
     let e = G::exp(tau);
     assert!(e.is_finite());
     close(&e.log(), tau, 16.0 * eps * (1.0 + angle), "log(exp τ)");
+    // ... and relative to τ itself, which matters for small steps (a 1e-9 rotation must come
+    // back as 1e-9 to a few ulps, not to ε absolute).
+    let rel = diff(&e.log(), tau) / maxabs(tau).max(f64::MIN_POSITIVE);
+    assert!(maxabs(tau) == 0.0 || rel <= 8.0 * eps, "log(exp τ) relative error {rel:.3e} at {tau:?}");
     // exp∘log.
     close(
         &G::exp(&a.log()).matrix(),

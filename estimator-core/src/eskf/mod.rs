@@ -1,1 +1,134 @@
-//! On-manifold error-state Kalman filter (work in progress).
+//! On-manifold error-state Kalman filter: a 15-state inertial navigator ([`Ins`]) and an
+//! attitude-only AHRS ([`Ahrs`]), with chi-square gating, Joseph-form updates, iterated
+//! (Gauss-Newton) updates and typed outcomes. Allocation-free and panic-free.
+//!
+//! # State and error
+//!
+//! Nominal state `x = (R, v, p, b_g, b_a)`: `R ∈ SO(3)` world-from-body ([`crate::lie::So3`]),
+//! velocity `v` and position `p` in the world frame (ENU, z up), gyro and accelerometer biases in
+//! the body frame. Error state `δx = (δθ, δv, δp, δb_g, δb_a) ∈ R¹⁵` with the attitude error on the
+//! right (seed eq. 4.5, the crate's convention):
+//!
+//! ```text
+//! R = R̂ · exp(δθ^),   v = v̂ + δv,   p = p̂ + δp,   b_g = b̂_g + δb_g,   b_a = b̂_a + δb_a
+//! ```
+//!
+//! so `x = x̂ ⊕ δx` ([`ErrorState::oplus`]). The attitude-only state is `(R, b_g)` with
+//! `δx = (δθ, δb_g) ∈ R⁶`.
+//!
+//! # Prediction ([`Ins::predict`], [`Ahrs::predict`])
+//!
+//! One IMU sample `(ω_m, f_m, dt)`, held constant over `dt`; `ω = ω_m − b_g`, `f = f_m − b_a`,
+//! `a = R f + g` (`g = [0, 0, −9.81]` by default):
+//!
+//! ```text
+//! R⁺ = R · exp((ω dt)^)           (on the manifold, not a first-order quaternion step)
+//! v⁺ = v + a dt
+//! p⁺ = p + v dt + ½ a dt²
+//! ```
+//!
+//! The error propagates as `δx⁺ = F δx + w`, with `ΔR = exp(ω dt)` and `J_r` the SO(3) right
+//! Jacobian (`exp(τ + δ) ≈ exp(τ)·exp(J_r(τ)δ)`); the nonzero 3×3 blocks of `F` are
+//!
+//! ```text
+//!        δθ                δv      δp    δb_g              δb_a
+//! δθ⁺ [ ΔRᵀ               0       0     −J_r(ω dt) dt     0         ]
+//! δv⁺ [ −R[f]× dt         I       0     0                 −R dt     ]
+//! δp⁺ [ −½R[f]× dt²       I dt    I     0                 −½R dt²   ]
+//! δb_g⁺[ 0                0       0     I                 0         ]
+//! δb_a⁺[ 0                0       0     0                 I         ]
+//! ```
+//!
+//! `P⁺ = F P Fᵀ + Q` is computed block by block (`F P`, then `(F P) Fᵀ` in place), never as a
+//! dense 15×15×15 product. From the Kalibr continuous-time densities (`σ_g` rad/s/√Hz,
+//! `σ_a` m/s²/√Hz, random walks `σ_bg`, `σ_ba`; [`ImuNoise`]):
+//!
+//! ```text
+//! Q_θθ = σ_g² dt I,  Q_vv = σ_a² dt I,  Q_vp = Q_pv = ½σ_a² dt² I,  Q_pp = ¼σ_a² dt³ I,
+//! Q_bgbg = σ_bg² dt I,  Q_baba = σ_ba² dt I.
+//! ```
+//!
+//! The AHRS uses the `(δθ, δb_g)` corner: `F = [ΔRᵀ, −J_r dt; 0, I]`,
+//! `Q = diag(σ_g² dt I, σ_bg² dt I)`.
+//!
+//! # Measurement update ([`Ins::update`], [`Ahrs::update`])
+//!
+//! A model ([`Measurement`]) gives the residual `r = z ⊖ h(x̂)` and the right Jacobian
+//! `H = ∂h(x̂ ⊕ δx)/∂δx` (seed eq. 4.3 and Def. 4.6), and its noise `R`. Then
+//!
+//! ```text
+//! S   = H P Hᵀ + R
+//! NIS = rᵀ S⁻¹ r                        squared Mahalanobis distance (seed eq. 4.1, Remark 4.2)
+//! gate: NIS ≤ χ²_m(p), else Rejected { nis } and nothing changes
+//! K   = P Hᵀ S⁻¹,  δx = K r            the minimizer of seed eq. 4.4 with the prior added
+//! P⁺  = (I − KH) P (I − KH)ᵀ + K R Kᵀ  Joseph form, evaluated as P − KUᵀ − UKᵀ + KSKᵀ, U = P Hᵀ
+//!                                       = P + V Kᵀ + K Vᵀ, V = ½KS − U (exactly symmetric, in place)
+//! x⁺  = x̂ ⊕ δx                          injection (seed eq. 4.5)
+//! P⁺ ← G P⁺ Gᵀ,  G = blockdiag(J_r(δθ), I)   reset to the error about x⁺
+//! ```
+//!
+//! The iterated update ([`UpdateOptions::iterated`]) is Gauss-Newton on the manifold (seed §4) for
+//! `‖δx‖²_P + ‖z ⊖ h(x̂ ⊕ δx)‖²_R`: at `x_k = x̂ ⊕ δx_k` the model is linearized again,
+//! `H̃_k = H_k · blockdiag(J_r(δθ_k), I)` and `δx_{k+1} = K_k (r_k + H̃_k δx_k)`, until
+//! `‖δx_{k+1} − δx_k‖ < tol` or the iteration cap. The gate uses the NIS at the prior.
+//!
+//! # Measurement models
+//!
+//! | model | `h(x)` | nonzero blocks of `H` |
+//! |---|---|---|
+//! | [`GnssPosition`] | `p + R ℓ` | `δθ: −R[ℓ]×` (seed Thm 5.1 / Ex. 5.2), `δp: I` |
+//! | [`GnssVelocity`] | `v` | `δv: I` |
+//! | [`ZeroVelocity`] | `v` (z = 0) | `δv: I` |
+//! | [`BaroAltitude`] | `p_z + offset` | `δp: [0 0 1]` |
+//! | [`Magnetometer`] | `Rᵀ m_w` | `δθ: [Rᵀ m_w]×` |
+//! | [`GravityDirection`] | `Rᵀ u` (u up) vs `f_m/‖f_m‖` | `δθ: [Rᵀ u]×` |
+//! | [`AccelerometerAtRest`] | `Rᵀ(−g) + b_a` | `δθ: [Rᵀ(−g)]×`, `δb_a: I` |
+//! | [`Heading`] | `atan2(R₂₁, R₁₁)` | `δθ: (c_x ∂c_y − c_y ∂c_x)/(c_x²+c_y²)`, `∂(R e₁) = −R[e₁]×` |
+//! | [`CameraLandmark`] | `π(T_cw ℓ)` (seed `z_ij = π(T_i p_j)`) | `δθ: J_π R_bcᵀ [q]×`, `δp: −J_π R_bcᵀ Rᵀ` |
+//!
+//! # Start-up
+//!
+//! [`align_at_rest`] gives tilt from the mean specific force, heading from the magnetometer when
+//! present, and the gyro bias from the mean rate; [`Ins::from_alignment`] /
+//! [`Ahrs::from_alignment`] start from it, [`Ins::new`] / [`Ahrs::new`] from a given state and
+//! covariance.
+//!
+//! # Resources
+//!
+//! `size_of::<Ins<f32>>()` is 996 bytes (state 64, `P` as a full 15 × 15 `f32` 900, configuration
+//! 32); `Ahrs<f32>` is 204 bytes. No scratch space is stored. Each update runs in three
+//! non-inlined phases (linearize, gain, commit) sharing one small working set, so no `N × N`
+//! temporary exists during an update; the prediction uses one `9 × 15` temporary. Static stack
+//! analysis of a `thumbv7em-none-eabihf` release build (f32) gives a peak of about 1.1 KiB for
+//! the 15-state predict, 1.8 KiB for a GNSS or magnetometer update and under 1 KiB for the AHRS.
+//!
+//! # Edges
+//!
+//! Every entry point with outside data returns a `Result`. NaN/∞ anywhere, `dt ≤ 0`,
+//! `dt > max_dt`, a noise matrix that is not symmetric positive definite, a zero-norm
+//! magnetometer/accelerometer vector, a landmark behind the camera: an [`EskfError`], and the
+//! filter is bit-for-bit unchanged. A gated-out measurement returns
+//! `Ok(`[`UpdateOutcome::Rejected`]`)` and also changes nothing.
+
+mod ahrs;
+mod align;
+mod error;
+mod gate;
+mod imu;
+mod ins;
+mod models;
+mod state;
+mod update;
+
+pub use ahrs::Ahrs;
+pub use align::{align_at_rest, Alignment, InitialSigmas, MagnetometerWindow};
+pub use error::{EskfError, UpdateOutcome};
+pub use gate::{Gate, GateProbability, CHI_SQUARE_TABLE};
+pub use imu::{FilterConfig, ImuNoise, ImuSample};
+pub use ins::Ins;
+pub use models::{
+    AccelerometerAtRest, BaroAltitude, CameraLandmark, GnssPosition, GnssVelocity,
+    GravityDirection, Heading, Magnetometer, PinholeIntrinsics, ZeroVelocity,
+};
+pub use state::{AhrsState, ErrorState, InsState};
+pub use update::{Linearization, Measurement, UpdateOptions};

@@ -1,0 +1,166 @@
+//! Start-up: static alignment from a window of samples at rest.
+//!
+//! * Tilt: at rest the accelerometer reads `f = Rᵀ u ‖g‖` with `u = −g/‖g‖`, so the mean
+//!   specific force `f̄` gives the world up direction in the body, `u_b = f̄/‖f̄‖`.
+//! * Heading: with a magnetometer, the horizontal part of the mean field
+//!   `m_h = m̄ − (m̄·u_b)u_b` is matched to the horizontal part of the world reference field.
+//!   Without one, yaw is set so that the body `x` axis projects onto world `x`.
+//! * `R` is the rotation taking the body triad `(u_b, h_b, u_b × h_b)` onto the world triad
+//!   `(u, h_w, u × h_w)`: `R = W Bᵀ`.
+//! * Initial gyro bias: the mean angular rate `ω̄` (the body does not rotate).
+
+use super::error::EskfError;
+use super::imu::finite_vec;
+use crate::lie::So3;
+use crate::Real;
+use nalgebra::{Matrix3, Vector3};
+
+/// The result of a static alignment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Alignment<T: Real> {
+    /// `R`, world from body.
+    pub attitude: So3<T>,
+    /// Initial gyroscope bias, the mean rate over the window, rad/s.
+    pub gyro_bias: Vector3<T>,
+    /// `true` when the heading came from a magnetometer.
+    pub heading_from_magnetometer: bool,
+}
+
+/// Magnetometer data for the alignment.
+#[derive(Clone, Copy, Debug)]
+pub struct MagnetometerWindow<'a, T: Real> {
+    /// Body-frame field samples.
+    pub samples: &'a [Vector3<T>],
+    /// World reference field.
+    pub reference: Vector3<T>,
+}
+
+fn mean<T: Real>(xs: &[Vector3<T>]) -> Result<Vector3<T>, EskfError> {
+    if xs.is_empty() {
+        return Err(EskfError::EmptyWindow);
+    }
+    let mut sum = Vector3::zeros();
+    let mut n = T::zero();
+    for x in xs {
+        if !finite_vec(x) {
+            return Err(EskfError::NonFinite);
+        }
+        sum += x;
+        n += T::one();
+    }
+    Ok(sum / n)
+}
+
+/// The unit vector along the part of `v` orthogonal to the unit `u`, if any.
+fn horizontal<T: Real>(v: &Vector3<T>, u: &Vector3<T>) -> Option<Vector3<T>> {
+    let h = v - u * u.dot(v);
+    let n = h.norm();
+    if n > T::lit(1e-6) * v.norm() && n > T::zero() {
+        Some(h / n)
+    } else {
+        None
+    }
+}
+
+/// Static alignment from samples at rest.
+///
+/// `accel`, `gyro`: the IMU window (body frame, same length not required); `gravity`: the
+/// world gravity vector (`[0, 0, −9.81]`); `mag`: optional magnetometer window. The mean specific
+/// force must have a norm within `rest_tolerance` (m/s²) of `‖g‖`, else [`EskfError::NotAtRest`].
+/// Errors: [`EskfError::EmptyWindow`], [`EskfError::NonFinite`], [`EskfError::ZeroNorm`] (zero
+/// mean accelerometer, magnetometer or reference, or a field with no horizontal part).
+pub fn align_at_rest<T: Real>(
+    accel: &[Vector3<T>],
+    gyro: &[Vector3<T>],
+    gravity: &Vector3<T>,
+    mag: Option<&MagnetometerWindow<'_, T>>,
+    rest_tolerance: T,
+) -> Result<Alignment<T>, EskfError> {
+    let f = mean(accel)?;
+    let w = mean(gyro)?;
+    if !(finite_vec(gravity) && rest_tolerance.is_finite()) {
+        return Err(EskfError::NonFinite);
+    }
+    let (nf, ng) = (f.norm(), gravity.norm());
+    if !(nf > T::zero() && ng > T::zero()) {
+        return Err(EskfError::ZeroNorm);
+    }
+    if (nf - ng).abs() > rest_tolerance {
+        return Err(EskfError::NotAtRest);
+    }
+    let ub = f / nf;
+    let uw = -gravity / ng;
+    let (hb, hw, from_mag) = match mag {
+        Some(m) => {
+            let mb = mean(m.samples)?;
+            if !finite_vec(&m.reference) {
+                return Err(EskfError::NonFinite);
+            }
+            let hb = horizontal(&mb, &ub).ok_or(EskfError::ZeroNorm)?;
+            let hw = horizontal(&m.reference, &uw).ok_or(EskfError::ZeroNorm)?;
+            (hb, hw, true)
+        }
+        None => {
+            let hb = horizontal(&Vector3::x(), &ub)
+                .or_else(|| horizontal(&Vector3::y(), &ub))
+                .ok_or(EskfError::ZeroNorm)?;
+            let hw = horizontal(&Vector3::x(), &uw)
+                .or_else(|| horizontal(&Vector3::y(), &uw))
+                .ok_or(EskfError::ZeroNorm)?;
+            (hb, hw, false)
+        }
+    };
+    let b = Matrix3::from_columns(&[ub, hb, ub.cross(&hb)]);
+    let wm = Matrix3::from_columns(&[uw, hw, uw.cross(&hw)]);
+    let attitude = So3::from_rotation_matrix(&(wm * b.transpose())).ok_or(EskfError::NonFinite)?;
+    Ok(Alignment {
+        attitude,
+        gyro_bias: w,
+        heading_from_magnetometer: from_mag,
+    })
+}
+
+/// Initial 1-σ uncertainties for a filter started from an [`Alignment`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InitialSigmas<T: Real> {
+    /// Roll/pitch (tilt), rad.
+    pub tilt: T,
+    /// Yaw about world up, rad (large without a magnetometer).
+    pub yaw: T,
+    /// Velocity, m/s.
+    pub velocity: T,
+    /// Position, m.
+    pub position: T,
+    /// Gyro bias, rad/s.
+    pub gyro_bias: T,
+    /// Accelerometer bias, m/s².
+    pub accel_bias: T,
+}
+
+impl<T: Real> Default for InitialSigmas<T> {
+    /// 1° tilt, 5° yaw, 0.1 m/s, 1 m, 0.2 °/s, 0.05 m/s².
+    fn default() -> Self {
+        Self {
+            tilt: T::lit(0.017_453_29),
+            yaw: T::lit(0.087_266_46),
+            velocity: T::lit(0.1),
+            position: T::lit(1.0),
+            gyro_bias: T::lit(0.003_490_66),
+            accel_bias: T::lit(0.05),
+        }
+    }
+}
+
+impl<T: Real> InitialSigmas<T> {
+    /// The attitude covariance in the body-frame error: the world-frame
+    /// `diag(σ_t², σ_t², σ_ψ²)` (z up) mapped by `δθ = Rᵀ δθ_w`: `Rᵀ Σ_w R`.
+    #[must_use]
+    pub fn attitude_covariance(&self, attitude: &So3<T>, up: &Vector3<T>) -> Matrix3<T> {
+        let r = attitude.rotation_matrix();
+        let t2 = self.tilt * self.tilt;
+        let y2 = self.yaw * self.yaw;
+        // Σ_w = σ_t² I + (σ_ψ² − σ_t²) u uᵀ.
+        let sw = Matrix3::identity() * t2 + up * up.transpose() * (y2 - t2);
+        r.transpose() * sw * r
+    }
+}

@@ -1,0 +1,488 @@
+//! Measurement models `z = h(x) + n`, each with its right Jacobian `H = ∂h(x ⊕ δx)/∂δx`.
+//!
+//! Derivations use `R·exp(δθ^) ≈ R(I + [δθ]×)`, hence `(R exp(δθ^))ᵀ a ≈ Rᵀa + [Rᵀa]× δθ` and
+//! `R exp(δθ^) b ≈ R b − R[b]× δθ` (seed Theorem 5.1 / Example 5.2: the action Jacobian
+//! `R[−b]×`).
+
+use super::error::EskfError;
+use super::imu::{finite_vec, greater};
+use super::state::{ErrorState, InsState};
+use super::update::{Linearization, Measurement};
+use crate::lie::{skew, LieGroup, Se3};
+use crate::Real;
+use nalgebra::{Matrix1, Matrix2, Matrix2x3, Matrix3, SMatrix, Vector1, Vector2, Vector3};
+
+fn iso3<T: Real>(sigma: T) -> Matrix3<T> {
+    Matrix3::identity() * (sigma * sigma)
+}
+
+/// `M × N` zero Jacobian with `block` in columns `0..3` (the attitude error).
+fn attitude_jacobian<T: Real, const M: usize, const N: usize>(
+    block: &SMatrix<T, M, 3>,
+) -> SMatrix<T, M, N> {
+    let mut h = SMatrix::<T, M, N>::zeros();
+    for (mut dst, src) in h.column_iter_mut().zip(block.column_iter()) {
+        dst.copy_from(&src);
+    }
+    h
+}
+
+/// GNSS antenna position in the world frame, with the antenna at `lever_arm` in the body frame.
+///
+/// `h(x) = p + R ℓ`; `H = [−R[ℓ]×, 0, I, 0, 0]` (blocks δθ, δv, δp, δb_g, δb_a).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GnssPosition<T: Real> {
+    /// Measured antenna position `z`, world frame, m.
+    pub position: Vector3<T>,
+    /// Antenna position `ℓ` in the body frame, m.
+    pub lever_arm: Vector3<T>,
+    /// `R`, m².
+    pub noise: Matrix3<T>,
+}
+
+impl<T: Real> GnssPosition<T> {
+    /// Isotropic noise `σ² I`.
+    #[must_use]
+    pub fn new(position: Vector3<T>, lever_arm: Vector3<T>, sigma: T) -> Self {
+        Self {
+            position,
+            lever_arm,
+            noise: iso3(sigma),
+        }
+    }
+}
+
+impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssPosition<T> {
+    fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
+        if !(finite_vec(&self.position) && finite_vec(&self.lever_arm)) {
+            return Err(EskfError::NonFinite);
+        }
+        let (rl, d_att, _) = x.attitude.act_jac(&self.lever_arm);
+        let mut h = SMatrix::<T, 3, 15>::zeros();
+        h.fixed_view_mut::<3, 3>(0, 0).copy_from(&d_att);
+        h.fixed_view_mut::<3, 3>(0, 6)
+            .copy_from(&Matrix3::identity());
+        Ok(Linearization {
+            residual: self.position - (x.position + rl),
+            jacobian: h,
+        })
+    }
+    fn noise(&self) -> Matrix3<T> {
+        self.noise
+    }
+}
+
+/// GNSS velocity in the world frame (lever arm neglected): `h(x) = v`, `H = [0, I, 0, 0, 0]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GnssVelocity<T: Real> {
+    /// Measured velocity, world frame, m/s.
+    pub velocity: Vector3<T>,
+    /// `R`, (m/s)².
+    pub noise: Matrix3<T>,
+}
+
+impl<T: Real> GnssVelocity<T> {
+    /// Isotropic noise `σ² I`.
+    #[must_use]
+    pub fn new(velocity: Vector3<T>, sigma: T) -> Self {
+        Self {
+            velocity,
+            noise: iso3(sigma),
+        }
+    }
+}
+
+impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssVelocity<T> {
+    fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
+        if !finite_vec(&self.velocity) {
+            return Err(EskfError::NonFinite);
+        }
+        let mut h = SMatrix::<T, 3, 15>::zeros();
+        h.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&Matrix3::identity());
+        Ok(Linearization {
+            residual: self.velocity - x.velocity,
+            jacobian: h,
+        })
+    }
+    fn noise(&self) -> Matrix3<T> {
+        self.noise
+    }
+}
+
+/// Zero-velocity update: `z = 0`, `h(x) = v`, `H = [0, I, 0, 0, 0]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ZeroVelocity<T: Real> {
+    /// `R`, (m/s)².
+    pub noise: Matrix3<T>,
+}
+
+impl<T: Real> ZeroVelocity<T> {
+    /// Isotropic noise `σ² I`.
+    #[must_use]
+    pub fn new(sigma: T) -> Self {
+        Self { noise: iso3(sigma) }
+    }
+}
+
+impl<T: Real> Measurement<T, InsState<T>, 15, 3> for ZeroVelocity<T> {
+    fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
+        let mut h = SMatrix::<T, 3, 15>::zeros();
+        h.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&Matrix3::identity());
+        Ok(Linearization {
+            residual: -x.velocity,
+            jacobian: h,
+        })
+    }
+    fn noise(&self) -> Matrix3<T> {
+        self.noise
+    }
+}
+
+/// Barometric altitude (world `z`, up): `h(x) = p_z + offset`, `H = e₃ᵀ` on `δp`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BaroAltitude<T: Real> {
+    /// Measured altitude, m.
+    pub altitude: T,
+    /// Known offset between the barometric and the world altitude datum, m.
+    pub offset: T,
+    /// `R = σ²`, m².
+    pub noise: Matrix1<T>,
+}
+
+impl<T: Real> BaroAltitude<T> {
+    /// Zero offset, noise `σ²`.
+    #[must_use]
+    pub fn new(altitude: T, sigma: T) -> Self {
+        Self {
+            altitude,
+            offset: T::zero(),
+            noise: Matrix1::new(sigma * sigma),
+        }
+    }
+}
+
+impl<T: Real> Measurement<T, InsState<T>, 15, 1> for BaroAltitude<T> {
+    fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 1>, EskfError> {
+        if !(self.altitude.is_finite() && self.offset.is_finite()) {
+            return Err(EskfError::NonFinite);
+        }
+        let mut h = SMatrix::<T, 1, 15>::zeros();
+        if let Some(e) = h.get_mut((0, 8)) {
+            *e = T::one();
+        }
+        Ok(Linearization {
+            residual: Vector1::new(self.altitude - (x.position.z + self.offset)),
+            jacobian: h,
+        })
+    }
+    fn noise(&self) -> Matrix1<T> {
+        self.noise
+    }
+}
+
+/// Three-axis magnetometer against a world reference field: `h(x) = Rᵀ m_w`,
+/// `H = [[Rᵀ m_w]×, 0, …]` (only the attitude columns are nonzero). For both filters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Magnetometer<T: Real> {
+    /// Measured field, body frame (any unit, the same as `reference`).
+    pub field: Vector3<T>,
+    /// The world reference field `m_w`.
+    pub reference: Vector3<T>,
+    /// `R`, unit².
+    pub noise: Matrix3<T>,
+}
+
+impl<T: Real> Magnetometer<T> {
+    /// Isotropic noise `σ² I`.
+    #[must_use]
+    pub fn new(field: Vector3<T>, reference: Vector3<T>, sigma: T) -> Self {
+        Self {
+            field,
+            reference,
+            noise: iso3(sigma),
+        }
+    }
+}
+
+impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for Magnetometer<T> {
+    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
+        if !(finite_vec(&self.field) && finite_vec(&self.reference)) {
+            return Err(EskfError::NonFinite);
+        }
+        if self.field.norm_squared() <= T::zero() || self.reference.norm_squared() <= T::zero() {
+            return Err(EskfError::ZeroNorm);
+        }
+        let hx = x.attitude().inverse().act(&self.reference);
+        Ok(Linearization {
+            residual: self.field - hx,
+            jacobian: attitude_jacobian(&skew(&hx)),
+        })
+    }
+    fn noise(&self) -> Matrix3<T> {
+        self.noise
+    }
+}
+
+/// Accelerometer gravity direction (tilt aiding, for a body near rest):
+/// `z = f_m/‖f_m‖`, `h(x) = Rᵀ u` with `u` the world up direction, `H = [[Rᵀ u]×, 0, …]`.
+/// For both filters.
+///
+/// The model neglects the accelerometer bias and any non-gravitational acceleration; both are
+/// time-correlated errors (`‖b_a‖/g`, `‖a‖/g` radians), so `σ` must cover them, or repeated
+/// updates make the filter overconfident. In the 15-state filter, which estimates `b_a`, prefer
+/// [`ZeroVelocity`] at rest.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GravityDirection<T: Real> {
+    /// Measured specific force `f_m`, body frame (normalized inside).
+    pub accel: Vector3<T>,
+    /// World direction the accelerometer reads at rest (`−g/‖g‖`, `[0, 0, 1]` in ENU).
+    pub up: Vector3<T>,
+    /// `R` on the unit direction (rad², small-angle).
+    pub noise: Matrix3<T>,
+}
+
+impl<T: Real> GravityDirection<T> {
+    /// ENU up `[0, 0, 1]`, isotropic noise `σ² I` (σ in radians of tilt).
+    #[must_use]
+    pub fn new(accel: Vector3<T>, sigma: T) -> Self {
+        Self {
+            accel,
+            up: Vector3::z(),
+            noise: iso3(sigma),
+        }
+    }
+}
+
+impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for GravityDirection<T> {
+    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
+        if !(finite_vec(&self.accel) && finite_vec(&self.up)) {
+            return Err(EskfError::NonFinite);
+        }
+        let (na, nu) = (self.accel.norm(), self.up.norm());
+        if !(na > T::zero() && nu > T::zero()) {
+            return Err(EskfError::ZeroNorm);
+        }
+        let hx = x.attitude().inverse().act(&(self.up / nu));
+        Ok(Linearization {
+            residual: self.accel / na - hx,
+            jacobian: attitude_jacobian(&skew(&hx)),
+        })
+    }
+    fn noise(&self) -> Matrix3<T> {
+        self.noise
+    }
+}
+
+/// The accelerometer of a body at rest (15-state filter): `h(x) = Rᵀ(−g) + b_a`,
+/// `H = [[Rᵀ(−g)]×, 0, 0, 0, I]`. Unlike [`GravityDirection`] it models the accelerometer bias,
+/// so repeated updates at rest stay consistent (tilt and horizontal bias are separated only as
+/// far as the data allow).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AccelerometerAtRest<T: Real> {
+    /// Measured specific force `f_m`, body frame, m/s².
+    pub accel: Vector3<T>,
+    /// World gravity `g` (`[0, 0, −9.81]`).
+    pub gravity: Vector3<T>,
+    /// `R`, (m/s²)².
+    pub noise: Matrix3<T>,
+}
+
+impl<T: Real> AccelerometerAtRest<T> {
+    /// ENU gravity `[0, 0, −9.81]`, isotropic noise `σ² I`.
+    #[must_use]
+    pub fn new(accel: Vector3<T>, sigma: T) -> Self {
+        Self {
+            accel,
+            gravity: Vector3::new(T::zero(), T::zero(), T::lit(-9.81)),
+            noise: iso3(sigma),
+        }
+    }
+}
+
+impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
+    fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
+        if !(finite_vec(&self.accel) && finite_vec(&self.gravity)) {
+            return Err(EskfError::NonFinite);
+        }
+        if self.accel.norm_squared() <= T::zero() {
+            return Err(EskfError::ZeroNorm);
+        }
+        let f = x.attitude.inverse().act(&(-self.gravity));
+        let mut h = SMatrix::<T, 3, 15>::zeros();
+        h.fixed_view_mut::<3, 3>(0, 0).copy_from(&skew(&f));
+        h.fixed_view_mut::<3, 3>(0, 12)
+            .copy_from(&Matrix3::identity());
+        Ok(Linearization {
+            residual: self.accel - (f + x.accel_bias),
+            jacobian: h,
+        })
+    }
+    fn noise(&self) -> Matrix3<T> {
+        self.noise
+    }
+}
+
+/// Heading (yaw about world `z`) of the body `x` axis: `h(x) = ψ = atan2(R₂₁, R₁₁)`.
+///
+/// With `(c_x, c_y)` the first two entries of `R e₁` and `d(R e₁) = −R[e₁]× δθ`,
+/// `H = (c_x ∂c_y − c_y ∂c_x)/(c_x² + c_y²)` on the attitude columns; the residual is wrapped
+/// to `(−π, π]`. Singular (an error) when the body `x` axis is vertical. For both filters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Heading<T: Real> {
+    /// Measured yaw, rad (counter-clockwise from world `x` = east).
+    pub yaw: T,
+    /// `R = σ²`, rad².
+    pub noise: Matrix1<T>,
+}
+
+impl<T: Real> Heading<T> {
+    /// Noise `σ²`.
+    #[must_use]
+    pub fn new(yaw: T, sigma: T) -> Self {
+        Self {
+            yaw,
+            noise: Matrix1::new(sigma * sigma),
+        }
+    }
+}
+
+impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for Heading<T> {
+    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 1>, EskfError> {
+        if !self.yaw.is_finite() {
+            return Err(EskfError::NonFinite);
+        }
+        let r = x.attitude().rotation_matrix();
+        let (cx, cy) = (r.m11, r.m21);
+        let n2 = cx * cx + cy * cy;
+        if !greater(n2, T::lit(1e-6)) {
+            return Err(EskfError::SingularGeometry);
+        }
+        let d = -(r * skew(&Vector3::x()));
+        let row = (d.row(1) * cx - d.row(0) * cy) / n2;
+        let psi = cy.atan2(cx);
+        let (s, c) = (self.yaw - psi).sincos();
+        Ok(Linearization {
+            residual: Vector1::new(s.atan2(c)),
+            jacobian: attitude_jacobian(&row),
+        })
+    }
+    fn noise(&self) -> Matrix1<T> {
+        self.noise
+    }
+}
+
+/// Pinhole intrinsics: `u = f_x x/z + c_x`, `v = f_y y/z + c_y` (pixels).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PinholeIntrinsics<T: Real> {
+    /// Focal length along `u`, px.
+    pub fx: T,
+    /// Focal length along `v`, px.
+    pub fy: T,
+    /// Principal point `u`, px.
+    pub cx: T,
+    /// Principal point `v`, px.
+    pub cy: T,
+}
+
+/// A known world landmark seen by a camera rigidly mounted on the body:
+/// `z = π(T_cw p)` (seed `z_ij = π(T_i p_j)`), with `T_cw = T_bcᵀ·T_wbᵀ` from the body pose
+/// `(R, p)` and the extrinsic `T_bc` (`body_from_camera`).
+///
+/// `q = Rᵀ(ℓ − p)` (landmark in the body), `c = R_bcᵀ(q − t_bc)` (in the camera),
+/// `∂q/∂δθ = [q]×`, `∂q/∂δp = −Rᵀ`, `∂c = R_bcᵀ ∂q`,
+/// `∂π/∂c = [f_x/z, 0, −f_x x/z²; 0, f_y/z, −f_y y/z²]`. A depth `z ≤ min_depth` is an error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraLandmark<T: Real> {
+    /// Observed pixel `(u, v)`.
+    pub pixel: Vector2<T>,
+    /// Landmark position, world frame, m.
+    pub landmark: Vector3<T>,
+    /// Intrinsics.
+    pub intrinsics: PinholeIntrinsics<T>,
+    /// `T_bc`: body from camera.
+    pub body_from_camera: Se3<T>,
+    /// `R`, px².
+    pub noise: Matrix2<T>,
+    /// Smallest accepted depth in the camera, m (e.g. `0.01`).
+    pub min_depth: T,
+}
+
+impl<T: Real> CameraLandmark<T> {
+    /// Isotropic pixel noise `σ² I`, minimum depth 1 cm.
+    #[must_use]
+    pub fn new(
+        pixel: Vector2<T>,
+        landmark: Vector3<T>,
+        intrinsics: PinholeIntrinsics<T>,
+        body_from_camera: Se3<T>,
+        sigma_px: T,
+    ) -> Self {
+        Self {
+            pixel,
+            landmark,
+            intrinsics,
+            body_from_camera,
+            noise: Matrix2::identity() * (sigma_px * sigma_px),
+            min_depth: T::lit(0.01),
+        }
+    }
+
+    /// The predicted pixel and the landmark in the camera frame, or [`EskfError::BehindCamera`].
+    pub fn project(&self, x: &InsState<T>) -> Result<(Vector2<T>, Vector3<T>), EskfError> {
+        let q = x.attitude.inverse().act(&(self.landmark - x.position));
+        let rbc = self.body_from_camera.rotation();
+        let c = rbc
+            .inverse()
+            .act(&(q - self.body_from_camera.translation()));
+        if !greater(c.z, self.min_depth) {
+            return Err(EskfError::BehindCamera);
+        }
+        let k = &self.intrinsics;
+        let u = Vector2::new(k.fx * c.x / c.z + k.cx, k.fy * c.y / c.z + k.cy);
+        Ok((u, c))
+    }
+}
+
+impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
+    fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 2>, EskfError> {
+        let k = &self.intrinsics;
+        let all = [k.fx, k.fy, k.cx, k.cy, self.min_depth];
+        if !(finite_vec(&self.pixel)
+            && finite_vec(&self.landmark)
+            && all.iter().all(|v| v.is_finite())
+            && self.body_from_camera.is_finite())
+        {
+            return Err(EskfError::NonFinite);
+        }
+        let (uv, c) = self.project(x)?;
+        let q = x.attitude.inverse().act(&(self.landmark - x.position));
+        let rcb = self
+            .body_from_camera
+            .rotation()
+            .rotation_matrix()
+            .transpose();
+        let rt = x.attitude.rotation_matrix().transpose();
+        let iz = T::one() / c.z;
+        let jpi = Matrix2x3::new(
+            k.fx * iz,
+            T::zero(),
+            -k.fx * c.x * iz * iz,
+            T::zero(),
+            k.fy * iz,
+            -k.fy * c.y * iz * iz,
+        );
+        let jc = jpi * rcb;
+        let mut h = SMatrix::<T, 2, 15>::zeros();
+        h.fixed_view_mut::<2, 3>(0, 0).copy_from(&(jc * skew(&q)));
+        h.fixed_view_mut::<2, 3>(0, 6).copy_from(&(-(jc * rt)));
+        Ok(Linearization {
+            residual: self.pixel - uv,
+            jacobian: h,
+        })
+    }
+    fn noise(&self) -> Matrix2<T> {
+        self.noise
+    }
+}

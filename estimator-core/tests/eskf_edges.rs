@@ -1,0 +1,490 @@
+//! Refused input and gated measurements leave the filter bit-for-bit unchanged; the gate table;
+//! alignment errors; outcomes carry the right NIS.
+
+mod eskf_common;
+
+use estimator_core::eskf::*;
+use estimator_core::lie::{LieGroup, Se3, So3};
+use nalgebra::{Matrix1, Matrix2, Matrix3, SMatrix, Vector2, Vector3};
+
+fn ins<T: estimator_core::Real>() -> Ins<T> {
+    let state = InsState {
+        attitude: So3::exp(&Vector3::new(T::lit(0.1), T::lit(-0.2), T::lit(0.7))),
+        velocity: Vector3::new(T::lit(0.5), T::zero(), T::zero()),
+        position: Vector3::new(T::lit(1.0), T::lit(2.0), T::lit(3.0)),
+        gyro_bias: Vector3::zeros(),
+        accel_bias: Vector3::zeros(),
+    };
+    Ins::new(
+        state,
+        SMatrix::<T, 15, 15>::identity() * T::lit(0.01),
+        FilterConfig::default(),
+    )
+    .expect("valid")
+}
+
+fn ahrs<T: estimator_core::Real>() -> Ahrs<T> {
+    Ahrs::new(
+        AhrsState {
+            attitude: So3::exp(&Vector3::new(T::lit(0.1), T::lit(-0.2), T::lit(0.7))),
+            gyro_bias: Vector3::zeros(),
+        },
+        SMatrix::<T, 6, 6>::identity() * T::lit(0.01),
+        FilterConfig::default(),
+    )
+    .expect("valid")
+}
+
+fn imu(gyro: [f64; 3], accel: [f64; 3], dt: f64) -> ImuSample<f64> {
+    ImuSample {
+        gyro: Vector3::from(gyro),
+        accel: Vector3::from(accel),
+        dt,
+    }
+}
+
+const NAN: f64 = f64::NAN;
+const INF: f64 = f64::INFINITY;
+
+#[test]
+fn refused_predict_leaves_filter_unchanged() {
+    let mut f = ins::<f64>();
+    let before = f;
+    let cases = [
+        (
+            imu([NAN, 0.0, 0.0], [0.0, 0.0, 9.81], 0.01),
+            EskfError::NonFinite,
+        ),
+        (imu([0.0; 3], [0.0, INF, 9.81], 0.01), EskfError::NonFinite),
+        (
+            imu([0.0; 3], [0.0, 0.0, 9.81], 0.0),
+            EskfError::NonPositiveDt,
+        ),
+        (
+            imu([0.0; 3], [0.0, 0.0, 9.81], -0.01),
+            EskfError::NonPositiveDt,
+        ),
+        (imu([0.0; 3], [0.0, 0.0, 9.81], NAN), EskfError::NonFinite),
+        (imu([0.0; 3], [0.0, 0.0, 9.81], 0.5), EskfError::DtTooLarge),
+        (
+            imu([1e300, 0.0, 0.0], [1e300, 0.0, 9.81], 0.01),
+            EskfError::NonFinite,
+        ),
+    ];
+    for (s, e) in cases {
+        assert_eq!(f.predict(&s), Err(e), "{s:?}");
+        assert_eq!(f, before);
+    }
+    let mut a = ahrs::<f64>();
+    let before = a;
+    assert_eq!(
+        a.predict(&Vector3::new(NAN, 0.0, 0.0), 0.01),
+        Err(EskfError::NonFinite)
+    );
+    assert_eq!(
+        a.predict(&Vector3::zeros(), 0.0),
+        Err(EskfError::NonPositiveDt)
+    );
+    assert_eq!(
+        a.predict(&Vector3::zeros(), 1.0),
+        Err(EskfError::DtTooLarge)
+    );
+    assert_eq!(a, before);
+    // f32 too.
+    let mut g = ins::<f32>();
+    let before = g;
+    let s = ImuSample {
+        gyro: Vector3::new(f32::NAN, 0.0, 0.0),
+        accel: Vector3::zeros(),
+        dt: 0.01,
+    };
+    assert_eq!(g.predict(&s), Err(EskfError::NonFinite));
+    assert_eq!(g, before);
+}
+
+fn intrinsics() -> PinholeIntrinsics<f64> {
+    PinholeIntrinsics {
+        fx: 400.0,
+        fy: 400.0,
+        cx: 320.0,
+        cy: 240.0,
+    }
+}
+
+#[test]
+fn refused_updates_leave_filter_unchanged() {
+    let mut f = ins::<f64>();
+    let before = f;
+    let o = UpdateOptions::default();
+    let z = Vector3::new(1.0, 2.0, 3.0);
+    let asym = Matrix3::new(1.0, 0.5, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+    let indefinite = Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, 1.0));
+    let r = |x: Result<UpdateOutcome<f64>, EskfError>| x.map(|_| ());
+
+    assert_eq!(
+        r(f.update(
+            &GnssPosition::new(Vector3::new(NAN, 0.0, 0.0), Vector3::zeros(), 1.0),
+            &o
+        )),
+        Err(EskfError::NonFinite)
+    );
+    assert_eq!(
+        r(f.update(&GnssPosition::new(z, Vector3::new(0.0, INF, 0.0), 1.0), &o)),
+        Err(EskfError::NonFinite)
+    );
+    let mut g = GnssPosition::new(z, Vector3::zeros(), 1.0);
+    g.noise = asym;
+    assert_eq!(
+        r(f.update(&g, &o)),
+        Err(EskfError::NoiseNotPositiveDefinite)
+    );
+    g.noise = indefinite;
+    assert_eq!(
+        r(f.update(&g, &o)),
+        Err(EskfError::NoiseNotPositiveDefinite)
+    );
+    g.noise = Matrix3::zeros();
+    assert_eq!(
+        r(f.update(&g, &o)),
+        Err(EskfError::NoiseNotPositiveDefinite)
+    );
+    assert_eq!(
+        r(f.update(&GnssPosition::new(z, Vector3::zeros(), NAN), &o)),
+        Err(EskfError::NoiseNotPositiveDefinite)
+    );
+    assert_eq!(
+        r(f.update(&GnssVelocity::new(Vector3::new(0.0, 0.0, INF), 0.1), &o)),
+        Err(EskfError::NonFinite)
+    );
+    assert_eq!(
+        r(f.update(&Magnetometer::new(Vector3::zeros(), Vector3::y(), 0.1), &o)),
+        Err(EskfError::ZeroNorm)
+    );
+    assert_eq!(
+        r(f.update(&Magnetometer::new(Vector3::y(), Vector3::zeros(), 0.1), &o)),
+        Err(EskfError::ZeroNorm)
+    );
+    assert_eq!(
+        r(f.update(&GravityDirection::new(Vector3::zeros(), 0.1), &o)),
+        Err(EskfError::ZeroNorm)
+    );
+    assert_eq!(
+        r(f.update(&AccelerometerAtRest::new(Vector3::zeros(), 0.1), &o)),
+        Err(EskfError::ZeroNorm)
+    );
+    assert_eq!(
+        r(f.update(
+            &AccelerometerAtRest::new(Vector3::new(0.0, NAN, 9.8), 0.1),
+            &o
+        )),
+        Err(EskfError::NonFinite)
+    );
+    assert_eq!(
+        r(f.update(&BaroAltitude::new(NAN, 0.5), &o)),
+        Err(EskfError::NonFinite)
+    );
+    let mut baro = BaroAltitude::new(3.0, 0.5);
+    baro.noise = Matrix1::new(-1.0);
+    assert_eq!(
+        r(f.update(&baro, &o)),
+        Err(EskfError::NoiseNotPositiveDefinite)
+    );
+    assert_eq!(
+        r(f.update(&Heading::new(INF, 0.1), &o)),
+        Err(EskfError::NonFinite)
+    );
+    // Landmark behind the camera (camera = body, looking along body z).
+    let behind = f.state().position - f.state().attitude.act(&Vector3::new(0.0, 0.0, 1.0));
+    let cam = CameraLandmark::new(
+        Vector2::new(320.0, 240.0),
+        behind,
+        intrinsics(),
+        Se3::identity(),
+        1.0,
+    );
+    assert_eq!(r(f.update(&cam, &o)), Err(EskfError::BehindCamera));
+    let mut cam2 = cam;
+    cam2.noise = Matrix2::new(1.0, 2.0, 2.0, 1.0);
+    assert_eq!(
+        r(f.update(&cam2, &o)),
+        Err(EskfError::NoiseNotPositiveDefinite)
+    );
+    // Invalid options.
+    let bad = UpdateOptions {
+        max_iterations: 0,
+        ..UpdateOptions::default()
+    };
+    assert_eq!(
+        r(f.update(&GnssPosition::new(z, Vector3::zeros(), 1.0), &bad)),
+        Err(EskfError::InvalidOption)
+    );
+    let bad = UpdateOptions::ekf(Gate::Threshold(NAN));
+    assert_eq!(
+        r(f.update(&GnssPosition::new(z, Vector3::zeros(), 1.0), &bad)),
+        Err(EskfError::InvalidOption)
+    );
+    assert_eq!(f, before);
+
+    // Heading singular: body x axis vertical.
+    let mut h = Ins::new(
+        InsState {
+            attitude: So3::exp(&Vector3::new(0.0, -core::f64::consts::FRAC_PI_2, 0.0)),
+            ..InsState::identity()
+        },
+        SMatrix::<f64, 15, 15>::identity(),
+        FilterConfig::default(),
+    )
+    .expect("valid");
+    let hb = h;
+    assert_eq!(
+        r(h.update(&Heading::new(0.0, 0.1), &o)),
+        Err(EskfError::SingularGeometry)
+    );
+    assert_eq!(h, hb);
+
+    let mut a = ahrs::<f64>();
+    let ab = a;
+    assert_eq!(
+        r(a.update(&Magnetometer::new(Vector3::zeros(), Vector3::y(), 0.1), &o)),
+        Err(EskfError::ZeroNorm)
+    );
+    assert_eq!(
+        r(a.update(&GravityDirection::new(Vector3::new(NAN, 0.0, 1.0), 0.1), &o)),
+        Err(EskfError::NonFinite)
+    );
+    assert_eq!(a, ab);
+}
+
+#[test]
+fn gated_measurement_is_rejected_and_changes_nothing() {
+    for gate in [
+        Gate::Probability(GateProbability::P95),
+        Gate::Probability(GateProbability::P99),
+        Gate::Probability(GateProbability::P999),
+        Gate::Threshold(5.0),
+    ] {
+        let mut f = ins::<f64>();
+        let before = f;
+        let far = f.state().position + Vector3::new(100.0, 0.0, 0.0);
+        let out = f
+            .update(
+                &GnssPosition::new(far, Vector3::zeros(), 1.0),
+                &UpdateOptions::ekf(gate),
+            )
+            .expect("ok");
+        match out {
+            UpdateOutcome::Rejected { nis, threshold } => {
+                // r = 100 m on x; S_xx = P_xx + R = 0.01 + 1.
+                assert!((nis - 100.0 * 100.0 / 1.01).abs() < 1e-6, "{nis}");
+                assert_eq!(threshold, gate.threshold(3));
+            }
+            UpdateOutcome::Accepted { .. } => panic!("accepted an outlier"),
+        }
+        assert_eq!(f, before);
+        // The same with f32 and the AHRS magnetometer.
+        let mut a = ahrs::<f32>();
+        let ab = a;
+        let out = a
+            .update(
+                &Magnetometer::new(
+                    Vector3::new(0.0, -50.0, 0.0),
+                    Vector3::new(0.0, 50.0, 0.0),
+                    0.5,
+                ),
+                &UpdateOptions::default(),
+            )
+            .expect("ok");
+        assert!(!out.is_accepted());
+        assert_eq!(a, ab);
+    }
+    // With the gate off the same outlier is accepted.
+    let mut f = ins::<f64>();
+    let far = f.state().position + Vector3::new(100.0, 0.0, 0.0);
+    let out = f
+        .update(
+            &GnssPosition::new(far, Vector3::zeros(), 1.0),
+            &UpdateOptions::ekf(Gate::Off),
+        )
+        .expect("ok");
+    assert!(out.is_accepted());
+}
+
+#[test]
+fn accepted_outcome_nis_and_posterior() {
+    let mut f = ins::<f64>();
+    let p0 = *f.covariance();
+    let z = f.state().position + Vector3::new(0.1, -0.2, 0.05);
+    let out = f
+        .update(
+            &GnssPosition::new(z, Vector3::zeros(), 0.1),
+            &UpdateOptions::default(),
+        )
+        .expect("ok");
+    // H = [0 0 I 0 0]: S = 0.01 I + 0.01 I.
+    let nis = (0.01 + 0.04 + 0.0025) / 0.02;
+    assert!(out.is_accepted());
+    assert!((out.nis() - nis).abs() < 1e-12);
+    // Posterior P_pp = P - P (P + R)⁻¹ P = 0.005 I; position moved half way.
+    let ppp = f.covariance().fixed_view::<3, 3>(6, 6).into_owned();
+    assert!((ppp - Matrix3::identity() * 0.005).amax() < 1e-12);
+    assert!((f.state().position - (z - Vector3::new(0.05, -0.1, 0.025))).amax() < 1e-12);
+    assert!((f.covariance() - f.covariance().transpose()).amax() == 0.0);
+    assert!(f.covariance()[(0, 0)] <= p0[(0, 0)]);
+}
+
+#[test]
+fn constructors_refuse_bad_input() {
+    let cfg = FilterConfig::<f64>::default();
+    let mut p = SMatrix::<f64, 15, 15>::identity();
+    p[(0, 0)] = -1.0;
+    assert_eq!(
+        Ins::new(InsState::identity(), p, cfg).err(),
+        Some(EskfError::CovarianceNotPositiveDefinite)
+    );
+    let mut s = InsState::<f64>::identity();
+    s.velocity.x = NAN;
+    assert_eq!(
+        Ins::new(s, SMatrix::identity(), cfg).err(),
+        Some(EskfError::NonFinite)
+    );
+    let mut bad_cfg = cfg;
+    bad_cfg.imu_noise.gyroscope_noise_density = -1.0;
+    assert_eq!(
+        Ins::new(InsState::identity(), SMatrix::identity(), bad_cfg).err(),
+        Some(EskfError::NoiseNotPositiveDefinite)
+    );
+    bad_cfg = cfg;
+    bad_cfg.max_dt = 0.0;
+    assert_eq!(
+        Ahrs::new(AhrsState::identity(), SMatrix::identity(), bad_cfg).err(),
+        Some(EskfError::InvalidOption)
+    );
+}
+
+#[test]
+fn alignment_recovers_tilt_heading_bias_and_refuses_bad_windows() {
+    let r = So3::exp(&Vector3::new(0.2, -0.1, 2.5));
+    let g = Vector3::new(0.0, 0.0, -9.81);
+    let f = r.inverse().act(&-g);
+    let m_ref = eskf_common::mag_reference();
+    let m = r.inverse().act(&m_ref);
+    let bias = Vector3::new(0.01, -0.005, 0.002);
+    let accel = [f; 10];
+    let gyro = [bias; 10];
+    let mags = [m; 5];
+    let window = MagnetometerWindow {
+        samples: &mags,
+        reference: m_ref,
+    };
+    let a = align_at_rest(&accel, &gyro, &g, Some(&window), 0.5).expect("align");
+    assert!(a.heading_from_magnetometer);
+    assert!(a.attitude.rminus(&r).norm() < 1e-12);
+    assert!((a.gyro_bias - bias).norm() < 1e-15);
+    // Without magnetometer: tilt right, yaw arbitrary.
+    let a = align_at_rest(&accel, &gyro, &g, None, 0.5).expect("align");
+    let up_err = (a.attitude.inverse().act(&Vector3::z()) - f.normalize()).norm();
+    assert!(up_err < 1e-12);
+    // Errors.
+    let e = |x: Result<Alignment<f64>, EskfError>| x.err();
+    assert_eq!(
+        e(align_at_rest(&[], &gyro, &g, None, 0.5)),
+        Some(EskfError::EmptyWindow)
+    );
+    let mut bad = accel;
+    bad[3].y = NAN;
+    assert_eq!(
+        e(align_at_rest(&bad, &gyro, &g, None, 0.5)),
+        Some(EskfError::NonFinite)
+    );
+    assert_eq!(
+        e(align_at_rest(&[Vector3::zeros(); 3], &gyro, &g, None, 0.5)),
+        Some(EskfError::ZeroNorm)
+    );
+    assert_eq!(
+        e(align_at_rest(&[f * 1.2; 3], &gyro, &g, None, 0.5)),
+        Some(EskfError::NotAtRest)
+    );
+    let zero_mag = [Vector3::zeros(); 2];
+    let w0 = MagnetometerWindow {
+        samples: &zero_mag,
+        reference: m_ref,
+    };
+    assert_eq!(
+        e(align_at_rest(&accel, &gyro, &g, Some(&w0), 0.5)),
+        Some(EskfError::ZeroNorm)
+    );
+    // Started filters.
+    let ins = Ins::from_alignment(
+        &align_at_rest(&accel, &gyro, &g, Some(&window), 0.5).expect("align"),
+        Vector3::new(1.0, 2.0, 3.0),
+        &InitialSigmas::default(),
+        FilterConfig::default(),
+    )
+    .expect("ins");
+    // The attitude covariance has yaw variance about world z.
+    let p = ins.covariance().fixed_view::<3, 3>(0, 0).into_owned();
+    let rm = ins.state().attitude.rotation_matrix();
+    let world = rm * p * rm.transpose();
+    let s = InitialSigmas::<f64>::default();
+    assert!((world[(2, 2)] - s.yaw * s.yaw).abs() < 1e-12);
+    assert!((world[(0, 0)] - s.tilt * s.tilt).abs() < 1e-12);
+}
+
+/// Regularized lower incomplete gamma `P(a, x)` by its series (f64, test only).
+fn gamma_p(a: f64, x: f64) -> f64 {
+    let mut sum = 1.0 / a;
+    let mut term = sum;
+    let mut n = 1.0;
+    while term > 1e-17 * sum {
+        term *= x / (a + n);
+        sum += term;
+        n += 1.0;
+    }
+    // ln Γ(a) for a = k/2 exactly.
+    let lgamma = if (a * 2.0).round() as i64 % 2 == 0 {
+        (1..a as i64).map(|k| (k as f64).ln()).sum::<f64>()
+    } else {
+        // Γ(n + ½) = √π (2n)! / (4ⁿ n!)
+        let n = (a - 0.5) as i64;
+        let mut l = 0.5 * core::f64::consts::PI.ln();
+        for k in 1..=n {
+            l += ((2 * k - 1) as f64 / 2.0).ln();
+        }
+        l
+    };
+    (sum.ln() + a * x.ln() - x - lgamma).exp()
+}
+
+#[test]
+fn chi_square_table_matches_cdf() {
+    for dof in 1..=6usize {
+        for (p, prob) in [
+            (GateProbability::P95, 0.95),
+            (GateProbability::P99, 0.99),
+            (GateProbability::P999, 0.999),
+        ] {
+            let q: f64 = p.quantile(dof);
+            let cdf = gamma_p(dof as f64 / 2.0, q / 2.0);
+            assert!((cdf - prob).abs() < 2e-7, "dof {dof} p {prob}: cdf {cdf}");
+            let q32: f32 = p.quantile(dof);
+            assert!((q32 as f64 - q).abs() < 1e-5 * q);
+        }
+    }
+    // Wilson–Hilferty above the table: within 0.5 %.
+    for dof in [7usize, 10, 15] {
+        for (p, prob) in [(GateProbability::P95, 0.95), (GateProbability::P999, 0.999)] {
+            let q: f64 = p.quantile(dof);
+            let cdf = gamma_p(dof as f64 / 2.0, q / 2.0);
+            assert!((cdf - prob).abs() < 2e-3, "dof {dof}: {cdf}");
+        }
+    }
+}
+
+#[test]
+fn f32_filter_fits_the_memory_budget() {
+    let ins = core::mem::size_of::<Ins<f32>>();
+    let ahrs = core::mem::size_of::<Ahrs<f32>>();
+    println!("size_of Ins<f32> = {ins} B, Ahrs<f32> = {ahrs} B");
+    assert!(ins <= 1200, "{ins}");
+    assert!(ahrs <= 256, "{ahrs}");
+}

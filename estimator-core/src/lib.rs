@@ -3,7 +3,14 @@
 //! * [`lie`]: the fixed-size Lie groups SO(2), SE(2), SO(3), SE(3) with every Jacobian, generic
 //!   over `f32` and `f64`, following one convention (right perturbation `a ⊕ τ = a·exp(τ^)`,
 //!   seed paper eq. 4.5). Its module docs state the conventions.
+//! * [`eskf`]: the on-manifold error-state Kalman filter, 15-state inertial ([`eskf::Ins`]) and
+//!   attitude-only ([`eskf::Ahrs`]), with gated Joseph and iterated updates and typed outcomes.
+//! * [`gn`]: a fixed-size Gauss-Newton / Levenberg-Marquardt solver on manifolds with robust
+//!   losses, and on top of it [`gn::solve_pnp`], triangulation and rotation from vector pairs.
 //! * [`scalar`]: the [`Real`] scalar trait, with an all-`f32` sine/cosine for Cortex-M4F.
+//!
+//! Nothing allocates and nothing panics: every entry point that takes outside data returns a
+//! `Result` with a typed error.
 //!
 //! The mathematics follows the seed paper on Lie groups for state estimation; equation numbers in
 //! the docs refer to it.

@@ -373,18 +373,9 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for H
     }
 }
 
-/// Pinhole intrinsics: `u = f_x x/z + c_x`, `v = f_y y/z + c_y` (pixels).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PinholeIntrinsics<T: Real> {
-    /// Focal length along `u`, px.
-    pub fx: T,
-    /// Focal length along `v`, px.
-    pub fy: T,
-    /// Principal point `u`, px.
-    pub cx: T,
-    /// Principal point `v`, px.
-    pub cy: T,
-}
+/// Pinhole intrinsics: `u = f_x x/z + c_x`, `v = f_y y/z + c_y` (pixels). The same type as the
+/// solver's camera ([`crate::gn::PinholeCamera`]), so one calibration serves both.
+pub type PinholeIntrinsics<T> = crate::gn::PinholeCamera<T>;
 
 /// A known world landmark seen by a camera rigidly mounted on the body:
 /// `z = π(T_cw p)` (seed `z_ij = π(T_i p_j)`), with `T_cw = T_bcᵀ·T_wbᵀ` from the body pose

@@ -209,7 +209,10 @@ fn check_algebra<T, G, const N: usize, const D: usize, const M: usize>(
     // ... and relative to τ itself, which matters for small steps (a 1e-9 rotation must come
     // back as 1e-9 to a few ulps, not to ε absolute).
     let rel = diff(&e.log(), tau) / maxabs(tau).max(f64::MIN_POSITIVE);
-    assert!(maxabs(tau) == 0.0 || rel <= 8.0 * eps, "log(exp τ) relative error {rel:.3e} at {tau:?}");
+    assert!(
+        maxabs(tau) == 0.0 || rel <= 8.0 * eps,
+        "log(exp τ) relative error {rel:.3e} at {tau:?}"
+    );
     // exp∘log.
     close(
         &G::exp(&a.log()).matrix(),

@@ -169,7 +169,11 @@ fn print_summary(name: &str, seed: u64, cfg: &ReplayConfig, m: &Metrics, out: &P
         );
     }
     for (name, v) in &m.baseline_attitude_rmse_deg {
-        println!("  {:<28} {:>12}", format!("  {name} attitude RMSE [deg]"), fmt(*v));
+        println!(
+            "  {:<28} {:>12}",
+            format!("  {name} attitude RMSE [deg]"),
+            fmt(*v)
+        );
     }
     println!(
         "  {:<28} {:>12}",

@@ -54,7 +54,13 @@ impl Madgwick {
     /// Starts at `attitude` with the magnetic reference `reference` (world frame).
     #[must_use]
     pub fn new(attitude: So3<f64>, reference: Vector3<f64>) -> Self {
-        Self { attitude, beta: 0.1, accel: Vector3::z(), mag: None, reference }
+        Self {
+            attitude,
+            beta: 0.1,
+            accel: Vector3::z(),
+            mag: None,
+            reference,
+        }
     }
 
     /// Records the latest magnetometer sample.
@@ -75,7 +81,11 @@ impl Madgwick {
             grad += skew(&mb).transpose() * (mb - m);
         }
         let n = grad.norm();
-        let corr = if n > 0.0 { grad * (self.beta / n) } else { Vector3::zeros() };
+        let corr = if n > 0.0 {
+            grad * (self.beta / n)
+        } else {
+            Vector3::zeros()
+        };
         // ∇ is the gradient along +δθ; descending it means subtracting.
         self.attitude = self.attitude.rplus(&((gyro - corr) * dt)).normalize();
     }
@@ -85,7 +95,15 @@ impl Mahony {
     /// Starts at `attitude` with the magnetic reference `reference` (world frame).
     #[must_use]
     pub fn new(attitude: So3<f64>, reference: Vector3<f64>) -> Self {
-        Self { attitude, bias: Vector3::zeros(), kp: 1.0, ki: 0.05, accel: Vector3::z(), mag: None, reference }
+        Self {
+            attitude,
+            bias: Vector3::zeros(),
+            kp: 1.0,
+            ki: 0.05,
+            accel: Vector3::z(),
+            mag: None,
+            reference,
+        }
     }
 
     /// Records the latest magnetometer sample.
@@ -104,7 +122,10 @@ impl Mahony {
             e += m.cross(&r_inv.act(&mw));
         }
         self.bias -= e * (self.ki * dt);
-        self.attitude = self.attitude.rplus(&((gyro - self.bias + e * self.kp) * dt)).normalize();
+        self.attitude = self
+            .attitude
+            .rplus(&((gyro - self.bias + e * self.kp) * dt))
+            .normalize();
     }
 }
 
@@ -129,7 +150,15 @@ mod tests {
             mw.imu(&Vector3::zeros(), &a, 0.005);
             mh.imu(&Vector3::zeros(), &a, 0.005);
         }
-        assert!(mw.attitude.rminus(&truth).norm() < 0.01, "madgwick {}", mw.attitude.rminus(&truth).norm());
-        assert!(mh.attitude.rminus(&truth).norm() < 0.01, "mahony {}", mh.attitude.rminus(&truth).norm());
+        assert!(
+            mw.attitude.rminus(&truth).norm() < 0.01,
+            "madgwick {}",
+            mw.attitude.rminus(&truth).norm()
+        );
+        assert!(
+            mh.attitude.rminus(&truth).norm() < 0.01,
+            "mahony {}",
+            mh.attitude.rminus(&truth).norm()
+        );
     }
 }

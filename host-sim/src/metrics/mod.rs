@@ -268,7 +268,11 @@ impl Scorer {
 
     /// Scores a reference filter's attitude against the truth.
     pub fn add_baseline(&mut self, name: &str, attitude: &So3<f64>, truth: &Truth) {
-        let e = attitude.inverse().compose(&truth.attitude).log().norm_squared();
+        let e = attitude
+            .inverse()
+            .compose(&truth.attitude)
+            .log()
+            .norm_squared();
         let entry = self.baselines.entry(name.to_string()).or_insert((0.0, 0));
         entry.0 += e;
         entry.1 += 1;

@@ -331,8 +331,8 @@ fn replay_in<T: Real>(
         };
         let t0 = *t_first.get_or_insert(ev.t_ns());
         let in_window = ev.t_ns() < t0 + window_ns;
-        let need_fix = (ds.gnss.is_some() && first_fix.is_none())
-            || (pnp_start && first_frame.is_none());
+        let need_fix =
+            (ds.gnss.is_some() && first_fix.is_none()) || (pnp_start && first_frame.is_none());
         if !in_window && !need_fix {
             break;
         }
@@ -349,7 +349,9 @@ fn replay_in<T: Real>(
             Event::Imu { t_ns, .. } => last_imu = Some(*t_ns),
             Event::Mag { field, .. } if in_window => mags.push(lit3::<T>(field)),
             Event::Gnss { position, .. } => first_fix = Some(*position),
-            Event::Camera { observations, .. } if pnp_start && !in_window && observations.len() >= 6 => {
+            Event::Camera { observations, .. }
+                if pnp_start && !in_window && observations.len() >= 6 =>
+            {
                 first_frame = Some(observations.clone());
             }
             _ => {}
@@ -420,7 +422,10 @@ fn replay_in<T: Real>(
     // Reference filters on the same data, from the same start (where a magnetometer exists).
     let mut baselines = ds.mag.as_ref().map(|m| {
         let start = filter.estimate(0).attitude;
-        (Madgwick::new(start, m.reference_field), Mahony::new(start, m.reference_field))
+        (
+            Madgwick::new(start, m.reference_field),
+            Mahony::new(start, m.reference_field),
+        )
     });
 
     // --- Outputs: written as `*.partial`, renamed only when the whole run succeeded. ---
@@ -496,7 +501,9 @@ fn replay_in<T: Real>(
                 if let Filter::Ahrs(f) = &mut filter {
                     // Tilt aiding while the specific force is close to gravity.
                     let mismatch = (accel.norm() - g_norm).abs();
-                    if imu_count.is_multiple_of(cfg.gravity_every.max(1)) && mismatch < cfg.gravity_gate {
+                    if imu_count.is_multiple_of(cfg.gravity_every.max(1))
+                        && mismatch < cfg.gravity_gate
+                    {
                         // Only the mismatch beyond three sigmas of the white noise reveals motion.
                         let excess = (mismatch - 3.0 * white_dir_sq.sqrt() * g_norm).max(0.0);
                         let sigma = (white_dir_sq
@@ -573,7 +580,12 @@ fn replay_in<T: Real>(
             Event::Camera { t_ns, observations } => {
                 if let (Filter::Ins(f), Some(cam)) = (&mut filter, &ds.camera) {
                     let [fx, fy, cx, cy] = cam.intrinsics;
-                    let intrinsics = PinholeIntrinsics { fx: T::lit(fx), fy: T::lit(fy), cx: T::lit(cx), cy: T::lit(cy) };
+                    let intrinsics = PinholeIntrinsics {
+                        fx: T::lit(fx),
+                        fy: T::lit(fy),
+                        cx: T::lit(cx),
+                        cy: T::lit(cy),
+                    };
                     let body_from_camera = cam.body_from_camera.cast::<T>();
                     for (id, pixel) in &observations {
                         let Some(landmark) = cam.landmarks.get(id) else {
@@ -689,14 +701,21 @@ fn pnp_pose(
     }
     let [fx, fy, cx, cy] = cam.intrinsics;
     let camera = PinholeCamera { fx, fy, cx, cy };
-    let world_from_camera_guess = Se3::from_parts(*attitude, Vector3::zeros()).compose(&cam.body_from_camera);
+    let world_from_camera_guess =
+        Se3::from_parts(*attitude, Vector3::zeros()).compose(&cam.body_from_camera);
     let options = PnpOptions {
         loss: Loss::Cauchy(2.0),
         sigma_px: cam.sigma_px,
         ..PnpOptions::default()
     };
-    let sol = solve_pnp(&world, &pixels, &camera, &world_from_camera_guess.inverse(), &options)
-        .map_err(|e| ReplayError::Start(format!("camera pose from the first frame: {e}")))?;
+    let sol = solve_pnp(
+        &world,
+        &pixels,
+        &camera,
+        &world_from_camera_guess.inverse(),
+        &options,
+    )
+    .map_err(|e| ReplayError::Start(format!("camera pose from the first frame: {e}")))?;
     Ok(sol
         .camera_from_world
         .inverse()

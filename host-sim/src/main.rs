@@ -2,6 +2,14 @@
 
 mod cli;
 
+/// `println!` that ignores a closed pipe (`host-sim run | head`) instead of panicking.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 use clap::Parser;
 use cli::{Cli, Command};
 use host_sim::dataset::write::simulate;
@@ -31,7 +39,7 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
     match command {
         Command::Scenarios => {
             for s in builtin_scenarios() {
-                println!("{:<14} {}", s.name, s.description);
+                out!("{:<14} {}", s.name, s.description);
             }
             Ok(())
         }
@@ -42,7 +50,7 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
         } => {
             let sc = Scenario::load(&scenario)?;
             simulate(&sc, seed, &out)?;
-            println!(
+            out!(
                 "wrote {} ({} s of '{}', seed {seed})",
                 out.display(),
                 sc.duration_s,
@@ -100,13 +108,19 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
         } => {
             let sc = Scenario::load(&scenario)?;
             let report = host_sim::montecarlo::run(&sc, runs, 20.0, true)?;
-            println!(
+            out!(
                 "scenario {}: {} runs; 95 % chi-square bands",
-                sc.name, report.runs
+                sc.name,
+                report.runs
             );
-            println!(
+            out!(
                 "  {:<22} {:>8} {:>8} {:>17} {:>8} {:>7}",
-                "statistic", "value", "expect", "band", "inside", "holds"
+                "statistic",
+                "value",
+                "expect",
+                "band",
+                "inside",
+                "holds"
             );
             for r in report.nees.iter().chain(&report.nis) {
                 let label = if r.fraction_inside.is_some() {
@@ -117,7 +131,7 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                 let inside = r
                     .fraction_inside
                     .map_or("-".into(), |f| format!("{:.0} %", 100.0 * f));
-                println!(
+                out!(
                     "  {:<22} {:>8.3} {:>8.3} {:>17} {:>8} {:>7}",
                     label,
                     r.value,
@@ -136,24 +150,24 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
 }
 
 fn print_summary(name: &str, seed: u64, cfg: &ReplayConfig, m: &Metrics, out: &Path) {
-    println!("scenario {name}  seed {seed}  precision {}", cfg.precision);
-    println!(
+    out!("scenario {name}  seed {seed}  precision {}", cfg.precision);
+    out!(
         "  {:<28} {:>12}",
         "position RMSE (ATE) [m]",
         fmt(m.ate_position_rmse_m)
     );
-    println!(
+    out!(
         "  {:<28} {:>12}",
         "attitude RMSE [deg]",
         fmt(m.attitude_rmse_deg)
     );
-    println!(
+    out!(
         "  {:<28} {:>12}",
         "velocity RMSE [m/s]",
         fmt(m.velocity_rmse_mps)
     );
     for (block, v) in &m.nees_mean {
-        println!(
+        out!(
             "  {:<28} {:>12}",
             format!("ANEES {block} (expect 3)"),
             fmt(*v)
@@ -162,25 +176,25 @@ fn print_summary(name: &str, seed: u64, cfg: &ReplayConfig, m: &Metrics, out: &P
     for (sensor, nis) in &m.nis_mean {
         let a = m.updates_accepted.get(sensor).copied().unwrap_or(0);
         let r = m.updates_rejected.get(sensor).copied().unwrap_or(0);
-        println!(
+        out!(
             "  {:<28} {:>12}   accepted {a}, rejected {r}",
             format!("mean NIS {sensor}"),
             fmt(*nis)
         );
     }
     for (name, v) in &m.baseline_attitude_rmse_deg {
-        println!(
+        out!(
             "  {:<28} {:>12}",
             format!("  {name} attitude RMSE [deg]"),
             fmt(*v)
         );
     }
-    println!(
+    out!(
         "  {:<28} {:>12}",
         "filter ns per IMU sample",
         fmt(m.filter_ns_per_imu_sample)
     );
-    println!("  outputs in {}", out.display());
+    out!("  outputs in {}", out.display());
 }
 
 fn fmt(x: f64) -> String {

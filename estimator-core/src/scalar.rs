@@ -96,11 +96,7 @@ pub fn sincos_f32(x: f32) -> (f32, f32) {
     const DP3: f32 = 3.774_895e-8;
 
     let ax = libm::fabsf(x);
-    let ax = if ax > 8192.0 {
-        ax % core::f32::consts::TAU
-    } else {
-        ax
-    };
+    let ax = if ax > 8192.0 { reduce_large(ax) } else { ax };
     // Saturating float-to-int conversion: NaN gives 0, huge values give u32::MAX (then masked).
     let j = (ax * FOUR_OVER_PI) as u32;
     let j = j.wrapping_add(j & 1);
@@ -122,6 +118,14 @@ pub fn sincos_f32(x: f32) -> (f32, f32) {
     } else {
         (f32::NAN, f32::NAN)
     }
+}
+
+/// `x mod 2π` for the rare huge argument, kept out of line: inlined, LLVM hoists the `fmodf` out
+/// of its branch and every call would pay for it.
+#[cold]
+#[inline(never)]
+fn reduce_large(x: f32) -> f32 {
+    x % core::f32::consts::TAU
 }
 
 /// The largest `x = θ²` at which a truncated Taylor series is exact to half an epsilon.

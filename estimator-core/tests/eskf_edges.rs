@@ -458,12 +458,22 @@ fn gamma_p(a: f64, x: f64) -> f64 {
 #[test]
 fn chi_square_table_matches_cdf() {
     for dof in 1..=6usize {
-        for (p, prob) in [
+        for (col, (p, prob)) in [
             (GateProbability::P95, 0.95),
             (GateProbability::P99, 0.99),
             (GateProbability::P999, 0.999),
-        ] {
+        ]
+        .into_iter()
+        .enumerate()
+        {
             let q: f64 = p.quantile(dof);
+            // `quantile` writes the table's numbers as literals (no run-time f64 on a
+            // Cortex-M4F): it must agree with the published table exactly.
+            assert_eq!(
+                q,
+                estimator_core::eskf::CHI_SQUARE_TABLE[dof - 1][col],
+                "dof {dof} col {col}"
+            );
             let cdf = gamma_p(dof as f64 / 2.0, q / 2.0);
             assert!((cdf - prob).abs() < 2e-7, "dof {dof} p {prob}: cdf {cdf}");
             let q32: f32 = p.quantile(dof);

@@ -55,10 +55,22 @@ impl GateProbability {
         if dof == 0 {
             return T::zero();
         }
-        if let Some(row) = CHI_SQUARE_TABLE.get(dof - 1) {
-            if let Some(q) = row.get(self.column()) {
-                return T::lit(*q);
-            }
+        // Each `T::lit` takes a literal, so it folds to a `T` constant: no run-time f64 → f32
+        // conversion (soft-float on a Cortex-M4F). Same numbers as `CHI_SQUARE_TABLE`.
+        let col = self.column();
+        let pick = |a: f64, b: f64, c: f64| match col {
+            0 => T::lit(a),
+            1 => T::lit(b),
+            _ => T::lit(c),
+        };
+        match dof {
+            1 => return pick(3.841_459, 6.634_897, 10.827_566),
+            2 => return pick(5.991_465, 9.210_340, 13.815_511),
+            3 => return pick(7.814_728, 11.344_867, 16.266_236),
+            4 => return pick(9.487_729, 13.276_704, 18.466_827),
+            5 => return pick(11.070_498, 15.086_272, 20.515_006),
+            6 => return pick(12.591_587, 16.811_894, 22.457_744),
+            _ => {}
         }
         // `dof` as a `T` without an integer-to-f64 conversion (software on a Cortex-M4F).
         let mut m = T::zero();
@@ -66,7 +78,12 @@ impl GateProbability {
             m += T::one();
         }
         let c = T::lit(2.0 / 9.0) / m;
-        let base = T::one() - c + T::lit(self.z_score()) * c.sqrt();
+        let z = match self {
+            Self::P95 => T::lit(1.644_853_6),
+            Self::P99 => T::lit(2.326_347_9),
+            Self::P999 => T::lit(3.090_232_3),
+        };
+        let base = T::one() - c + z * c.sqrt();
         m * base * base * base
     }
 }

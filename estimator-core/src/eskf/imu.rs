@@ -113,7 +113,9 @@ pub(crate) fn check_dt<T: Real>(dt: T, max_dt: T) -> Result<(), EskfError> {
 
 pub(crate) fn finite_vec<T: Real, const R: usize, const C: usize>(m: &SMatrix<T, R, C>) -> bool {
     // Branch-free and-reduction; `all` would branch per element.
-    m.iter().fold(true, |acc, x| acc & x.is_finite())
+    // Over the contiguous storage: nalgebra's strided `iter()` costs ~170 instructions per
+    // element on a Cortex-M4 (fully unrolled with pointer selects), the slice ~4.
+    m.as_slice().iter().fold(true, |acc, x| acc & x.is_finite())
 }
 
 /// Block `(i, j)` (3×3, offsets `3i, 3j`) of an `R × C` matrix, read element by element (with

@@ -7,7 +7,7 @@ use super::imu::{finite_vec, greater};
 use super::state::ErrorState;
 use crate::lie::{LieGroup, So3};
 use crate::Real;
-use nalgebra::{Cholesky, Matrix3, SMatrix, SVector};
+use nalgebra::{Cholesky, Matrix3, SMatrix, SVector, Vector3};
 
 /// A measurement linearized at a state: the residual `r = z ⊖ h(x)` (for a vector measurement
 /// `z − h(x)`; angles wrapped) and `H = ∂h(x ⊕ δx)/∂δx` at `δx = 0` (seed eq. 4.3 / Def. 4.6).
@@ -186,7 +186,7 @@ fn gain_into<T: Real, const N: usize, const M: usize>(
     p: &SMatrix<T, N, N>,
     r_noise: &SMatrix<T, M, M>,
     w: &mut Work<T, N, M>,
-) -> Result<Cholesky<T, nalgebra::Const<M>>, EskfError> {
+) -> Result<SMatrix<T, M, M>, EskfError> {
     // U = P Hᵀ = Σ_k P e_k (H e_k)ᵀ over the nonzero columns of H only (most models touch 3–6
     // of the 15 error components).
     w.u.fill(T::zero());
@@ -207,7 +207,7 @@ fn gain_into<T: Real, const N: usize, const M: usize>(
     if !finite_vec(&w.k) {
         return Err(EskfError::SingularInnovation);
     }
-    Ok(chol)
+    Ok(s_inv)
 }
 
 /// The generic update on `(x, P)`; `x` and `P` are written only when the result is `Accepted`.
@@ -256,8 +256,14 @@ where
         dx: SVector::zeros(),
     };
     linearize_into(model, x, &mut w, true)?;
-    let chol = gain_into(p, &r_noise, &mut w)?;
-    let nis = w.r.dot(&chol.solve(&w.r));
+    let s_inv = gain_into(p, &r_noise, &mut w)?;
+    // NIS = rᵀ S⁻¹ r with the S⁻¹ already formed for K, and an explicit sum: `Cholesky::solve`
+    // (dynamic-range `dot`s) and `dot` keep shape asserts, panic paths at opt-level "s".
+    let y = s_inv * w.r;
+    let nis =
+        w.r.iter()
+            .zip(y.iter())
+            .fold(T::zero(), |acc, (a, b)| acc + *a * *b);
     if !nis.is_finite() {
         return Err(EskfError::SingularInnovation);
     }
@@ -335,7 +341,12 @@ where
     let k3 = w.k.fixed_rows::<3>(0);
     let mut top = p.fixed_rows::<3>(0).into_owned();
     for (mut c, (vj, kj)) in top.column_iter_mut().zip(v.row_iter().zip(w.k.row_iter())) {
-        let col = gr * (c.clone_owned() + v3 * kj.transpose() + k3 * vj.transpose());
+        // Copy through `copy_from` (shape checked at compile time): `clone_owned` of a view goes
+        // through nalgebra's `allocate_from_iterator`, whose length assert is a panic path
+        // that opt-level "s" does not remove.
+        let mut c0 = Vector3::<T>::zeros();
+        c0.copy_from(&c);
+        let col = gr * (c0 + v3 * kj.transpose() + k3 * vj.transpose());
         c.copy_from(&col);
     }
     let c00 = top.fixed_columns::<3>(0) * gr.transpose();

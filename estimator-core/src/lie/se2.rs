@@ -148,7 +148,7 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         let w2 = w * w;
         let half_w = T::lit(0.5) * w;
         let h = if w2 < T::lit(Cutoff::<T>::HALF_COT) {
-            poly(w2, [1.0, -1.0 / 12.0, -1.0 / 720.0])
+            poly(w2, [T::lit(1.0), T::lit(-1.0 / 12.0), T::lit(-1.0 / 720.0)])
         } else if c >= T::zero() {
             half_w * (T::one() + c) / s
         } else {

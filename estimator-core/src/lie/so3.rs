@@ -131,7 +131,7 @@ impl<T: Real> So3<T> {
         // θ = 2·atan2(n, w); below the cutoff (n/w small) use 2·atan(r)/r's series, r = n/w.
         let scale = if n2 < T::lit(Cutoff::<T>::ATAN_RATIO) * w * w {
             let r2 = n2 / (w * w);
-            T::lit(2.0) / w * poly(r2, [1.0, -1.0 / 3.0, 1.0 / 5.0])
+            T::lit(2.0) / w * poly(r2, [T::lit(1.0), T::lit(-1.0 / 3.0), T::lit(1.0 / 5.0)])
         } else {
             T::lit(2.0) * n.atan2(w) / n
         };

@@ -48,16 +48,13 @@ impl<T: Real> Cutoff<T> {
 
 /// Evaluates `p₀ + p₁x + p₂x² + …` (Horner).
 #[inline(always)]
-pub(crate) fn poly<T: Real, const N: usize>(x: T, coeffs: [f64; N]) -> T {
+pub(crate) fn poly<T: Real, const N: usize>(x: T, coeffs: [T; N]) -> T {
+    // Coefficients arrive as `T` (each `T::lit(literal)` folds at compile time): an `[f64; N]`
+    // indexed in a loop that is not unrolled (opt-level "s") would convert at run time, which
+    // is a soft-float `__aeabi_d2f` call on a Cortex-M4F.
     let mut acc = T::zero();
-    let mut i = N;
-    while i > 0 {
-        i -= 1;
-        let k = match coeffs.get(i) {
-            Some(k) => *k,
-            None => 0.0,
-        };
-        acc = acc * x + T::lit(k);
+    for k in coeffs.iter().rev() {
+        acc = acc * x + *k;
     }
     acc
 }
@@ -98,19 +95,30 @@ impl<T: Real> AngleCoeffs<T> {
     pub fn from_half_angle(theta_sq: T, theta: T, sin_half: T, cos_half: T) -> Self {
         let two = T::lit(2.0);
         let a = if theta_sq < T::lit(Cutoff::<T>::A) {
-            poly(theta_sq, [1.0, -1.0 / 6.0, 1.0 / 120.0])
+            poly(
+                theta_sq,
+                [T::lit(1.0), T::lit(-1.0 / 6.0), T::lit(1.0 / 120.0)],
+            )
         } else {
             two * sin_half * cos_half / theta
         };
         let b = if theta_sq < T::lit(Cutoff::<T>::B) {
-            poly(theta_sq, [0.5, -1.0 / 24.0, 1.0 / 720.0])
+            poly(
+                theta_sq,
+                [T::lit(0.5), T::lit(-1.0 / 24.0), T::lit(1.0 / 720.0)],
+            )
         } else {
             two * sin_half * sin_half / theta_sq
         };
         let c = if theta_sq < T::lit(Cutoff::<T>::C) {
             poly(
                 theta_sq,
-                [1.0 / 6.0, -1.0 / 120.0, 1.0 / 5040.0, -1.0 / 362_880.0],
+                [
+                    T::lit(1.0 / 6.0),
+                    T::lit(-1.0 / 120.0),
+                    T::lit(1.0 / 5040.0),
+                    T::lit(-1.0 / 362_880.0),
+                ],
             )
         } else {
             (T::one() - a) / theta_sq
@@ -119,11 +127,11 @@ impl<T: Real> AngleCoeffs<T> {
             poly(
                 theta_sq,
                 [
-                    1.0 / 12.0,
-                    1.0 / 720.0,
-                    1.0 / 30240.0,
-                    1.0 / 1_209_600.0,
-                    1.0 / 47_900_160.0,
+                    T::lit(1.0 / 12.0),
+                    T::lit(1.0 / 720.0),
+                    T::lit(1.0 / 30240.0),
+                    T::lit(1.0 / 1_209_600.0),
+                    T::lit(1.0 / 47_900_160.0),
                 ],
             )
         } else {
@@ -166,7 +174,12 @@ impl<T: Real> AngleCoeffs<T> {
         let e = if x < T::lit(Cutoff::<T>::E) {
             poly(
                 x,
-                [-1.0 / 24.0, 1.0 / 720.0, -1.0 / 40320.0, 1.0 / 3_628_800.0],
+                [
+                    T::lit(-1.0 / 24.0),
+                    T::lit(1.0 / 720.0),
+                    T::lit(-1.0 / 40320.0),
+                    T::lit(1.0 / 3_628_800.0),
+                ],
             )
         } else {
             (self.b - T::lit(0.5)) / x
@@ -174,7 +187,12 @@ impl<T: Real> AngleCoeffs<T> {
         let f = if x < T::lit(Cutoff::<T>::F) {
             poly(
                 x,
-                [-1.0 / 60.0, 1.0 / 1260.0, -1.0 / 60480.0, 1.0 / 4_989_600.0],
+                [
+                    T::lit(-1.0 / 60.0),
+                    T::lit(1.0 / 1260.0),
+                    T::lit(-1.0 / 60480.0),
+                    T::lit(1.0 / 4_989_600.0),
+                ],
             )
         } else {
             e - T::lit(3.0) * (self.c - T::lit(1.0 / 6.0)) / x
@@ -194,7 +212,10 @@ pub(crate) struct SeCoeffs<T> {
 #[inline]
 pub(crate) fn half_sinc<T: Real>(theta_sq: T, theta: T, sin_half: T) -> T {
     if theta_sq < T::lit(Cutoff::<T>::HALF_SINC) {
-        poly(theta_sq, [0.5, -1.0 / 48.0, 1.0 / 3840.0])
+        poly(
+            theta_sq,
+            [T::lit(0.5), T::lit(-1.0 / 48.0), T::lit(1.0 / 3840.0)],
+        )
     } else {
         sin_half / theta
     }
@@ -204,7 +225,10 @@ pub(crate) fn half_sinc<T: Real>(theta_sq: T, theta: T, sin_half: T) -> T {
 #[inline]
 pub(crate) fn half_cot<T: Real>(theta_sq: T, theta: T, sin_half: T, cos_half: T) -> T {
     if theta_sq < T::lit(Cutoff::<T>::HALF_COT) {
-        poly(theta_sq, [1.0, -1.0 / 12.0, -1.0 / 720.0])
+        poly(
+            theta_sq,
+            [T::lit(1.0), T::lit(-1.0 / 12.0), T::lit(-1.0 / 720.0)],
+        )
     } else {
         T::lit(0.5) * theta * cos_half / sin_half
     }

@@ -215,3 +215,25 @@ fn se2_log_near_pi() {
         }
     }
 }
+
+/// `renormalize` (one Newton step, no square root) takes a norm error ε to about ¾ε².
+#[test]
+fn renormalize_is_quadratic() {
+    for eps in [1e-3, 1e-5, -1e-4, 1e-7] {
+        let q = Quaternion::new(0.3, -0.5, 0.7, 0.1);
+        let q = q * ((1.0 + eps) as f64).sqrt() / q.norm();
+        let r = So3::from_unit_quaternion(nalgebra::UnitQuaternion::new_unchecked(q)).renormalize();
+        let err = r.quaternion().norm_squared() - 1.0;
+        assert!(
+            err.abs() <= 0.75 * eps * eps * 1.01 + 4.0 * f64::EPSILON,
+            "{eps}: {err}"
+        );
+        let dir = r.quaternion().coords.normalize() - q.coords.normalize();
+        assert!(dir.amax() < 4.0 * f64::EPSILON, "direction unchanged");
+    }
+    // f32: a product of unit quaternions comes back unit to rounding.
+    let a = So3::<f32>::exp(&Vector3::new(0.3, -1.2, 0.4));
+    let b = So3::<f32>::exp(&Vector3::new(-2.0, 0.1, 0.9));
+    let r = a.compose(&b).renormalize();
+    assert!((r.quaternion().norm_squared() - 1.0).abs() <= 4.0 * f32::EPSILON);
+}

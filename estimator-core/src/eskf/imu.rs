@@ -263,7 +263,7 @@ pub(crate) fn predict_ins<T: Real>(
     let r = x.attitude.rotation_matrix();
     let a = r * f + cfg.gravity;
     let new_x = InsState {
-        attitude: x.attitude.compose(&dr).normalize(),
+        attitude: x.attitude.compose(&dr).renormalize(),
         velocity: x.velocity + a * dt,
         position: x.position + x.velocity * dt + a * (half * dt * dt),
         gyro_bias: x.gyro_bias,
@@ -396,9 +396,26 @@ pub(crate) fn predict_ahrs<T: Real>(
     // M0j = F00 P0j + F01 P1j; P⁺00 = M00 F00ᵀ + M01 F01ᵀ; P⁺01 = M01; P⁺11 = P11.
     let m00 = mm(&f00, &p00) + mm(&f01, &p01.transpose());
     let m01 = mm(&f00, &p01) + mm(&f01, &p11);
-    let n00 = mm(&m00, &f00.transpose()) + mm(&m01, &f01.transpose());
-    let n00 = (n00 + n00.transpose()) * T::lit(0.5);
-    let att = x.attitude.compose(&dr).normalize();
+    // N00 = M00 F00ᵀ + M01 F01ᵀ is symmetric: compute its upper triangle and mirror it (half
+    // the products, and exactly symmetric without a separate symmetrization).
+    let row = |m: &Matrix3<T>, i: usize| match i {
+        0 => (m.m11, m.m12, m.m13),
+        1 => (m.m21, m.m22, m.m23),
+        _ => (m.m31, m.m32, m.m33),
+    };
+    let dot = |a: (T, T, T), b: (T, T, T)| a.0 * b.0 + a.1 * b.1 + a.2 * b.2;
+    let entry =
+        |i: usize, j: usize| dot(row(&m00, i), row(&f00, j)) + dot(row(&m01, i), row(&f01, j));
+    let (n11, n12, n13, n22, n23, n33) = (
+        entry(0, 0),
+        entry(0, 1),
+        entry(0, 2),
+        entry(1, 1),
+        entry(1, 2),
+        entry(2, 2),
+    );
+    let n00 = Matrix3::new(n11, n12, n13, n12, n22, n23, n13, n23, n33);
+    let att = x.attitude.compose(&dr).renormalize();
     if !(finite_vec(&n00) && finite_vec(&m01) && att.is_finite()) {
         return Err(EskfError::NonFinite);
     }

@@ -125,7 +125,7 @@ impl<T: Real> Se3<T> {
         // J_l⁻¹(ω) t = t − ½ ω×t + d ω×(ω×t).
         let t = &self.translation;
         let wt = w.cross(t);
-        let v = t - wt * T::lit(0.5) + w.cross(&wt) * k.d;
+        let v = t - wt * T::lit(0.5) + w.cross(&wt) * k.d();
         (join(&v, &w), k)
     }
 }

@@ -76,8 +76,6 @@ pub(crate) struct AngleCoeffs<T> {
     pub b: T,
     /// `(θ − sin θ)/θ³`.
     pub c: T,
-    /// `1/θ² − (1 + cos θ)/(2θ sin θ)`, the coefficient of `[θ]×²` in `J_r⁻¹`.
-    pub d: T,
 }
 
 impl<T: Real> AngleCoeffs<T> {
@@ -123,7 +121,23 @@ impl<T: Real> AngleCoeffs<T> {
         } else {
             (T::one() - a) / theta_sq
         };
-        let d = if theta_sq < T::lit(Cutoff::<T>::D) {
+        Self {
+            theta_sq,
+            theta,
+            sin_half,
+            cos_half,
+            a,
+            b,
+            c,
+        }
+    }
+
+    /// `d = 1/θ² − (1 + cos θ)/(2θ sin θ)`, the coefficient of `[θ]×²` in `J_r⁻¹`; computed on
+    /// demand, since only the inverse Jacobians need it.
+    #[inline]
+    pub fn d(&self) -> T {
+        let (theta_sq, theta) = (self.theta_sq, self.theta);
+        if theta_sq < T::lit(Cutoff::<T>::D) {
             poly(
                 theta_sq,
                 [
@@ -135,17 +149,7 @@ impl<T: Real> AngleCoeffs<T> {
                 ],
             )
         } else {
-            (T::one() - half_cot(theta_sq, theta, sin_half, cos_half)) / theta_sq
-        };
-        Self {
-            theta_sq,
-            theta,
-            sin_half,
-            cos_half,
-            a,
-            b,
-            c,
-            d,
+            (T::one() - half_cot(theta_sq, theta, self.sin_half, self.cos_half)) / theta_sq
         }
     }
 
@@ -281,7 +285,7 @@ mod tests {
             let k = AngleCoeffs::<f64>::from_theta_sq(theta * theta);
             let se = k.se();
             let r = exact(theta);
-            let got = [k.a, k.b, k.c, k.d, se.e, se.f];
+            let got = [k.a, k.b, k.c, k.d(), se.e, se.f];
             // The cancelling coefficients multiply θ² (c, d) or θ⁴ (e, f) wherever they are used.
             let weight = [
                 1.0,

@@ -1,0 +1,16 @@
+//! Puts memory.x where cortex-m-rt's link.x finds it.
+use std::{env, fs, path::PathBuf};
+
+fn main() {
+    let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
+    fs::copy("memory.x", out.join("memory.x")).unwrap();
+    println!("cargo:rustc-link-search={}", out.display());
+    println!("cargo:rerun-if-changed=memory.x");
+    // The expected results the demo checks: src/expected.rs (committed), or the file named by
+    // FIRMWARE_EXPECTED (CI regenerates it on the host from the current estimator-core).
+    let expected = env::var("FIRMWARE_EXPECTED").unwrap_or_else(|_| "src/expected.rs".into());
+    fs::copy(&expected, out.join("expected.rs")).unwrap();
+    println!("cargo:rerun-if-env-changed=FIRMWARE_EXPECTED");
+    println!("cargo:rerun-if-changed={expected}");
+    println!("cargo:rerun-if-changed=build.rs");
+}

@@ -1,0 +1,342 @@
+//! The firmware proof, run under QEMU (`mps2-an386`, Cortex-M4F):
+//!
+//! 1. runs the Lie-group operations, the 15-state filter (`Ins<f32>`), the attitude-only filter
+//!    (`Ahrs<f32>`) and a 20-point PnP solve on the embedded stream (`scenario.rs`), and checks
+//!    the results against the host's (`expected.rs`): f64 reference within stated tolerances,
+//!    the host's f32 run within a few ulps, and a sanity bound on the error against the truth;
+//! 2. measures each operation once more between the `bench_start`/`bench_stop` markers (the
+//!    instruction-count plugin `qemu-plugin/icount.c` counts between them) with the stack
+//!    painted below the caller, and prints the peak stack of each;
+//! 3. prints `size_of` of the filter and solver types;
+//! 4. exits through semihosting: status 0 when every check passed, 1 otherwise.
+#![no_std]
+#![no_main]
+
+/// The host's results (`src/expected.rs`, or `$FIRMWARE_EXPECTED`; see build.rs).
+mod expected {
+    include!(concat!(env!("OUT_DIR"), "/expected.rs"));
+}
+#[path = "../scenario.rs"]
+mod scenario;
+
+use core::hint::black_box;
+use core::mem::size_of;
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hprintln};
+use estimator_core::eskf::{Ahrs, Ins, InsState, UpdateOptions};
+use estimator_core::gn::{solve_pnp, PnpSolution, SolveError};
+use estimator_core::lie::{LieGroup, Se3, So3};
+use nalgebra::{Vector3, Vector6};
+
+// ---------------------------------------------------------------- benchmark markers
+
+/// Start of a measured window (the plugin's `start=` address).
+#[no_mangle]
+#[inline(never)]
+pub extern "C" fn bench_start() {
+    // SAFETY: no operation; the asm keeps the function (and its address) alive and distinct.
+    unsafe { core::arch::asm!("nop", options(nomem, nostack, preserves_flags)) };
+}
+
+/// End of a measured window (the plugin's `stop=` address).
+#[no_mangle]
+#[inline(never)]
+pub extern "C" fn bench_stop() {
+    // SAFETY: as in `bench_start` (two nops, so the two functions cannot be merged).
+    unsafe { core::arch::asm!("nop", "nop", options(nomem, nostack, preserves_flags)) };
+}
+
+// ---------------------------------------------------------------- stack painting
+
+const PAINT: u32 = 0xC5A5_5A5C;
+/// How far below the caller's stack pointer the paint reaches (bytes).
+const PAINT_DEPTH: usize = 16 * 1024;
+
+/// The caller's stack pointer after its prologue: a leaf with no frame, so `sp` here is the
+/// caller's `sp` at the call.
+#[inline(never)]
+fn caller_stack_pointer() -> usize {
+    let sp: usize;
+    // SAFETY: reads the stack pointer register, no side effect.
+    unsafe {
+        core::arch::asm!("mov {}, sp", out(reg) sp, options(nomem, nostack, preserves_flags))
+    };
+    sp
+}
+
+/// Measures `f` once: paints `PAINT_DEPTH` bytes below this frame, runs `f` between the
+/// benchmark markers, and returns the peak stack below this frame (`f`'s frames, the closure
+/// trampoline included).
+#[inline(never)]
+fn measure(f: &mut dyn FnMut()) -> usize {
+    let top = caller_stack_pointer() & !3;
+    let bottom = top - PAINT_DEPTH;
+    let mut a = bottom;
+    while a < top {
+        // SAFETY: the words below this frame's stack pointer belong to no live frame (no call
+        // happens during the loop); the RAM there is ours (the stack grows down from the end of
+        // the 4 MiB RAM); no interrupt is enabled.
+        unsafe { core::ptr::write_volatile(a as *mut u32, PAINT) };
+        a += 4;
+    }
+    bench_start();
+    f();
+    bench_stop();
+    let mut a = bottom;
+    while a < top {
+        // SAFETY: as above; reading back the paint.
+        if unsafe { core::ptr::read_volatile(a as *const u32) } != PAINT {
+            break;
+        }
+        a += 4;
+    }
+    top - a
+}
+
+// ---------------------------------------------------------------- result checks
+
+struct Checker {
+    failures: u32,
+}
+
+impl Checker {
+    fn close(&mut self, what: &str, got: &[f32], want: &[f32], tol: f32) {
+        let mut worst = 0.0f32;
+        for (g, w) in got.iter().zip(want.iter()) {
+            let d = if g.is_finite() {
+                (g - w).abs()
+            } else {
+                f32::INFINITY
+            };
+            if !(d <= worst) {
+                worst = d;
+            }
+        }
+        let ok = worst <= tol && got.len() == want.len();
+        if !ok {
+            self.failures += 1;
+        }
+        hprintln!(
+            "check {:<28} max|diff| {:e} <= {:e} {}",
+            what,
+            worst,
+            tol,
+            if ok { "ok" } else { "FAIL" }
+        );
+        if !ok {
+            hprintln!("  got  {:?}", got);
+            hprintln!("  want {:?}", want);
+        }
+    }
+
+    fn below(&mut self, what: &str, got: f32, bound: f32) {
+        let ok = got <= bound;
+        if !ok {
+            self.failures += 1;
+        }
+        hprintln!(
+            "check {:<28} {:e} <= {:e} {}",
+            what,
+            got,
+            bound,
+            if ok { "ok" } else { "FAIL" }
+        );
+    }
+
+    fn equal(&mut self, what: &str, got: u32, want: u32) {
+        let ok = got == want;
+        if !ok {
+            self.failures += 1;
+        }
+        hprintln!(
+            "check {:<28} {} == {} {}",
+            what,
+            got,
+            want,
+            if ok { "ok" } else { "FAIL" }
+        );
+    }
+}
+
+fn check_outcome(c: &mut Checker, o: &scenario::Outcome<f32>) {
+    let r = &expected::EXPECTED_F64;
+    let h = &expected::EXPECTED_F32_HOST;
+    c.equal("no error returned", o.failure, 0);
+    // Against the f64 reference: tolerances of the f32 arithmetic (README, "Tolerances").
+    c.close("so3 exp vs f64", &o.so3_exp, &r.so3_exp, 1e-6);
+    c.close("so3 log vs f64", &o.so3_log, &r.so3_log, 1e-5);
+    c.close("se3 log vs f64", &o.se3_log, &r.se3_log, 1e-5);
+    c.close("ins attitude q vs f64", &o.ins_q, &r.ins_q, 2e-5);
+    c.close("ins velocity vs f64", &o.ins_v, &r.ins_v, 1e-4);
+    c.close("ins position vs f64", &o.ins_p, &r.ins_p, 1e-4);
+    c.equal("ins updates accepted", o.ins_accepted, r.ins_accepted);
+    c.close("ahrs attitude q vs f64", &o.ahrs_q, &r.ahrs_q, 2e-5);
+    c.close("ahrs gyro bias vs f64", &o.ahrs_bg, &r.ahrs_bg, 1e-5);
+    c.equal("ahrs updates accepted", o.ahrs_accepted, r.ahrs_accepted);
+    c.close("pnp rotation q vs f64", &o.pnp_q, &r.pnp_q, 1e-5);
+    c.close("pnp translation vs f64", &o.pnp_t, &r.pnp_t, 1e-4);
+    // Against the host's own f32 run: the same IEEE f32 arithmetic, so (nearly) identical.
+    let all = |o: &scenario::Outcome<f32>| {
+        let mut v = [0.0f32; 45];
+        let parts: [&[f32]; 11] = [
+            &o.so3_exp,
+            &o.so3_log,
+            &o.se3_log,
+            &o.ins_q,
+            &o.ins_v,
+            &o.ins_p,
+            &o.ahrs_q,
+            &o.ahrs_bg,
+            &o.pnp_q,
+            &o.pnp_t,
+            &o.truth_errors,
+        ];
+        let mut i = 0;
+        for p in parts {
+            for x in p {
+                if let Some(slot) = v.get_mut(i) {
+                    *slot = *x;
+                }
+                i += 1;
+            }
+        }
+        v
+    };
+    c.close("all values vs host f32", &all(o), &all(h), 1e-5);
+    // Sanity against the simulated truth.
+    c.below("ins position error (m)", o.truth_errors[0], 0.2);
+    c.below("ins attitude error (rad)", o.truth_errors[1], 0.05);
+    c.below("ahrs attitude error (rad)", o.truth_errors[2], 0.1);
+    c.below("pnp rotation error (rad)", o.truth_errors[3], 0.01);
+    c.below("pnp translation error (m)", o.truth_errors[4], 0.02);
+}
+
+// ---------------------------------------------------------------- benchmarks
+
+fn bench(index: &mut u32, name: &str, mut f: impl FnMut()) {
+    let stack = measure(&mut f);
+    hprintln!("bench {} {} stack={}", index, name, stack);
+    *index += 1;
+}
+
+fn run_benchmarks(w: &scenario::Workload<f32>) {
+    let mut i = 0u32;
+    bench(&mut i, "empty", || {});
+
+    // Scalar kernels the estimators call (what a Cortex-M4F pays for them in f32).
+    let x = 0.7f32;
+    bench(&mut i, "sincos_f32", || {
+        black_box(estimator_core::scalar::sincos_f32(black_box(x)));
+    });
+    bench(&mut i, "libm_sqrtf", || {
+        black_box(libm::sqrtf(black_box(x)));
+    });
+    bench(&mut i, "libm_atan2f", || {
+        black_box(libm::atan2f(black_box(x), black_box(0.3f32)));
+    });
+
+    let tau = Vector3::new(0.3f32, -0.2, 0.9);
+    let r = So3::exp(&tau);
+    let r2 = So3::exp(&Vector3::new(-0.1f32, 0.5, 0.2));
+    bench(&mut i, "so3_exp", || {
+        black_box(So3::exp(black_box(&tau)));
+    });
+    bench(&mut i, "so3_log", || {
+        black_box(black_box(&r).log());
+    });
+    bench(&mut i, "so3_compose", || {
+        black_box(black_box(&r).compose(black_box(&r2)));
+    });
+    let xi = Vector6::new(0.5f32, -1.0, 2.0, 0.1, 0.4, -0.3);
+    let a = Se3::exp(&xi);
+    let b = Se3::exp(&Vector6::new(-0.2f32, 0.3, 0.1, -0.6, 0.2, 0.5));
+    bench(&mut i, "se3_exp", || {
+        black_box(Se3::exp(black_box(&xi)));
+    });
+    bench(&mut i, "se3_log", || {
+        black_box(black_box(&a).log());
+    });
+    bench(&mut i, "se3_compose", || {
+        black_box(black_box(&a).compose(black_box(&b)));
+    });
+
+    let opts: &UpdateOptions<f32> = &w.options;
+    let mut ins = w.ins;
+    bench(&mut i, "ins_predict", || {
+        let _ = black_box(black_box(&mut ins).predict(black_box(&w.imu)));
+    });
+    let mut ins = w.ins;
+    bench(&mut i, "ins_update_gnss_position", || {
+        let _ = black_box(black_box(&mut ins).update(black_box(&w.gnss), opts));
+    });
+    let mut ins = w.ins;
+    bench(&mut i, "ins_update_magnetometer", || {
+        let _ = black_box(black_box(&mut ins).update(black_box(&w.mag), opts));
+    });
+    let mut ahrs = w.ahrs;
+    bench(&mut i, "ahrs_predict", || {
+        let _ = black_box(black_box(&mut ahrs).predict(black_box(&w.imu.gyro), w.imu.dt));
+    });
+    let mut ahrs = w.ahrs;
+    bench(&mut i, "ahrs_update_magnetometer", || {
+        let _ = black_box(black_box(&mut ahrs).update(black_box(&w.mag), opts));
+    });
+    let mut ahrs = w.ahrs;
+    bench(&mut i, "ahrs_update_gravity", || {
+        let _ = black_box(black_box(&mut ahrs).update(black_box(&w.gravity), opts));
+    });
+    let mut sol: Option<Result<PnpSolution<f32>, SolveError>> = None;
+    bench(&mut i, "pnp_solve_20", || {
+        sol = Some(solve_pnp(
+            black_box(&w.world),
+            black_box(&w.pixels),
+            black_box(&w.camera),
+            black_box(&w.guess),
+            black_box(&w.pnp_options),
+        ));
+    });
+    if let Some(Ok(s)) = sol {
+        hprintln!("info pnp_iterations {}", s.iterations);
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    hprintln!("estimator-core firmware demo (thumbv7em-none-eabihf, f32)");
+    let (outcome, work) = scenario::run::<f32>();
+    let mut c = Checker { failures: 0 };
+    check_outcome(&mut c, &outcome);
+
+    run_benchmarks(&work);
+
+    hprintln!("size_of Ins<f32> {}", size_of::<Ins<f32>>());
+    hprintln!("size_of Ahrs<f32> {}", size_of::<Ahrs<f32>>());
+    hprintln!("size_of InsState<f32> {}", size_of::<InsState<f32>>());
+    hprintln!("size_of PnpSolution<f32> {}", size_of::<PnpSolution<f32>>());
+    hprintln!(
+        "size_of PnpOptions<f32> {}",
+        size_of::<estimator_core::gn::PnpOptions<f32>>()
+    );
+    hprintln!("size_of Se3<f32> {}", size_of::<Se3<f32>>());
+    hprintln!("size_of So3<f32> {}", size_of::<So3<f32>>());
+    hprintln!(
+        "size_of NormalEquations<f32,6> {}",
+        size_of::<estimator_core::gn::NormalEquations<f32, 6>>()
+    );
+
+    if c.failures == 0 {
+        hprintln!("RESULT PASS");
+        debug::exit(debug::EXIT_SUCCESS);
+    } else {
+        hprintln!("RESULT FAIL ({} checks failed)", c.failures);
+        debug::exit(debug::EXIT_FAILURE);
+    }
+    loop {}
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    hprintln!("PANIC {}", info);
+    debug::exit(debug::EXIT_FAILURE);
+    loop {}
+}

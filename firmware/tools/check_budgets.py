@@ -1,0 +1,98 @@
+#!/usr/bin/env python3
+"""Collects the firmware figures and checks them against firmware/budgets.txt.
+
+  check_budgets.py BUDGETS DEMO_OUT ICOUNT_OUT [EXTRA...]   check, print the table
+  check_budgets.py BUDGETS --allowed CHECK                   exit 0 if CHECK has an allowance
+
+DEMO_OUT: the demo's semihosting output (`bench <i> <name> stack=<bytes>`, `size_of <T> <n>`).
+ICOUNT_OUT: the plugin's output (`icount <i> <instructions>`); window 0 is the empty one, whose
+count (the marker overhead) is subtracted from the others.
+EXTRA: files of `name value` lines (flash sizes measured by the script).
+FIRMWARE_STRICT=1: enforce the issue's targets instead of the ceilings; no allowances.
+"""
+import os
+import re
+import sys
+
+strict = os.environ.get("FIRMWARE_STRICT") == "1"
+
+
+def read_budgets(path):
+    budgets, allow = {}, set()
+    for raw in open(path):
+        line = raw.split("#", 1)[0].split()
+        if not line:
+            continue
+        if line[0] == "allow":
+            allow.add(line[1])
+        else:
+            budgets[line[0]] = (int(line[1]), int(line[2]))
+    return budgets, allow
+
+
+budgets, allow = read_budgets(sys.argv[1])
+if sys.argv[2] == "--allowed":
+    sys.exit(0 if (sys.argv[3] in allow and not strict) else 1)
+
+names, stack, icount, sizes, extra = {}, {}, {}, {}, {}
+for line in open(sys.argv[2]):
+    m = re.match(r"bench (\d+) (\S+) stack=(\d+)", line)
+    if m:
+        names[int(m.group(1))] = m.group(2)
+        stack[m.group(2)] = int(m.group(3))
+    m = re.match(r"size_of (.+) (\d+)$", line.strip())
+    if m:
+        sizes[m.group(1)] = int(m.group(2))
+raw = {}
+for line in open(sys.argv[3]):
+    m = re.match(r"icount (\d+) (\d+)$", line.strip())
+    if m:
+        raw[int(m.group(1))] = int(m.group(2))
+if not names or 0 not in raw:
+    print("check_budgets: no benchmark output (did the demo or the plugin fail?)")
+    sys.exit(1)
+overhead = raw[0]
+for i, name in names.items():
+    if i in raw and i != 0:
+        icount[name] = raw[i] - overhead
+for path in sys.argv[4:]:
+    for line in open(path):
+        parts = line.split()
+        if len(parts) == 2:
+            extra[parts[0]] = int(parts[1])
+
+figures = {}
+for k, v in icount.items():
+    figures["icount." + k] = v
+for k, v in stack.items():
+    if k != "empty":
+        figures["stack." + k] = v
+figures["stack.max"] = max(v for k, v in stack.items())
+for k, v in sizes.items():
+    figures["sizeof." + k] = v
+figures.update(extra)
+
+print(f"instruction-count overhead of the empty window: {overhead} (subtracted)")
+print(f"{'figure':<36} {'measured':>10} {'target':>10} {'ceiling':>10}  verdict")
+failed = 0
+for k in sorted(figures):
+    v = figures[k]
+    if k in budgets:
+        target, ceiling = budgets[k]
+        limit = target if strict else ceiling
+        if v > limit:
+            verdict = "FAIL (over " + ("target" if strict else "ceiling") + ")"
+            failed += 1
+        elif v > target:
+            verdict = "over target (allowed ceiling)"
+        else:
+            verdict = "ok"
+        print(f"{k:<36} {v:>10} {target:>10} {limit:>10}  {verdict}")
+    else:
+        print(f"{k:<36} {v:>10} {'-':>10} {'-':>10}")
+missing = [k for k in budgets if k not in figures]
+for k in missing:
+    print(f"{k:<36} {'missing':>10}  FAIL")
+    failed += 1
+print(f"budgets: {failed} over")
+sys.exit(1 if failed else 0)

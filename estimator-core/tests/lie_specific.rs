@@ -221,7 +221,7 @@ fn se2_log_near_pi() {
 fn renormalize_is_quadratic() {
     for eps in [1e-3, 1e-5, -1e-4, 1e-7] {
         let q = Quaternion::new(0.3, -0.5, 0.7, 0.1);
-        let q = q * ((1.0 + eps) as f64).sqrt() / q.norm();
+        let q = q * (1.0f64 + eps).sqrt() / q.norm();
         let r = So3::from_unit_quaternion(nalgebra::UnitQuaternion::new_unchecked(q)).renormalize();
         let err = r.quaternion().norm_squared() - 1.0;
         assert!(

@@ -72,10 +72,38 @@ impl<T: Real, const N: usize> Factor<T, N> {
     /// # Errors
     /// [`SolveError::NonFiniteResidual`] if an entry is not finite.
     pub fn inverse(&self) -> Result<SMatrix<T, N, N>, SolveError> {
-        let x = self.chol.inverse();
-        let x = (x + x.transpose()) * T::lit(0.5);
+        let mut x = SMatrix::zeros();
+        self.inverse_into(&mut x)?;
+        Ok(x)
+    }
+
+    /// [`Self::inverse`] written into `x`, without `N × N` temporaries (for small stacks).
+    ///
+    /// # Errors
+    /// As [`Self::inverse`]; `x` then holds the non-finite result.
+    #[inline(never)]
+    pub(crate) fn inverse_into(&self, x: &mut SMatrix<T, N, N>) -> Result<(), SolveError> {
+        x.fill_with_identity();
+        self.chol.solve_mut(x);
+        // (X + Xᵀ)/2 in place: entry (r, c) and (c, r) both get (x_rc + x_cr)·½ (the sum is
+        // commutative, so both equal the out-of-place result).
+        let half = T::lit(0.5);
+        for c in 0..N {
+            for r in c..N {
+                let (Some(&a), Some(&b)) = (x.get((r, c)), x.get((c, r))) else {
+                    continue;
+                };
+                let s = (a + b) * half;
+                if let Some(v) = x.get_mut((r, c)) {
+                    *v = s;
+                }
+                if let Some(v) = x.get_mut((c, r)) {
+                    *v = s;
+                }
+            }
+        }
         if x.iter().all(|v| v.is_finite()) {
-            Ok(x)
+            Ok(())
         } else {
             Err(SolveError::NonFiniteResidual)
         }

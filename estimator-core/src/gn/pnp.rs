@@ -1,5 +1,5 @@
 //! Camera pose from landmark projections (PnP): `z_j = K π(T p_j)` (seed §4), solved by the
-//! [`solve`] core over `T ∈ SE(3)`.
+//! [`solve`](super::solve) core over `T ∈ SE(3)`.
 //!
 //! The Jacobian of the pixel with respect to the right perturbation `T ⊕ ξ`, `ξ = [v; ω]`, is the
 //! chain rule of seed Theorem 5.1 (`∂(T p)/∂ξ = [R | −R[p]×]`, [`crate::lie::Se3`]'s `act_jac`)
@@ -13,7 +13,7 @@
 //! same product without forming `R[p]×` (the tests compare it with `act_jac` and with finite
 //! differences).
 
-use super::solver::{solve, Method, Problem, SolverOptions, Status};
+use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
 use super::{Loss, PinholeCamera, SolveError};
 use crate::lie::{LieGroup, Se3};
 use crate::Real;
@@ -280,6 +280,44 @@ fn inlier_mask<T: Real>(
     })
 }
 
+/// The Cauchy fallback of [`solve_pnp`]: a Huber solve of scale `k` (whitened) from `guess`,
+/// then Cauchy (`options`) from there; when that reaches a lower cost than `best.0` and its
+/// inlier test succeeds, it replaces `best`. Returns the iterations run.
+///
+/// Out of line so that its second solution does not sit in [`solve_pnp`]'s frame on the common
+/// path (no retry).
+#[inline(never)]
+fn cauchy_retry<T: Real>(
+    problem: &PnpProblem<'_, T>,
+    guess: &Se3<T>,
+    options: &SolverOptions<T>,
+    k: T,
+    inlier_chi2: T,
+    best: (&mut Solution<T, Se3<T>, 6>, &mut Inliers),
+) -> usize {
+    let huber = SolverOptions {
+        loss: Loss::Huber(k),
+        ..*options
+    };
+    // One buffer serves both solves: only the Huber state is kept for the second.
+    let mut c = Solution::placeholder(guess);
+    if solve_into(problem, guess, &huber, &mut c).is_err() {
+        return 0;
+    }
+    let mut iterations = c.iterations;
+    let start = c.state;
+    if solve_into(problem, &start, options, &mut c).is_ok() {
+        iterations += c.iterations;
+        if c.final_cost < best.0.final_cost {
+            if let Ok(m) = inlier_mask(problem, &c.state, inlier_chi2) {
+                *best.0 = c;
+                *best.1 = m;
+            }
+        }
+    }
+    iterations
+}
+
 /// Camera pose from landmark projections: minimizes `Σⱼ ρ(‖K π(T pⱼ) − zⱼ‖² / σ²)` over
 /// `T = camera_from_world ∈ SE(3)`, from `camera_from_world_guess` (seed §4, `z = π(T p)`).
 ///
@@ -359,7 +397,8 @@ pub fn solve_pnp<T: Real>(
         information_step_tolerance: options.information_step_tolerance,
         initial_damping: SolverOptions::<T>::default().initial_damping,
     };
-    let mut sol = solve(&problem, camera_from_world_guess, &solver_options)?;
+    let mut sol = Solution::placeholder(camera_from_world_guess);
+    solve_into(&problem, camera_from_world_guess, &solver_options, &mut sol)?;
     let mut inliers = inlier_mask(&problem, &sol.state, options.inlier_chi2)?;
     let mut iterations = sol.iterations;
 
@@ -369,22 +408,14 @@ pub fn solve_pnp<T: Real>(
     // scale) from the guess, continue with Cauchy from there, and keep the lower Cauchy cost.
     if let Loss::Cauchy(k) = options.loss {
         if inliers.count() * 2 < n {
-            let huber = SolverOptions {
-                loss: Loss::Huber(k * inv_sigma),
-                ..solver_options
-            };
-            if let Ok(h) = solve(&problem, camera_from_world_guess, &huber) {
-                iterations += h.iterations;
-                if let Ok(c) = solve(&problem, &h.state, &solver_options) {
-                    iterations += c.iterations;
-                    if c.final_cost < sol.final_cost {
-                        if let Ok(m) = inlier_mask(&problem, &c.state, options.inlier_chi2) {
-                            sol = c;
-                            inliers = m;
-                        }
-                    }
-                }
-            }
+            iterations += cauchy_retry(
+                &problem,
+                camera_from_world_guess,
+                &solver_options,
+                k * inv_sigma,
+                options.inlier_chi2,
+                (&mut sol, &mut inliers),
+            );
         }
     }
 

@@ -84,7 +84,15 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
     pub fn add<const K: usize>(&mut self, loss: &Loss<T>, e: &SVector<T, K>, j: &SMatrix<T, K, N>) {
         let (rho, w) = loss.evaluate(e.norm_squared());
         let wj = j * w;
-        self.information += wj.tr_mul(j);
+        // `A += (w J)ᵀ J` entry by entry (the same dot products as `tr_mul`, without its
+        // `N × N` temporary).
+        for (r, wcol) in wj.column_iter().enumerate() {
+            for (c, jcol) in j.column_iter().enumerate() {
+                if let Some(x) = self.information.get_mut((r, c)) {
+                    *x += wcol.dot(&jcol);
+                }
+            }
+        }
         self.gradient += wj.tr_mul(e);
         self.cost += rho;
         self.blocks += 1;
@@ -103,12 +111,33 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
         P: Problem<T, S, N, K> + ?Sized,
     {
         let mut ne = Self::zeros();
-        problem.linearize(state, |e, j| ne.add(loss, e, j))?;
-        if ne.cost.is_finite()
-            && ne.gradient.iter().all(|x| x.is_finite())
-            && ne.information.iter().all(|x| x.is_finite())
+        ne.rebuild(problem, state, loss)?;
+        Ok(ne)
+    }
+
+    /// [`Self::build`] in place: resets `self` and accumulates every block of `problem` at
+    /// `state` into it (no `N × N` temporary is returned by value, which keeps the stack small
+    /// on embedded targets). On error `self` holds a partial sum.
+    ///
+    /// # Errors
+    /// As [`Self::build`].
+    #[inline(never)]
+    pub(crate) fn rebuild<S, P, const K: usize>(
+        &mut self,
+        problem: &P,
+        state: &S,
+        loss: &Loss<T>,
+    ) -> Result<(), SolveError>
+    where
+        P: Problem<T, S, N, K> + ?Sized,
+    {
+        *self = Self::zeros();
+        problem.linearize(state, |e, j| self.add(loss, e, j))?;
+        if self.cost.is_finite()
+            && self.gradient.iter().all(|x| x.is_finite())
+            && self.information.iter().all(|x| x.is_finite())
         {
-            Ok(ne)
+            Ok(())
         } else {
             Err(SolveError::NonFiniteResidual)
         }
@@ -244,6 +273,44 @@ where
     S: Manifold<T, N>,
     P: Problem<T, S, N, K> + ?Sized,
 {
+    let mut out = Solution::placeholder(initial);
+    solve_into(problem, initial, options, &mut out)?;
+    Ok(out)
+}
+
+impl<T: Real, S: Copy, const N: usize> Solution<T, S, N> {
+    /// A value to be overwritten by [`solve_into`]: `state = *initial`, zero covariance and
+    /// costs, no iterations.
+    pub(crate) fn placeholder(initial: &S) -> Self {
+        Self {
+            state: *initial,
+            covariance: SMatrix::zeros(),
+            iterations: 0,
+            initial_cost: T::zero(),
+            final_cost: T::zero(),
+            status: Status::MaxIterations,
+        }
+    }
+}
+
+/// [`solve`] writing its result into `out` (every field, on success) instead of returning it:
+/// callers that keep a solution avoid the by-value copies of the `N × N` covariance through
+/// `Result`, which matters for the stack on embedded targets. On error `out` may hold a partial
+/// result.
+///
+/// # Errors
+/// As [`solve`].
+pub(crate) fn solve_into<T, S, P, const N: usize, const K: usize>(
+    problem: &P,
+    initial: &S,
+    options: &SolverOptions<T>,
+    out: &mut Solution<T, S, N>,
+) -> Result<(), SolveError>
+where
+    T: Real,
+    S: Manifold<T, N>,
+    P: Problem<T, S, N, K> + ?Sized,
+{
     if !options.is_valid() {
         return Err(SolveError::InvalidOptions);
     }
@@ -252,7 +319,10 @@ where
     }
     let loss = options.loss;
     let mut state = *initial;
-    let mut ne = NormalEquations::build(problem, &state, &loss)?;
+    let mut ne = NormalEquations::zeros();
+    ne.rebuild(problem, &state, &loss)?;
+    // The trial linearization, reused across iterations.
+    let mut trial = NormalEquations::zeros();
     let initial_cost = ne.cost;
     let mut lambda = options.initial_damping;
     let mut nu = T::lit(2.0);
@@ -266,20 +336,11 @@ where
             status = Status::CostConverged;
             break;
         }
-        let mut damped = ne.information;
-        if lm {
-            // Marquardt scaling: λ·diag(A), with a floor so a zero column still gets damped.
-            let floor = ne.information.diagonal().max() * T::lit(T::EPSILON_F64);
-            for (k, d) in ne.information.diagonal().iter().enumerate() {
-                if let Some(x) = damped.get_mut((k, k)) {
-                    *x += lambda * (*d).max(floor);
-                }
-            }
-        }
-        let factor = match Factor::new(&damped) {
-            Ok(f) => f,
-            Err(e) if !lm => return Err(e),
-            Err(_) => {
+        let step = match damped_step(&ne, lambda, lm) {
+            Ok(s) => s,
+            Err(StepError::Solve(e)) => return Err(e),
+            Err(StepError::Factor(e)) if !lm => return Err(e),
+            Err(StepError::Factor(_)) => {
                 lambda *= nu;
                 nu *= T::lit(2.0);
                 if lambda > T::lit(MAX_DAMPING) {
@@ -289,7 +350,6 @@ where
                 continue;
             }
         };
-        let step = factor.solve(&-ne.gradient)?;
         let step_norm = step.norm();
         let step_info = step.dot(&(ne.information * step));
         let small_step =
@@ -307,60 +367,57 @@ where
             status = Status::StepConverged;
             break;
         }
-        let trial = if candidate.all_finite() {
-            NormalEquations::build(problem, &candidate, &loss)
+        let built = if candidate.all_finite() {
+            trial.rebuild(problem, &candidate, &loss)
         } else {
             Err(SolveError::NonFiniteResidual)
         };
-        let accepted = match trial {
-            Ok(t) => {
+        let accepted = match built {
+            Ok(()) => {
                 if lm {
                     // Gain ratio of the actual to the predicted decrease of the weighted model
                     // F(ξ) ≈ F + 2ξᵀg + ξᵀAξ: predicted = −2ξᵀg − ξᵀAξ.
-                    let actual = ne.cost - t.cost;
+                    let actual = ne.cost - trial.cost;
                     let predicted = -(step.dot(&ne.gradient) * T::lit(2.0)) - step_info;
                     if actual > T::zero() && predicted > T::zero() {
                         let r = actual / predicted;
                         let c = T::lit(2.0) * r - T::one();
                         lambda *= (T::one() - c * c * c).max(T::lit(1.0 / 3.0));
                         nu = T::lit(2.0);
-                        Some(t)
+                        true
                     } else {
-                        None
+                        false
                     }
                 } else {
-                    Some(t)
+                    true
                 }
             }
             Err(e) if !lm => return Err(e),
-            Err(_) => None,
+            Err(_) => false,
         };
-        match accepted {
-            Some(t) => {
-                let decrease = ne.cost - t.cost;
-                let old_cost = ne.cost;
-                state = candidate;
-                ne = t;
-                if small_step {
-                    status = Status::StepConverged;
-                    break;
-                }
-                if decrease >= T::zero() && decrease <= options.cost_tolerance * old_cost {
-                    status = Status::CostConverged;
-                    break;
-                }
+        if accepted {
+            let decrease = ne.cost - trial.cost;
+            let old_cost = ne.cost;
+            state = candidate;
+            ne = trial;
+            if small_step {
+                status = Status::StepConverged;
+                break;
             }
-            None => {
-                if small_step {
-                    status = Status::StepConverged;
-                    break;
-                }
-                lambda *= nu;
-                nu *= T::lit(2.0);
-                if lambda > T::lit(MAX_DAMPING) {
-                    status = Status::DampingSaturated;
-                    break;
-                }
+            if decrease >= T::zero() && decrease <= options.cost_tolerance * old_cost {
+                status = Status::CostConverged;
+                break;
+            }
+        } else {
+            if small_step {
+                status = Status::StepConverged;
+                break;
+            }
+            lambda *= nu;
+            nu *= T::lit(2.0);
+            if lambda > T::lit(MAX_DAMPING) {
+                status = Status::DampingSaturated;
+                break;
             }
         }
     }
@@ -368,13 +425,60 @@ where
     if !state.all_finite() || !ne.cost.is_finite() {
         return Err(SolveError::NonFiniteResidual);
     }
-    let covariance = Factor::new(&ne.information)?.inverse()?;
-    Ok(Solution {
-        state,
-        covariance,
-        iterations,
-        initial_cost,
-        final_cost: ne.cost,
-        status,
-    })
+    finish(state, &ne, iterations, initial_cost, status, out)
+}
+
+/// Writes the [`Solution`] at `state` into `out`, with the covariance `A⁻¹` of the last
+/// linearization `ne`. Out of line (see [`damped_step`]): the inverse's temporaries live in its
+/// own frame, not in the iteration's.
+///
+/// # Errors
+/// Those of [`Factor::new`] and [`Factor::inverse`] (then `out` may hold a partial result).
+#[inline(never)]
+fn finish<T: Real, S, const N: usize>(
+    state: S,
+    ne: &NormalEquations<T, N>,
+    iterations: usize,
+    initial_cost: T,
+    status: Status,
+    out: &mut Solution<T, S, N>,
+) -> Result<(), SolveError> {
+    Factor::new(&ne.information)?.inverse_into(&mut out.covariance)?;
+    out.state = state;
+    out.iterations = iterations;
+    out.initial_cost = initial_cost;
+    out.final_cost = ne.cost;
+    out.status = status;
+    Ok(())
+}
+
+/// Why [`damped_step`] produced no step.
+enum StepError {
+    /// The (damped) information did not factorize.
+    Factor(SolveError),
+    /// The substitution gave a non-finite step.
+    Solve(SolveError),
+}
+
+/// The step `ξ` of one iteration: `(A + λ diag A) ξ = −g` (Levenberg-Marquardt, `lm`) or
+/// `A ξ = −g` (Gauss-Newton). Kept out of line so its `N × N` temporaries (the damped matrix,
+/// its factor) do not share a frame with the linearization.
+#[inline(never)]
+fn damped_step<T: Real, const N: usize>(
+    ne: &NormalEquations<T, N>,
+    lambda: T,
+    lm: bool,
+) -> Result<SVector<T, N>, StepError> {
+    let mut damped = ne.information;
+    if lm {
+        // Marquardt scaling: λ·diag(A), with a floor so a zero column still gets damped.
+        let floor = ne.information.diagonal().max() * T::lit(T::EPSILON_F64);
+        for (k, d) in ne.information.diagonal().iter().enumerate() {
+            if let Some(x) = damped.get_mut((k, k)) {
+                *x += lambda * (*d).max(floor);
+            }
+        }
+    }
+    let factor = Factor::new(&damped).map_err(StepError::Factor)?;
+    factor.solve(&-ne.gradient).map_err(StepError::Solve)
 }

@@ -1,10 +1,10 @@
 //! The attitude-only filter (AHRS).
 
-use super::align::{Alignment, InitialSigmas};
+use super::align::{prior_attitude_covariance, Alignment, InitialSigmas};
 use super::error::{EskfError, UpdateOutcome};
-use super::imu::{add_diag, greater, predict_ahrs, set_blk, FilterConfig};
-use super::state::{AhrsState, ErrorState};
-use super::update::{check_spd, update, Measurement, UpdateOptions};
+use super::imu::{add_diag, predict_ahrs, set_blk, FilterConfig};
+use super::state::AhrsState;
+use super::update::{check_start, update, Measurement, UpdateOptions};
 use crate::Real;
 use nalgebra::{SMatrix, SVector, Vector3};
 
@@ -27,13 +27,7 @@ impl<T: Real> Ahrs<T> {
         covariance: SMatrix<T, 6, 6>,
         config: FilterConfig<T>,
     ) -> Result<Self, EskfError> {
-        config.validate()?;
-        if !state.is_finite() {
-            return Err(EskfError::NonFinite);
-        }
-        if !check_spd(&covariance) {
-            return Err(EskfError::CovarianceNotPositiveDefinite);
-        }
+        check_start(&state, &covariance, &config)?;
         Ok(Self {
             state,
             covariance,
@@ -48,17 +42,12 @@ impl<T: Real> Ahrs<T> {
         config: FilterConfig<T>,
     ) -> Result<Self, EskfError> {
         config.validate()?;
-        let gn = config.gravity.norm();
-        if !greater(gn, T::zero()) {
-            return Err(EskfError::ZeroNorm);
-        }
-        let up: Vector3<T> = -config.gravity / gn;
         let mut p = SMatrix::<T, 6, 6>::zeros();
         set_blk(
             &mut p,
             0,
             0,
-            &sigmas.attitude_covariance(&alignment.attitude, &up),
+            &prior_attitude_covariance(alignment, sigmas, &config)?,
         );
         add_diag(&mut p, 1, sigmas.gyro_bias * sigmas.gyro_bias);
         Self::new(

@@ -164,3 +164,18 @@ impl<T: Real> InitialSigmas<T> {
         r.transpose() * sw * r
     }
 }
+
+/// The prior attitude covariance of a filter started from `alignment`: tilt and yaw sigmas
+/// about the world up `−g/‖g‖` of `config`. Error: a zero or non-finite gravity.
+pub(crate) fn prior_attitude_covariance<T: Real>(
+    alignment: &Alignment<T>,
+    sigmas: &InitialSigmas<T>,
+    config: &super::imu::FilterConfig<T>,
+) -> Result<nalgebra::Matrix3<T>, EskfError> {
+    let gn = config.gravity.norm();
+    if !super::imu::greater(gn, T::zero()) {
+        return Err(EskfError::ZeroNorm);
+    }
+    let up = -config.gravity / gn;
+    Ok(sigmas.attitude_covariance(&alignment.attitude, &up))
+}

@@ -1,10 +1,10 @@
 //! The 15-state inertial filter.
 
-use super::align::{Alignment, InitialSigmas};
+use super::align::{prior_attitude_covariance, Alignment, InitialSigmas};
 use super::error::{EskfError, UpdateOutcome};
-use super::imu::{add_diag, greater, predict_ins, set_blk, FilterConfig, ImuSample};
-use super::state::{ErrorState, InsState};
-use super::update::{check_spd, update, Measurement, UpdateOptions};
+use super::imu::{add_diag, predict_ins, set_blk, FilterConfig, ImuSample};
+use super::state::InsState;
+use super::update::{check_start, update, Measurement, UpdateOptions};
 use crate::Real;
 use nalgebra::{SMatrix, SVector, Vector3};
 
@@ -28,13 +28,7 @@ impl<T: Real> Ins<T> {
         covariance: SMatrix<T, 15, 15>,
         config: FilterConfig<T>,
     ) -> Result<Self, EskfError> {
-        config.validate()?;
-        if !state.is_finite() {
-            return Err(EskfError::NonFinite);
-        }
-        if !check_spd(&covariance) {
-            return Err(EskfError::CovarianceNotPositiveDefinite);
-        }
+        check_start(&state, &covariance, &config)?;
         Ok(Self {
             state,
             covariance,
@@ -59,17 +53,12 @@ impl<T: Real> Ins<T> {
             gyro_bias: alignment.gyro_bias,
             accel_bias: Vector3::zeros(),
         };
-        let gn = config.gravity.norm();
-        if !greater(gn, T::zero()) {
-            return Err(EskfError::ZeroNorm);
-        }
-        let up = -config.gravity / gn;
         let mut p = SMatrix::<T, 15, 15>::zeros();
         set_blk(
             &mut p,
             0,
             0,
-            &sigmas.attitude_covariance(&alignment.attitude, &up),
+            &prior_attitude_covariance(alignment, sigmas, &config)?,
         );
         let sq = |s: T| s * s;
         add_diag(&mut p, 1, sq(sigmas.velocity));

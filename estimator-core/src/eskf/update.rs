@@ -72,6 +72,23 @@ impl<T: Real> UpdateOptions<T> {
     }
 }
 
+/// The checks every filter constructor makes on a given start: a valid configuration, a finite
+/// state and a symmetric positive definite covariance.
+pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
+    state: &S,
+    covariance: &SMatrix<T, N, N>,
+    config: &super::imu::FilterConfig<T>,
+) -> Result<(), EskfError> {
+    config.validate()?;
+    if !state.is_finite() {
+        return Err(EskfError::NonFinite);
+    }
+    if !check_spd(covariance) {
+        return Err(EskfError::CovarianceNotPositiveDefinite);
+    }
+    Ok(())
+}
+
 /// Checks that `A` is finite, symmetric (to `1e-6` of its largest entry) and positive definite,
 /// by an in-place Cholesky factorization of one copy (no other `N × N` temporary).
 pub(crate) fn check_spd<T: Real, const M: usize>(r: &SMatrix<T, M, M>) -> bool {

@@ -24,9 +24,7 @@ pub struct Madgwick {
     pub attitude: So3<f64>,
     /// Gain β, rad/s.
     pub beta: f64,
-    accel: Vector3<f64>,
-    mag: Option<Vector3<f64>>,
-    reference: Vector3<f64>,
+    directions: Directions,
 }
 
 /// Mahony's complementary filter.
@@ -40,9 +38,43 @@ pub struct Mahony {
     pub kp: f64,
     /// Integral gain.
     pub ki: f64,
+    directions: Directions,
+}
+
+/// The unit directions both filters compare: the latest accelerometer and magnetometer samples
+/// (body frame) against world up and the magnetic reference.
+#[derive(Clone, Debug)]
+struct Directions {
     accel: Vector3<f64>,
     mag: Option<Vector3<f64>>,
-    reference: Vector3<f64>,
+    reference: Option<Vector3<f64>>,
+}
+
+impl Directions {
+    fn new(reference: &Vector3<f64>) -> Self {
+        Self {
+            accel: Vector3::z(),
+            mag: None,
+            reference: unit(reference),
+        }
+    }
+
+    fn record_accel(&mut self, a: &Vector3<f64>) {
+        if let Some(a) = unit(a) {
+            self.accel = a;
+        }
+    }
+
+    /// `(measured, predicted)` pairs in the body frame: `(a, Rᵀu)` and, with a magnetometer
+    /// sample, `(m, Rᵀm̂_w)`.
+    fn pairs(&self, attitude: &So3<f64>) -> impl Iterator<Item = (Vector3<f64>, Vector3<f64>)> {
+        let r_inv = attitude.inverse();
+        let mag = match (self.mag, self.reference) {
+            (Some(m), Some(mw)) => Some((m, r_inv.act(&mw))),
+            _ => None,
+        };
+        std::iter::once((self.accel, r_inv.act(&Vector3::z()))).chain(mag)
+    }
 }
 
 fn unit(v: &Vector3<f64>) -> Option<Vector3<f64>> {
@@ -57,29 +89,24 @@ impl Madgwick {
         Self {
             attitude,
             beta: 0.1,
-            accel: Vector3::z(),
-            mag: None,
-            reference,
+            directions: Directions::new(&reference),
         }
     }
 
     /// Records the latest magnetometer sample.
     pub fn mag(&mut self, m: &Vector3<f64>) {
-        self.mag = unit(m);
+        self.directions.mag = unit(m);
     }
 
     /// One IMU step.
     pub fn imu(&mut self, gyro: &Vector3<f64>, accel: &Vector3<f64>, dt: f64) {
-        if let Some(a) = unit(accel) {
-            self.accel = a;
-        }
-        let r_inv = self.attitude.inverse();
-        let up = r_inv.act(&Vector3::z());
-        let mut grad = skew(&up).transpose() * (up - self.accel);
-        if let (Some(m), Some(mw)) = (self.mag, unit(&self.reference)) {
-            let mb = r_inv.act(&mw);
-            grad += skew(&mb).transpose() * (mb - m);
-        }
+        self.directions.record_accel(accel);
+        let grad = self
+            .directions
+            .pairs(&self.attitude)
+            .fold(Vector3::zeros(), |g, (meas, pred)| {
+                g + skew(&pred).transpose() * (pred - meas)
+            });
         let n = grad.norm();
         let corr = if n > 0.0 {
             grad * (self.beta / n)
@@ -100,27 +127,22 @@ impl Mahony {
             bias: Vector3::zeros(),
             kp: 1.0,
             ki: 0.05,
-            accel: Vector3::z(),
-            mag: None,
-            reference,
+            directions: Directions::new(&reference),
         }
     }
 
     /// Records the latest magnetometer sample.
     pub fn mag(&mut self, m: &Vector3<f64>) {
-        self.mag = unit(m);
+        self.directions.mag = unit(m);
     }
 
     /// One IMU step.
     pub fn imu(&mut self, gyro: &Vector3<f64>, accel: &Vector3<f64>, dt: f64) {
-        if let Some(a) = unit(accel) {
-            self.accel = a;
-        }
-        let r_inv = self.attitude.inverse();
-        let mut e = self.accel.cross(&r_inv.act(&Vector3::z()));
-        if let (Some(m), Some(mw)) = (self.mag, unit(&self.reference)) {
-            e += m.cross(&r_inv.act(&mw));
-        }
+        self.directions.record_accel(accel);
+        let e = self
+            .directions
+            .pairs(&self.attitude)
+            .fold(Vector3::zeros(), |e, (meas, pred)| e + meas.cross(&pred));
         self.bias -= e * (self.ki * dt);
         self.attitude = self
             .attitude

@@ -250,6 +250,18 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         (xi, Self::jr_inv_from(&k, &v, &w))
     }
 
+    /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))` with one trigonometric kernel for the log and both
+    /// inverse Jacobians (`J_l⁻¹(τ) = J_r⁻¹(−τ)`, same angle).
+    fn rminus_jac(&self, b: &Self) -> (Vector6<T>, Matrix6<T>, Matrix6<T>) {
+        let (tau, k) = b.between(self).log_with_coeffs();
+        let (v, w) = split(&tau);
+        (
+            tau,
+            Self::jr_inv_from(&k, &v, &w),
+            -Self::jr_inv_from(&k, &-v, &-w),
+        )
+    }
+
     /// `(R p + t, [R | −R[p]×], R)`: seed Theorem 5.1.
     fn act_jac(&self, p: &Vector3<T>) -> (Vector3<T>, Matrix3x6<T>, Matrix3<T>) {
         let r = self.rotation.rotation_matrix();

@@ -90,42 +90,34 @@ pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
 }
 
 /// Checks that `A` is finite, symmetric (to `1e-6` of its largest entry) and positive definite,
-/// by an in-place Cholesky factorization of one copy (no other `N × N` temporary).
+/// by an in-place Cholesky factorization of one packed copy (no other `N × N` temporary).
 pub(crate) fn check_spd<T: Real, const M: usize>(r: &SMatrix<T, M, M>) -> bool {
-    if !finite_vec(r) {
-        return false;
-    }
-    let tol = r.amax() * T::lit(1e-6);
-    for (i, col) in r.column_iter().enumerate() {
-        for (j, v) in col.iter().enumerate().skip(i + 1) {
-            // v = A(j, i); compare with A(i, j).
-            match r.get((i, j)) {
-                Some(w) if (*v - *w).abs() <= tol => {}
-                _ => return false,
-            }
-        }
-    }
     if M <= PACKED_MAX_DIM {
-        cholesky_packed(r)
+        spd_packed(r.as_slice(), M)
     } else {
-        Cholesky::new(*r).is_some()
+        finite_symmetric(r.as_slice(), M) && Cholesky::new(*r).is_some()
     }
 }
 
 /// Largest dimension whose Cholesky test uses the packed lower triangle.
 const PACKED_MAX_DIM: usize = 15;
 
-/// Cholesky test (`A = L Lᵀ` with a positive diagonal) storing only the lower triangle of `L`
-/// (packed row by row: `(i, j) ↦ i(i+1)/2 + j`): 480 bytes for a 15 × 15 `f32` matrix instead of
-/// a full copy.
+/// [`check_spd`] on the column-major storage `a` of an `n × n` matrix (`n ≤ 15`): the
+/// symmetry test, then the Cholesky recurrence `L_ij = (A_ij − Σ_k<j L_ik L_jk) / L_jj`,
+/// `L_jj = √(A_jj − Σ_k<j L_jk²) > 0`, storing only the lower triangle of `L` (packed row by
+/// row: `(i, j) ↦ i(i+1)/2 + j`), 480 bytes for `f32` instead of a full copy. Not generic over
+/// the size: one copy of this code serves every matrix.
 #[inline(never)]
-fn cholesky_packed<T: Real, const M: usize>(r: &SMatrix<T, M, M>) -> bool {
+fn spd_packed<T: Real>(a: &[T], n: usize) -> bool {
+    if !finite_symmetric(a, n) {
+        return false;
+    }
+    let get = |s: &[T], idx: usize| s.get(idx).copied().unwrap_or_else(T::zero);
     let mut l = [T::zero(); PACKED_MAX_DIM * (PACKED_MAX_DIM + 1) / 2];
-    let at =
-        |l: &[T], i: usize, j: usize| l.get(i * (i + 1) / 2 + j).copied().unwrap_or_else(T::zero);
-    for i in 0..M {
+    let at = |l: &[T], i: usize, j: usize| get(l, i * (i + 1) / 2 + j);
+    for i in 0..n {
         for j in 0..=i {
-            let mut s = r.get((i, j)).copied().unwrap_or_else(T::zero);
+            let mut s = get(a, j * n + i);
             for k in 0..j {
                 s -= at(&l, i, k) * at(&l, j, k);
             }
@@ -137,94 +129,135 @@ fn cholesky_packed<T: Real, const M: usize>(r: &SMatrix<T, M, M>) -> bool {
             } else {
                 s / at(&l, j, j)
             };
-            if let Some(e) = l.get_mut(i * (i + 1) / 2 + j) {
-                *e = v;
+            match l.get_mut(i * (i + 1) / 2 + j) {
+                Some(e) => *e = v,
+                None => return false,
             }
         }
     }
     true
 }
 
-/// The working set of one update, kept in one place on the caller's stack and filled in place
-/// by the phases below (each phase is a separate, non-inlined function, so their frames do not
-/// add up: the peak stack stays small on a Cortex-M).
-struct Work<T: Real, const N: usize, const M: usize> {
-    /// `H̃` at the current iterate.
-    h: SMatrix<T, M, N>,
-    /// Residual `r = z ⊖ h(x̂ ⊕ δx)` at the current iterate.
-    r: SVector<T, M>,
-    /// `U = P H̃ᵀ`.
-    u: SMatrix<T, N, M>,
-    /// `S = H̃ P H̃ᵀ + R`.
-    s: SMatrix<T, M, M>,
-    /// `K = U S⁻¹`.
-    k: SMatrix<T, N, M>,
-    /// The current correction `δx`.
-    dx: SVector<T, N>,
+/// `a` (column-major, `n × n`) is finite and symmetric to `1e-6` of its largest entry.
+fn finite_symmetric<T: Real>(a: &[T], n: usize) -> bool {
+    if a.len() != n * n || !a.iter().fold(true, |acc, x| acc & x.is_finite()) {
+        return false;
+    }
+    let tol = a.iter().fold(T::zero(), |m, x| m.max(x.abs())) * T::lit(1e-6);
+    let get = |idx: usize| a.get(idx).copied().unwrap_or_else(T::zero);
+    (0..n).all(|j| (j + 1..n).all(|i| (get(j * n + i) - get(i * n + j)).abs() <= tol))
 }
 
-/// Linearizes at `x̂ ⊕ δx` (`δx` = `w.dx`) into `w.h`, `w.r`, with the chart Jacobian
-/// `H̃ = H · blockdiag(J_r(δθ), I)` (the Jacobian of `h(x̂ ⊕ δx)` in `δx`, so that the iterated
-/// update is Gauss-Newton in the chart at the prior `x̂`; `J_r(0) = I`).
-#[inline(never)]
-fn linearize_into<T, S, Mo, const N: usize, const M: usize>(
-    model: &Mo,
-    x: &S,
-    w: &mut Work<T, N, M>,
-    first: bool,
-) -> Result<(), EskfError>
+/// Row capacity of the shared update core.
+///
+/// Every measurement with `M ≤ CORE_ROWS` rows runs through one compiled core per scalar type and
+/// state (one for `Ins<f32>`, one for `Ahrs<f32>`, …) instead of one per measurement model: on a
+/// Cortex-M4F the per-model copies of the update took about 35 KB of flash at opt-level "s". The
+/// core sees a model through [`Rows`], with its residual and Jacobian padded by zero rows and its
+/// noise padded by the identity, which leaves every result unchanged:
+/// `S_pad = [[S, 0], [0, I]]`, `S_pad⁻¹ = [[S⁻¹, 0], [0, I]]`, `K_pad = [K, 0]`,
+/// `NIS = r_padᵀ S_pad⁻¹ r_pad = rᵀ S⁻¹ r`; the products whose cost grows with the number of rows
+/// run over the `m = M` active rows only. A larger measurement (`M > CORE_ROWS`) gets a core of
+/// its own size (`C = M`).
+pub(crate) const CORE_ROWS: usize = 3;
+
+/// A measurement model as the update core sees it: through a row capacity `C ≥ M`.
+///
+/// The core takes `&dyn Rows<T, S, N, C>`, so it is compiled once per `(T, S, N, C)`, not once per
+/// model; only [`Padded::linearize_rows`] (the model's own `linearize` and a copy) is per model.
+trait Rows<T: Real, S, const N: usize, const C: usize> {
+    /// Linearizes at `x` into `ht = Hᵀ` (`N × C`; column `c` is row `c` of `H`, so that each row
+    /// of `H` is contiguous) and `r`; the columns and rows past `M` are zero.
+    fn linearize_rows(
+        &self,
+        x: &S,
+        ht: &mut SMatrix<T, N, C>,
+        r: &mut SVector<T, C>,
+    ) -> Result<(), EskfError>;
+}
+
+/// A model with `M` rows, seen through any capacity `C ≥ M`.
+struct Padded<'a, Mo, const M: usize>(&'a Mo);
+
+impl<T, S, Mo, const N: usize, const M: usize, const C: usize> Rows<T, S, N, C>
+    for Padded<'_, Mo, M>
 where
     T: Real,
-    S: ErrorState<T, N>,
     Mo: Measurement<T, S, N, M>,
 {
-    let lin = if first {
-        model.linearize(x)?
-    } else {
-        model.linearize(&x.oplus(&w.dx))?
-    };
-    if !(finite_vec(&lin.residual) && finite_vec(&lin.jacobian)) {
-        return Err(EskfError::NonFinite);
+    fn linearize_rows(
+        &self,
+        x: &S,
+        ht: &mut SMatrix<T, N, C>,
+        r: &mut SVector<T, C>,
+    ) -> Result<(), EskfError> {
+        let lin = self.0.linearize(x)?;
+        rows_into(
+            lin.jacobian.as_slice(),
+            lin.residual.as_slice(),
+            ht.as_mut_slice(),
+            r.as_mut_slice(),
+        );
+        Ok(())
     }
-    w.r = lin.residual;
-    w.h = lin.jacobian;
-    if !first {
-        let dth: SVector<T, 3> = w.dx.fixed_rows::<3>(0).into_owned();
-        let jr = So3::right_jacobian(&dth);
-        let hth = w.h.fixed_columns::<3>(0) * jr;
-        w.h.fixed_columns_mut::<3>(0).copy_from(&hth);
-    }
-    Ok(())
 }
 
-/// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`; returns the Cholesky factor of `S`.
-#[inline(never)]
-fn gain_into<T: Real, const N: usize, const M: usize>(
-    p: &SMatrix<T, N, N>,
-    r_noise: &SMatrix<T, M, M>,
-    w: &mut Work<T, N, M>,
-) -> Result<SMatrix<T, M, M>, EskfError> {
-    // U = P Hᵀ = Σ_k P e_k (H e_k)ᵀ over the nonzero columns of H only (most models touch 3–6
-    // of the 15 error components).
-    w.u.fill(T::zero());
-    for (pc, hc) in p.column_iter().zip(w.h.column_iter()) {
-        if hc.iter().any(|v| *v != T::zero()) {
-            w.u.ger(T::one(), &pc, &hc, T::one());
+/// Copies `H` (`m × n`, column-major in `h`, `m = r_in.len()`) into `ht` as `Hᵀ` (`n × C`,
+/// column `c` = row `c` of `H`) and the residual into `r`, zeros past `m`. Not generic over the
+/// model or its size: one copy of this code serves every model.
+fn rows_into<T: Real>(h: &[T], r_in: &[T], ht: &mut [T], r: &mut [T]) {
+    let m = r_in.len().max(1);
+    let n = h.len() / m;
+    ht.fill(T::zero());
+    for (c, col) in ht.chunks_exact_mut(n.max(1)).enumerate().take(r_in.len()) {
+        for (j, e) in col.iter_mut().enumerate() {
+            *e = h.get(j * m + c).copied().unwrap_or_else(T::zero);
         }
     }
-    w.s.copy_from(r_noise);
-    w.s.gemm(T::one(), &w.h, &w.u, T::one());
-    let st = w.s.transpose();
-    w.s += st;
-    w.s *= T::lit(0.5);
-    let chol = Cholesky::new(w.s).ok_or(EskfError::SingularInnovation)?;
-    // K = U S⁻¹ with S⁻¹ from the Cholesky factor (M × M, small).
-    let s_inv = chol.inverse();
-    w.k.gemm(T::one(), &w.u, &s_inv, T::zero());
-    if !finite_vec(&w.k) {
-        return Err(EskfError::SingularInnovation);
+    r.fill(T::zero());
+    for (d, s) in r.iter_mut().zip(r_in) {
+        *d = *s;
     }
-    Ok(s_inv)
+}
+
+/// `R` (`M × M`) padded to `C × C` with the identity.
+fn pad_noise<T: Real, const M: usize, const C: usize>(r: &SMatrix<T, M, M>) -> SMatrix<T, C, C> {
+    let mut out = SMatrix::<T, C, C>::identity();
+    pad_into(r.as_slice(), M, out.as_mut_slice(), C);
+    out
+}
+
+/// Copies the column-major `m × m` matrix `src` into the top-left of the column-major `c × c`
+/// matrix `dst` (one copy of this code for every size).
+fn pad_into<T: Real>(src: &[T], m: usize, dst: &mut [T], c: usize) {
+    for (j, col) in src.chunks_exact(m.max(1)).enumerate() {
+        for (i, v) in col.iter().enumerate() {
+            if let Some(e) = dst.get_mut(j * c + i) {
+                *e = *v;
+            }
+        }
+    }
+}
+
+/// The working set of one update, kept in one place on the caller's stack and filled in place
+/// by the phases below (each phase is a separate, non-inlined function, so their frames do not
+/// add up: the peak stack stays small on a Cortex-M). Columns (of `N × C` matrices) and rows
+/// past `m` are zero.
+struct Work<T: Real, const N: usize, const C: usize> {
+    /// `H̃ᵀ` at the current iterate.
+    ht: SMatrix<T, N, C>,
+    /// Residual `r = z ⊖ h(x̂ ⊕ δx)` at the current iterate.
+    r: SVector<T, C>,
+    /// `U = P H̃ᵀ`.
+    u: SMatrix<T, N, C>,
+    /// `S = H̃ P H̃ᵀ + R` (identity past `m`).
+    s: SMatrix<T, C, C>,
+    /// `K = U S⁻¹`.
+    k: SMatrix<T, N, C>,
+    /// The current correction `δx`.
+    dx: SVector<T, N>,
+    /// The number of active rows, `M`.
+    m: usize,
 }
 
 /// The generic update on `(x, P)`; `x` and `P` are written only when the result is `Accepted`.
@@ -241,6 +274,9 @@ fn gain_into<T: Real, const N: usize, const M: usize>(
 ///    `N × N` temporary).
 /// 4. Inject `x⁺ = x̂ ⊕ δx` (seed eq. 4.5) and reset `P ← G P Gᵀ`,
 ///    `G = blockdiag(J_r(δθ), I)` (the new error `e⁺ = log(exp(δθ)⁻¹ exp(e)) ≈ J_r(δθ)(e − δθ)`).
+///
+/// This wrapper is the only per-model code: it pads the model to the core's row capacity
+/// ([`CORE_ROWS`]) and calls the shared core.
 pub(crate) fn update<T, S, Mo, const N: usize, const M: usize>(
     x: &mut S,
     p: &mut SMatrix<T, N, N>,
@@ -252,6 +288,29 @@ where
     S: ErrorState<T, N>,
     Mo: Measurement<T, S, N, M>,
 {
+    let rows = Padded::<Mo, M>(model);
+    if M <= CORE_ROWS {
+        let noise = pad_noise::<T, M, CORE_ROWS>(&model.noise());
+        update_core::<T, S, N, CORE_ROWS>(x, p, &rows, &noise, M, opts)
+    } else {
+        update_core::<T, S, N, M>(x, p, &rows, &model.noise(), M, opts)
+    }
+}
+
+/// Steps 1–4 for a model seen through `C` rows, `m` of them active (see [`update`]).
+#[inline(never)]
+fn update_core<T, S, const N: usize, const C: usize>(
+    x: &mut S,
+    p: &mut SMatrix<T, N, N>,
+    model: &dyn Rows<T, S, N, C>,
+    r_noise: &SMatrix<T, C, C>,
+    m: usize,
+    opts: &UpdateOptions<T>,
+) -> Result<UpdateOutcome<T>, EskfError>
+where
+    T: Real,
+    S: ErrorState<T, N>,
+{
     if opts.max_iterations == 0 || !opts.step_tolerance.is_finite() {
         return Err(EskfError::InvalidOption);
     }
@@ -260,20 +319,20 @@ where
             return Err(EskfError::InvalidOption);
         }
     }
-    let r_noise = model.noise();
-    if !check_spd(&r_noise) {
+    if !check_spd(r_noise) {
         return Err(EskfError::NoiseNotPositiveDefinite);
     }
     let mut w = Work {
-        h: SMatrix::zeros(),
+        ht: SMatrix::zeros(),
         r: SVector::zeros(),
         u: SMatrix::zeros(),
         s: SMatrix::zeros(),
         k: SMatrix::zeros(),
         dx: SVector::zeros(),
+        m,
     };
     linearize_into(model, x, &mut w, true)?;
-    let s_inv = gain_into(p, &r_noise, &mut w)?;
+    let s_inv = gain_into(p, r_noise, &mut w)?;
     // NIS = rᵀ S⁻¹ r with the S⁻¹ already formed for K, and an explicit sum: `Cholesky::solve`
     // (dynamic-range `dot`s) and `dot` keep shape asserts, panic paths at opt-level "s".
     let y = s_inv * w.r;
@@ -284,38 +343,149 @@ where
     if !nis.is_finite() {
         return Err(EskfError::SingularInnovation);
     }
-    let threshold = opts.gate.threshold(M);
+    let threshold = opts.gate.threshold(m);
     if nis > threshold {
         return Ok(UpdateOutcome::Rejected { nis, threshold });
     }
     w.dx = w.k * w.r;
-    let iterations = iterate(x, p, model, opts, &r_noise, &mut w);
-    commit(x, p, &w)?;
+    let iterations = iterate(x, p, model, opts, r_noise, &mut w);
+    commit(x, p, &mut w)?;
     Ok(UpdateOutcome::Accepted { nis, iterations })
+}
+
+/// Linearizes at `x̂ ⊕ δx` (`δx` = `w.dx`) into `w.ht`, `w.r`, with the chart Jacobian
+/// `H̃ = H · blockdiag(J_r(δθ), I)` (the Jacobian of `h(x̂ ⊕ δx)` in `δx`, so that the iterated
+/// update is Gauss-Newton in the chart at the prior `x̂`; `J_r(0) = I`).
+#[inline(never)]
+fn linearize_into<T, S, const N: usize, const C: usize>(
+    model: &dyn Rows<T, S, N, C>,
+    x: &S,
+    w: &mut Work<T, N, C>,
+    first: bool,
+) -> Result<(), EskfError>
+where
+    T: Real,
+    S: ErrorState<T, N>,
+{
+    if first {
+        model.linearize_rows(x, &mut w.ht, &mut w.r)?;
+    } else {
+        model.linearize_rows(&x.oplus(&w.dx), &mut w.ht, &mut w.r)?;
+    }
+    if !(finite_vec(&w.r) && finite_vec(&w.ht)) {
+        return Err(EskfError::NonFinite);
+    }
+    if !first {
+        // H̃ᵀ = blockdiag(J_rᵀ, I) Hᵀ: only the first three rows of Hᵀ change.
+        let dth: SVector<T, 3> = w.dx.fixed_rows::<3>(0).into_owned();
+        let jrt = So3::right_jacobian(&dth).transpose();
+        let top = jrt * w.ht.fixed_rows::<3>(0);
+        w.ht.fixed_rows_mut::<3>(0).copy_from(&top);
+    }
+    Ok(())
+}
+
+/// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`; returns `S⁻¹`.
+///
+/// Column by column over contiguous storage (`N × C` matrices: column `c` is entries
+/// `c·N .. c·N + N`), for the `m` active columns only.
+#[inline(never)]
+fn gain_into<T: Real, const N: usize, const C: usize>(
+    p: &SMatrix<T, N, N>,
+    r_noise: &SMatrix<T, C, C>,
+    w: &mut Work<T, N, C>,
+) -> Result<SMatrix<T, C, C>, EskfError> {
+    let m = w.m;
+    // Column c of U = Σ_j P e_j H_cj over the nonzero entries of row c of H only (most models
+    // touch 3–6 of the 15 error components).
+    w.u.fill(T::zero());
+    for (uc, hc) in columns_mut::<T, N>(w.u.as_mut_slice())
+        .zip(columns::<T, N>(w.ht.as_slice()))
+        .take(m)
+    {
+        for (pc, h) in columns::<T, N>(p.as_slice()).zip(hc) {
+            if *h != T::zero() {
+                axpy(uc, *h, pc);
+            }
+        }
+    }
+    // S_ij = R_ij + (row i of H)·(column j of U) for i, j < m; the identity padding stays.
+    w.s.copy_from(r_noise);
+    for (j, uc) in columns::<T, N>(w.u.as_slice()).enumerate().take(m) {
+        for (i, hc) in columns::<T, N>(w.ht.as_slice()).enumerate().take(m) {
+            if let Some(e) = w.s.get_mut((i, j)) {
+                *e += dot(hc, uc);
+            }
+        }
+    }
+    let st = w.s.transpose();
+    w.s += st;
+    w.s *= T::lit(0.5);
+    let chol = Cholesky::new(w.s).ok_or(EskfError::SingularInnovation)?;
+    // K = U S⁻¹ with S⁻¹ from the Cholesky factor (C × C, small); the columns past m stay zero.
+    let s_inv = chol.inverse();
+    w.k.fill(T::zero());
+    for (kc, sc) in columns_mut::<T, N>(w.k.as_mut_slice())
+        .zip(s_inv.column_iter())
+        .take(m)
+    {
+        for (uc, s) in columns::<T, N>(w.u.as_slice()).zip(sc.iter()).take(m) {
+            axpy(kc, *s, uc);
+        }
+    }
+    if !finite_vec(&w.k) {
+        return Err(EskfError::SingularInnovation);
+    }
+    Ok(s_inv)
+}
+
+/// The columns of a column-major matrix with `N` rows, as contiguous slices.
+#[inline]
+fn columns<T: Real, const N: usize>(m: &[T]) -> core::slice::ChunksExact<'_, T> {
+    m.chunks_exact(N.max(1))
+}
+
+/// [`columns`], mutable.
+#[inline]
+fn columns_mut<T: Real, const N: usize>(m: &mut [T]) -> core::slice::ChunksExactMut<'_, T> {
+    m.chunks_exact_mut(N.max(1))
+}
+
+/// `y += a x` over two equally long slices.
+#[inline]
+fn axpy<T: Real>(y: &mut [T], a: T, x: &[T]) {
+    for (y, x) in y.iter_mut().zip(x) {
+        *y += a * *x;
+    }
+}
+
+/// `a · b` over two equally long slices.
+#[inline]
+fn dot<T: Real>(a: &[T], b: &[T]) -> T {
+    a.iter().zip(b).fold(T::zero(), |acc, (x, y)| acc + *x * *y)
 }
 
 /// The Gauss-Newton iterations (step 2 after the first): at `x̂ ⊕ δx_k`,
 /// `δx_{k+1} = K_k (r_k + H̃_k δx_k)`. A failure to re-linearize stops at the last good iterate
 /// (whose `K`, `U`, `S` are restored). Returns the number of linearizations used.
 #[inline(never)]
-fn iterate<T, S, Mo, const N: usize, const M: usize>(
+fn iterate<T, S, const N: usize, const C: usize>(
     x: &S,
     p: &SMatrix<T, N, N>,
-    model: &Mo,
+    model: &dyn Rows<T, S, N, C>,
     opts: &UpdateOptions<T>,
-    r_noise: &SMatrix<T, M, M>,
-    w: &mut Work<T, N, M>,
+    r_noise: &SMatrix<T, C, C>,
+    w: &mut Work<T, N, C>,
 ) -> u8
 where
     T: Real,
     S: ErrorState<T, N>,
-    Mo: Measurement<T, S, N, M>,
 {
     let mut iterations: u8 = 1;
     while iterations < opts.max_iterations {
         let (u, s, k, prev) = (w.u, w.s, w.k, w.dx);
         let ok = linearize_into(model, x, w, false).is_ok() && gain_into(p, r_noise, w).is_ok();
-        let y = w.r + w.h * prev;
+        let y = w.r + w.ht.tr_mul(&prev);
         let next = w.k * y;
         if !(ok && finite_vec(&next)) {
             w.u = u;
@@ -334,37 +504,44 @@ where
 }
 
 /// Steps 3–4: Joseph-form covariance, injection and reset; writes only when every check passed.
+/// Overwrites `w.u` (with `V`, below).
 #[inline(never)]
-fn commit<T, S, const N: usize, const M: usize>(
+fn commit<T, S, const N: usize, const C: usize>(
     x: &mut S,
     p: &mut SMatrix<T, N, N>,
-    w: &Work<T, N, M>,
+    w: &mut Work<T, N, C>,
 ) -> Result<(), EskfError>
 where
     T: Real,
     S: ErrorState<T, N>,
 {
-    // Joseph form, expanded and written as a symmetric rank-2M correction:
-    //   P⁺ = P − K Uᵀ − U Kᵀ + K S Kᵀ = P + V Kᵀ + K Vᵀ,  V = ½ K S − U,
-    // i.e. P⁺_ij = P_ij + V_i·K_j + V_j·K_i (rows V_i, K_i): exactly symmetric, computed in place
+    let m = w.m;
+    // Joseph form, expanded and written as m symmetric rank-2 corrections:
+    //   P⁺ = P − K Uᵀ − U Kᵀ + K S Kᵀ = P + V Kᵀ + K Vᵀ = P + Σ_c (v_c k_cᵀ + k_c v_cᵀ),
+    //   V = ½ K S − U (columns v_c, k_c of V and K): exactly symmetric, computed in place
     // without an N × N temporary. The checks below need only its diagonal and attitude rows.
-    let mut v = w.u;
-    v.gemm(T::lit(0.5), &w.k, &w.s, -T::one());
-    // Attitude rows of P⁺ (column j: P[0..3, j] + V[0..3] Kⱼᵀ + K[0..3] Vⱼᵀ), then the reset
-    // P⁺ ← G P⁺ Gᵀ, G = blockdiag(J_r(δθ), I): only the attitude rows and columns change.
+    w.u.gemm(T::lit(0.5), &w.k, &w.s, -T::one());
+    let (v, k) = (&w.u, &w.k);
+    // Attitude rows of P⁺ (column j: P[0..3, j] + Σ_c (v_c[0..3] k_c[j] + k_c[0..3] v_c[j])),
+    // then the reset P⁺ ← G P⁺ Gᵀ, G = blockdiag(J_r(δθ), I): only the attitude rows and
+    // columns change.
     let dth: SVector<T, 3> = w.dx.fixed_rows::<3>(0).into_owned();
     let gr: Matrix3<T> = So3::right_jacobian(&dth);
-    let v3 = v.fixed_rows::<3>(0);
-    let k3 = w.k.fixed_rows::<3>(0);
     let mut top = p.fixed_rows::<3>(0).into_owned();
-    for (mut c, (vj, kj)) in top.column_iter_mut().zip(v.row_iter().zip(w.k.row_iter())) {
-        // Copy through `copy_from` (shape checked at compile time): `clone_owned` of a view goes
-        // through nalgebra's `allocate_from_iterator`, whose length assert is a panic path
-        // that opt-level "s" does not remove.
+    for (j, mut col) in top.column_iter_mut().enumerate() {
         let mut c0 = Vector3::<T>::zeros();
-        c0.copy_from(&c);
-        let col = gr * (c0 + v3 * kj.transpose() + k3 * vj.transpose());
-        c.copy_from(&col);
+        c0.copy_from(&col);
+        for (vc, kc) in columns::<T, N>(v.as_slice())
+            .zip(columns::<T, N>(k.as_slice()))
+            .take(m)
+        {
+            let (vj, kj) = (at(vc, j), at(kc, j));
+            for (e, (a, b)) in c0.iter_mut().zip(vc.iter().zip(kc)) {
+                *e += *a * kj + *b * vj;
+            }
+        }
+        let c1 = gr * c0;
+        col.copy_from(&c1);
     }
     let c00 = top.fixed_columns::<3>(0) * gr.transpose();
     let c00 = (c00 + c00.transpose()) * T::lit(0.5);
@@ -373,45 +550,40 @@ where
     // P⁺, |P⁺_ij| ≤ √(P⁺_ii P⁺_jj), so a finite positive diagonal bounds every entry.
     let ok = |d: T| d.is_finite() && d > T::zero();
     let two = T::lit(2.0);
-    let diag_ok = p
-        .diagonal()
-        .iter()
-        .zip(v.row_iter().zip(w.k.row_iter()))
-        .skip(3)
-        .all(|(pii, (vi, ki))| ok(*pii + vi.dot(&ki) * two))
-        && c00.diagonal().iter().all(|d| ok(*d));
+    let diag_ok = p.diagonal().iter().enumerate().skip(3).all(|(i, pii)| {
+        let d = columns::<T, N>(v.as_slice())
+            .zip(columns::<T, N>(k.as_slice()))
+            .take(m)
+            .fold(T::zero(), |acc, (vc, kc)| acc + at(vc, i) * at(kc, i));
+        ok(*pii + d * two)
+    }) && c00.diagonal().iter().all(|d| ok(*d));
     if !(new_x.is_finite() && diag_ok) {
         return Err(EskfError::NumericalFailure);
     }
     *x = new_x;
-    // Upper triangle, mirrored: P_ij += V_i·K_j + K_i·V_j for i ≤ j (column-major slices:
-    // entry (i, c) of an N-row matrix is at c·N + i). Half of the N²·2M products of the full
-    // square, and exactly symmetric by construction.
-    let vs = v.as_slice();
-    let ks = w.k.as_slice();
-    let at = |s: &[T], idx: usize| s.get(idx).copied().unwrap_or_else(T::zero);
-    for j in 0..N {
-        let kj: [T; M] = core::array::from_fn(|c| at(ks, c * N + j));
-        let vj: [T; M] = core::array::from_fn(|c| at(vs, c * N + j));
-        for (i, (vi, ki)) in v.row_iter().zip(w.k.row_iter()).enumerate().take(j + 1) {
-            let (mut t, mut u) = (T::zero(), T::zero());
-            for ((a, b), (c, d)) in vi.iter().zip(kj.iter()).zip(ki.iter().zip(vj.iter())) {
-                t += *a * *b;
-                u += *c * *d;
-            }
-            let ps = p.as_mut_slice();
-            let mut new = T::zero();
-            if let Some(e) = ps.get_mut(j * N + i) {
-                *e += t + u;
-                new = *e;
-            }
-            if let Some(e) = ps.get_mut(i * N + j) {
-                *e = new;
+    // Upper triangle (column j of P holds entries (0..=j, j)): P_ij += v_i k_j + k_i v_j for
+    // each active c, then mirrored; half of the N²·2M products of the full square.
+    for (vc, kc) in columns::<T, N>(v.as_slice())
+        .zip(columns::<T, N>(k.as_slice()))
+        .take(m)
+    {
+        for (j, pc) in p.as_mut_slice().chunks_exact_mut(N.max(1)).enumerate() {
+            let (vj, kj) = (at(vc, j), at(kc, j));
+            for (e, (vi, ki)) in pc.iter_mut().zip(vc.iter().zip(kc)).take(j + 1) {
+                *e += *vi * kj + *ki * vj;
             }
         }
     }
-    // Rows 0..3 ← top, columns 0..3 ← topᵀ, block (0, 0) ← c00 (element by element: no
-    // transposed temporary).
+    // Mirror the upper triangle; then rows 0..3 ← top, columns 0..3 ← topᵀ, block (0, 0) ← c00
+    // (element by element: no transposed temporary).
+    for j in 0..N {
+        for i in 0..j {
+            let u = p.get((i, j)).copied().unwrap_or_else(T::zero);
+            if let Some(e) = p.get_mut((j, i)) {
+                *e = u;
+            }
+        }
+    }
     for (j, col) in top.column_iter().enumerate() {
         for (a, v) in col.iter().enumerate() {
             let v = if j < 3 {
@@ -428,4 +600,10 @@ where
         }
     }
     Ok(())
+}
+
+/// `s[i]`, or zero past the end (never reached: every caller indexes below the length).
+#[inline(always)]
+fn at<T: Real>(s: &[T], i: usize) -> T {
+    s.get(i).copied().unwrap_or_else(T::zero)
 }

@@ -451,6 +451,19 @@ fn columns_mut<T: Real, const N: usize>(m: &mut [T]) -> core::slice::ChunksExact
     m.chunks_exact_mut(N.max(1))
 }
 
+/// `out = K y` over the `m` active columns of `K` (`N × C`).
+fn gain_times<T: Real, const N: usize, const C: usize>(
+    k: &SMatrix<T, N, C>,
+    y: &SVector<T, C>,
+    m: usize,
+    out: &mut SVector<T, N>,
+) {
+    out.fill(T::zero());
+    for (kc, yc) in columns::<T, N>(k.as_slice()).zip(y.iter()).take(m) {
+        axpy(out.as_mut_slice(), *yc, kc);
+    }
+}
+
 /// `y += a x` over two equally long slices.
 #[inline]
 fn axpy<T: Real>(y: &mut [T], a: T, x: &[T]) {
@@ -485,8 +498,13 @@ where
     while iterations < opts.max_iterations {
         let (u, s, k, prev) = (w.u, w.s, w.k, w.dx);
         let ok = linearize_into(model, x, w, false).is_ok() && gain_into(p, r_noise, w).is_ok();
-        let y = w.r + w.ht.tr_mul(&prev);
-        let next = w.k * y;
+        // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
+        let mut y = w.r;
+        for (yc, hc) in y.iter_mut().zip(columns::<T, N>(w.ht.as_slice())).take(w.m) {
+            *yc += dot(hc, prev.as_slice());
+        }
+        let mut next = SVector::<T, N>::zeros();
+        gain_times(&w.k, &y, w.m, &mut next);
         if !(ok && finite_vec(&next)) {
             w.u = u;
             w.s = s;
@@ -496,7 +514,8 @@ where
         }
         w.dx = next;
         iterations += 1;
-        if (next - prev).norm() < opts.step_tolerance {
+        let step = next - prev;
+        if dot(step.as_slice(), step.as_slice()).sqrt() < opts.step_tolerance {
             break;
         }
     }

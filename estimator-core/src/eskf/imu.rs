@@ -111,27 +111,41 @@ pub(crate) fn check_dt<T: Real>(dt: T, max_dt: T) -> Result<(), EskfError> {
     }
 }
 
-/// `true` when every entry of `m` is finite.
-#[inline]
+/// `true` when every entry of `m` is finite; inlined, so that the check unrolls over values
+/// still in registers (the update's and the predictions' instruction counts at opt-level 3 are
+/// budgeted).
+#[inline(always)]
 pub(crate) fn finite_vec<T: Real, const R: usize, const C: usize>(m: &SMatrix<T, R, C>) -> bool {
+    sum_times_zero_is_zero(m.as_slice())
+}
+
+/// `true` when every entry of `m` is finite, through one out-of-line loop for every shape (for
+/// the measurement models and the start-up, where size matters more than speed).
+#[inline]
+pub(crate) fn finite<T: Real, const R: usize, const C: usize>(m: &SMatrix<T, R, C>) -> bool {
     all_finite(m.as_slice())
 }
 
-/// `true` when every element of `s` is finite.
+/// Not inlined: one copy of the loop for every matrix shape.
+#[inline(never)]
+fn all_finite<T: Real>(s: &[T]) -> bool {
+    sum_times_zero_is_zero(s)
+}
+
+/// `true` when every element of `s` is finite: `Σ x·0 = 0`.
 ///
 /// `x · 0` is `±0` for a finite `x` and NaN for `±∞` or NaN (IEEE 754-2008 §7.2: `0 · ∞` is an
-/// invalid operation), and NaN propagates through the sum (`−0 = +0` in the final comparison):
-/// two instructions per element and no branch. Over the contiguous storage (nalgebra's strided
-/// `iter()` costs ~170 instructions per element on a Cortex-M4), and not generic over the
-/// length: opt-level "s" keeps one small loop per call site.
-#[inline]
-fn all_finite<T: Real>(s: &[T]) -> bool {
-    s.iter().fold(T::zero(), |acc, x| acc + *x * T::zero()) == T::zero()
+/// invalid operation), and NaN propagates through the sum (`−0 = +0` in the comparison): two
+/// instructions per element and no branch. Over the contiguous storage: nalgebra's strided
+/// `iter()` costs ~170 instructions per element on a Cortex-M4.
+#[inline(always)]
+fn sum_times_zero_is_zero<T: Real>(s: &[T]) -> bool {
+    let z = T::zero();
+    s.iter().fold(z, |acc, x| acc + *x * z) == z
 }
 
 /// Block `(i, j)` (3×3, offsets `3i, 3j`) of an `R × C` matrix, read element by element (zero
 /// outside the matrix; with `i, j` known, the bounds checks fold away).
-#[inline]
 pub(crate) fn blk_rc<T: Real, const R: usize, const C: usize>(
     m: &SMatrix<T, R, C>,
     i: usize,
@@ -149,7 +163,6 @@ pub(crate) fn blk_rc<T: Real, const R: usize, const C: usize>(
 }
 
 /// Writes block `(i, j)` of an `R × C` matrix element by element.
-#[inline]
 pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
     m: &mut SMatrix<T, R, C>,
     i: usize,
@@ -183,13 +196,11 @@ pub(crate) fn set_blk<T: Real, const N: usize>(
 }
 
 /// Adds `s` to the diagonal of block `(i, i)`.
-#[inline]
 pub(crate) fn add_diag<T: Real, const N: usize>(m: &mut SMatrix<T, N, N>, i: usize, s: T) {
     add_cross(m, i, i, s);
 }
 
 /// Adds `s` to the diagonal of block `(i, j)`, and of block `(j, i)` when `i ≠ j`.
-#[inline]
 fn add_cross<T: Real, const N: usize>(m: &mut SMatrix<T, N, N>, i: usize, j: usize, s: T) {
     for k in 0..3 {
         if let Some(x) = m.get_mut((3 * i + k, 3 * j + k)) {
@@ -204,7 +215,6 @@ fn add_cross<T: Real, const N: usize>(m: &mut SMatrix<T, N, N>, i: usize, j: usi
 }
 
 /// `(a + aᵀ)/2`: the symmetric part of a diagonal block (removes the rounding asymmetry).
-#[inline]
 fn sym<T: Real>(a: &Matrix3<T>) -> Matrix3<T> {
     (a + a.transpose()) * T::lit(0.5)
 }
@@ -217,7 +227,6 @@ fn block_column<T: Real>(s: &[T], j: usize) -> Option<&[T; 45]> {
 }
 
 /// Block `k` (rows `3k..3k+3`) of a block column.
-#[inline]
 fn col_blk<T: Real>(q: &[T; 45], k: usize) -> Matrix3<T> {
     let g = |r: usize, c: usize| q.get(15 * c + 3 * k + r).copied().unwrap_or_else(T::zero);
     Matrix3::new(
@@ -251,7 +260,6 @@ impl<T: Real> FRows<T> {
     /// Block rows 0..2 of `F Q` for a block column `Q = (Q₀, …, Q₄)`:
     /// `(F Q)₀ = F00 Q₀ + F03 Q₃` (only when `rot`, else zero), `(F Q)₁ = Q₁ + C`,
     /// `(F Q)₂ = Q₂ + dt (Q₁ + ½ C)`, with `C = A Q₀ + B Q₄ = B([f]× Q₀ + Q₄)`.
-    #[inline]
     fn apply(&self, q: &[T; 45], rot: bool) -> [Matrix3<T>; 3] {
         let (q0, q1) = (col_blk(q, 0), col_blk(q, 1));
         let c = mm(&self.b, &(mm(&self.fx, &q0) + col_blk(q, 4)));
@@ -444,8 +452,8 @@ pub(crate) fn greater<T: Real>(a: T, b: T) -> bool {
 
 /// `a · b` for 3×3 matrices: `(a b)_rc = a_r0 b_0c + a_r1 b_1c + a_r2 b_2c`, column by column
 /// (nalgebra's generic product is not unrolled for a generic scalar). Loops, so that opt-level
-/// "s" keeps them small; opt-level 3 unrolls them completely.
-#[inline]
+/// "s" keeps them small; opt-level 3 unrolls them completely. No inline hint: opt-level "s"
+/// then keeps one out-of-line copy, opt-level 3 still inlines it.
 pub(crate) fn mm<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
     let mut out = Matrix3::zeros();
     let ga = |r: usize, k: usize| a.get((r, k)).copied().unwrap_or_else(T::zero);

@@ -10,7 +10,7 @@
 //! * Initial gyro bias: the mean angular rate `ω̄` (the body does not rotate).
 
 use super::error::EskfError;
-use super::imu::finite_vec;
+use super::imu::finite;
 use crate::lie::So3;
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
@@ -42,7 +42,7 @@ fn mean<T: Real>(xs: &[Vector3<T>]) -> Result<Vector3<T>, EskfError> {
     let mut sum = Vector3::zeros();
     let mut n = T::zero();
     for x in xs {
-        if !finite_vec(x) {
+        if !finite(x) {
             return Err(EskfError::NonFinite);
         }
         sum += x;
@@ -78,7 +78,7 @@ pub fn align_at_rest<T: Real>(
 ) -> Result<Alignment<T>, EskfError> {
     let f = mean(accel)?;
     let w = mean(gyro)?;
-    if !(finite_vec(gravity) && rest_tolerance.is_finite()) {
+    if !(finite(gravity) && rest_tolerance.is_finite()) {
         return Err(EskfError::NonFinite);
     }
     let (nf, ng) = (f.norm(), gravity.norm());
@@ -93,7 +93,7 @@ pub fn align_at_rest<T: Real>(
     let (hb, hw, from_mag) = match mag {
         Some(m) => {
             let mb = mean(m.samples)?;
-            if !finite_vec(&m.reference) {
+            if !finite(&m.reference) {
                 return Err(EskfError::NonFinite);
             }
             let hb = horizontal(&mb, &ub).ok_or(EskfError::ZeroNorm)?;

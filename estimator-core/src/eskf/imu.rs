@@ -111,41 +111,58 @@ pub(crate) fn check_dt<T: Real>(dt: T, max_dt: T) -> Result<(), EskfError> {
     }
 }
 
+/// `true` when every entry of `m` is finite; inlined, so that the check unrolls over values
+/// still in registers (the update's and the predictions' instruction counts at opt-level 3 are
+/// budgeted).
+#[inline(always)]
 pub(crate) fn finite_vec<T: Real, const R: usize, const C: usize>(m: &SMatrix<T, R, C>) -> bool {
-    // Branch-free and-reduction; `all` would branch per element.
-    // Over the contiguous storage: nalgebra's strided `iter()` costs ~170 instructions per
-    // element on a Cortex-M4 (fully unrolled with pointer selects), the slice ~4.
-    m.as_slice().iter().fold(true, |acc, x| acc & x.is_finite())
+    sum_times_zero_is_zero(m.as_slice())
 }
 
-/// Block `(i, j)` (3×3, offsets `3i, 3j`) of an `R × C` matrix, read element by element (with
-/// constant `i, j` the bounds checks fold away; nalgebra's `into_owned` goes through an iterator).
+/// `true` when every entry of `m` is finite, through one out-of-line loop for every shape (for
+/// the measurement models and the start-up, where size matters more than speed).
+#[inline]
+pub(crate) fn finite<T: Real, const R: usize, const C: usize>(m: &SMatrix<T, R, C>) -> bool {
+    all_finite(m.as_slice())
+}
+
+/// Not inlined: one copy of the loop for every matrix shape.
+#[inline(never)]
+fn all_finite<T: Real>(s: &[T]) -> bool {
+    sum_times_zero_is_zero(s)
+}
+
+/// `true` when every element of `s` is finite: `Σ x·0 = 0`.
+///
+/// `x · 0` is `±0` for a finite `x` and NaN for `±∞` or NaN (IEEE 754-2008 §7.2: `0 · ∞` is an
+/// invalid operation), and NaN propagates through the sum (`−0 = +0` in the comparison): two
+/// instructions per element and no branch. Over the contiguous storage: nalgebra's strided
+/// `iter()` costs ~170 instructions per element on a Cortex-M4.
 #[inline(always)]
+fn sum_times_zero_is_zero<T: Real>(s: &[T]) -> bool {
+    let z = T::zero();
+    s.iter().fold(z, |acc, x| acc + *x * z) == z
+}
+
+/// Block `(i, j)` (3×3, offsets `3i, 3j`) of an `R × C` matrix, read element by element (zero
+/// outside the matrix; with `i, j` known, the bounds checks fold away).
 pub(crate) fn blk_rc<T: Real, const R: usize, const C: usize>(
     m: &SMatrix<T, R, C>,
     i: usize,
     j: usize,
 ) -> Matrix3<T> {
-    let g = |r: usize, c: usize| {
-        m.get((3 * i + r, 3 * j + c))
-            .copied()
-            .unwrap_or_else(T::zero)
-    };
-    Matrix3::new(
-        g(0, 0),
-        g(0, 1),
-        g(0, 2),
-        g(1, 0),
-        g(1, 1),
-        g(1, 2),
-        g(2, 0),
-        g(2, 1),
-        g(2, 2),
-    )
+    let mut b = Matrix3::zeros();
+    for c in 0..3 {
+        for r in 0..3 {
+            if let (Some(d), Some(s)) = (b.get_mut((r, c)), m.get((3 * i + r, 3 * j + c))) {
+                *d = *s;
+            }
+        }
+    }
+    b
 }
 
 /// Writes block `(i, j)` of an `R × C` matrix element by element.
-#[inline(always)]
 pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
     m: &mut SMatrix<T, R, C>,
     i: usize,
@@ -162,13 +179,13 @@ pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
 }
 
 /// Block `(i, j)` of a square matrix.
-#[inline(always)]
+#[inline]
 pub(crate) fn blk<T: Real, const N: usize>(m: &SMatrix<T, N, N>, i: usize, j: usize) -> Matrix3<T> {
     blk_rc(m, i, j)
 }
 
 /// Writes block `(i, j)` of a square matrix.
-#[inline(always)]
+#[inline]
 pub(crate) fn set_blk<T: Real, const N: usize>(
     m: &mut SMatrix<T, N, N>,
     i: usize,
@@ -178,65 +195,85 @@ pub(crate) fn set_blk<T: Real, const N: usize>(
     set_blk_rc(m, i, j, v);
 }
 
-/// Block `(i, j)` of a `9 × 15` block-row matrix.
-#[inline(always)]
-fn blk9<T: Real>(m: &SMatrix<T, 9, 15>, i: usize, j: usize) -> Matrix3<T> {
-    blk_rc(m, i, j)
-}
-
-/// Writes block `(i, j)` of a `9 × 15` block-row matrix.
-#[inline(always)]
-fn set_blk9<T: Real>(m: &mut SMatrix<T, 9, 15>, i: usize, j: usize, v: &Matrix3<T>) {
-    set_blk_rc(m, i, j, v);
-}
-
 /// Adds `s` to the diagonal of block `(i, i)`.
-#[inline(always)]
 pub(crate) fn add_diag<T: Real, const N: usize>(m: &mut SMatrix<T, N, N>, i: usize, s: T) {
-    for k in 3 * i..3 * i + 3 {
-        if let Some(x) = m.get_mut((k, k)) {
-            *x += s;
-        }
-    }
+    add_cross(m, i, i, s);
 }
 
-/// Adds `s` to the diagonals of blocks `(i, j)` and `(j, i)`.
-#[inline(always)]
+/// Adds `s` to the diagonal of block `(i, j)`, and of block `(j, i)` when `i ≠ j`.
 fn add_cross<T: Real, const N: usize>(m: &mut SMatrix<T, N, N>, i: usize, j: usize, s: T) {
     for k in 0..3 {
         if let Some(x) = m.get_mut((3 * i + k, 3 * j + k)) {
             *x += s;
         }
-        if let Some(x) = m.get_mut((3 * j + k, 3 * i + k)) {
-            *x += s;
+        if i != j {
+            if let Some(x) = m.get_mut((3 * j + k, 3 * i + k)) {
+                *x += s;
+            }
         }
     }
 }
 
-/// Runs `$body` five times with `$i` bound to the constants 0..4 (the 3×3 block indices).
-macro_rules! unroll5 {
-    ($i:ident => $body:block) => {{
-        {
-            let $i: usize = 0;
-            $body
-        }
-        {
-            let $i: usize = 1;
-            $body
-        }
-        {
-            let $i: usize = 2;
-            $body
-        }
-        {
-            let $i: usize = 3;
-            $body
-        }
-        {
-            let $i: usize = 4;
-            $body
-        }
-    }};
+/// `(a + aᵀ)/2`: the symmetric part of a diagonal block (removes the rounding asymmetry).
+fn sym<T: Real>(a: &Matrix3<T>) -> Matrix3<T> {
+    (a + a.transpose()) * T::lit(0.5)
+}
+
+/// A block column: the `15 × 3` column-major storage of block columns `3j..3j+3` of a 15-row
+/// matrix (contiguous in nalgebra's column-major layout), or `None` past the end.
+#[inline]
+fn block_column<T: Real>(s: &[T], j: usize) -> Option<&[T; 45]> {
+    s.get(45 * j..45 * j + 45)?.try_into().ok()
+}
+
+/// Block `k` (rows `3k..3k+3`) of a block column.
+fn col_blk<T: Real>(q: &[T; 45], k: usize) -> Matrix3<T> {
+    let g = |r: usize, c: usize| q.get(15 * c + 3 * k + r).copied().unwrap_or_else(T::zero);
+    Matrix3::new(
+        g(0, 0),
+        g(0, 1),
+        g(0, 2),
+        g(1, 0),
+        g(1, 1),
+        g(1, 2),
+        g(2, 0),
+        g(2, 1),
+        g(2, 2),
+    )
+}
+
+/// The nonzero blocks of the block rows θ, v, p (0, 1, 2) of `F` (module docs; block indices
+/// θ=0, v=1, p=2, b_g=3, b_a=4):
+///   `F00 = ΔRᵀ`, `F03 = −J_r(ω dt) dt`,
+///   `F10 = A = −R[f]× dt`, `F11 = I`, `F14 = B = −R dt`,
+///   `F20 = ½ A dt`, `F21 = I dt`, `F22 = I`, `F24 = ½ B dt`,
+/// with `A = B [f]×`. Block rows 3 and 4 are identity rows.
+struct FRows<T: Real> {
+    f00: Matrix3<T>,
+    f03: Matrix3<T>,
+    b: Matrix3<T>,
+    fx: Matrix3<T>,
+    dt: T,
+}
+
+impl<T: Real> FRows<T> {
+    /// Block rows 0..2 of `F Q` for a block column `Q = (Q₀, …, Q₄)`:
+    /// `(F Q)₀ = F00 Q₀ + F03 Q₃` (only when `rot`, else zero), `(F Q)₁ = Q₁ + C`,
+    /// `(F Q)₂ = Q₂ + dt (Q₁ + ½ C)`, with `C = A Q₀ + B Q₄ = B([f]× Q₀ + Q₄)`.
+    fn apply(&self, q: &[T; 45], rot: bool) -> [Matrix3<T>; 3] {
+        let (q0, q1) = (col_blk(q, 0), col_blk(q, 1));
+        let c = mm(&self.b, &(mm(&self.fx, &q0) + col_blk(q, 4)));
+        let top = if rot {
+            mm(&self.f00, &q0) + mm(&self.f03, &col_blk(q, 3))
+        } else {
+            Matrix3::zeros()
+        };
+        [
+            top,
+            q1 + c,
+            col_blk(q, 2) + (q1 + c * T::lit(0.5)) * self.dt,
+        ]
+    }
 }
 
 /// The 15-state prediction; writes only after every check passed.
@@ -270,84 +307,58 @@ pub(crate) fn predict_ins<T: Real>(
         accel_bias: x.accel_bias,
     };
 
-    // Nonzero blocks of F (block indices θ=0, v=1, p=2, b_g=3, b_a=4):
-    //   F00 = ΔRᵀ, F03 = −J_r(ω dt) dt,
-    //   F10 = A = −R[f]× dt, F11 = I, F14 = B = −R dt,
-    //   F20 = ½ A dt, F21 = I dt, F22 = I, F24 = ½ B dt, F33 = I, F44 = I.
-    // With A = B [f]×, the v-row of F·P is P1j + B([f]× P0j + P4j).
-    let f00 = dr.rotation_matrix().transpose();
-    let f03 = jr * (-dt);
-    let b = r * (-dt);
-    let fx = skew(&f);
-
-    let f_finite = finite_vec(&f00) && finite_vec(&f03) && finite_vec(&b) && finite_vec(&fx);
-    // M = F P for the block rows 0..2 (rows 3 and 4 of F are identity rows: M_3j = P_3j,
-    // M_4j = P_4j), block column by block column.
-    let mut m = SMatrix::<T, 9, 15>::zeros();
-    unroll5!(j => {
-        let p0 = blk(p, 0, j);
-        let p1 = blk(p, 1, j);
-        let p3 = blk(p, 3, j);
-        let p4 = blk(p, 4, j);
-        let c = mm(&b, &(mm(&fx, &p0) + p4));
-        set_blk9(&mut m, 0, j, &(mm(&f00, &p0) + mm(&f03, &p3)));
-        set_blk9(&mut m, 1, j, &(p1 + c));
-        set_blk9(&mut m, 2, j, &(blk(p, 2, j) + (p1 + c * half) * dt));
-    });
-    // N = M Fᵀ, only the blocks on and above the diagonal (j ≥ i):
-    //   N_i0 = M_i0 F00ᵀ + M_i3 F03ᵀ, N_i1 = M_i1 + D_i with D_i = (M_i4 − M_i0 [f]×) Bᵀ,
-    //   N_i2 = M_i2 + dt (M_i1 + ½ D_i), N_i3 = M_i3, N_i4 = M_i4.
-    // Row i of N needs only row i of M, so each row overwrites its own blocks in place.
-    let f00t = f00.transpose();
-    let f03t = f03.transpose();
-    let bt = b.transpose();
-    let sym = |a: Matrix3<T>| (a + a.transpose()) * half;
-    {
-        let (m0, m1, m2) = (blk9(&m, 0, 0), blk9(&m, 0, 1), blk9(&m, 0, 2));
-        let (m3, m4) = (blk9(&m, 0, 3), blk9(&m, 0, 4));
-        let d = mm(&(m4 - mm(&m0, &fx)), &bt);
-        set_blk9(&mut m, 0, 0, &sym(mm(&m0, &f00t) + mm(&m3, &f03t)));
-        set_blk9(&mut m, 0, 1, &(m1 + d));
-        set_blk9(&mut m, 0, 2, &(m2 + (m1 + d * half) * dt));
+    let fr = FRows {
+        f00: dr.rotation_matrix().transpose(),
+        f03: jr * (-dt),
+        b: r * (-dt),
+        fx: skew(&f),
+        dt,
+    };
+    let f_finite =
+        finite_vec(&fr.f00) && finite_vec(&fr.f03) && finite_vec(&fr.b) && finite_vec(&fr.fx);
+    // L = (F P)ᵀ = P Fᵀ for the block columns 0..2 (a 15 × 9 temporary): block column j of P
+    // gives M_ij = (F P)_ij, i = 0..2, stored as L_ji = M_ijᵀ. Rows 3 and 4 of F are identity
+    // rows, so (F P)_3j = P_3j and (F P)_4j = P_4j need no storage.
+    let mut l = SMatrix::<T, 15, 9>::zeros();
+    for j in 0..5 {
+        if let Some(q) = block_column(p.as_slice(), j) {
+            for (i, m) in fr.apply(q, true).iter().enumerate() {
+                set_blk_rc(&mut l, j, i, &m.transpose());
+            }
+        }
     }
-    {
-        let (m0, m1, m2, m4) = (
-            blk9(&m, 1, 0),
-            blk9(&m, 1, 1),
-            blk9(&m, 1, 2),
-            blk9(&m, 1, 4),
-        );
-        let d = mm(&(m4 - mm(&m0, &fx)), &bt);
-        set_blk9(&mut m, 1, 1, &sym(m1 + d));
-        set_blk9(&mut m, 1, 2, &(m2 + (m1 + d * half) * dt));
-    }
-    {
-        let (m0, m1, m2, m4) = (
-            blk9(&m, 2, 0),
-            blk9(&m, 2, 1),
-            blk9(&m, 2, 2),
-            blk9(&m, 2, 4),
-        );
-        let d = mm(&(m4 - mm(&m0, &fx)), &bt);
-        set_blk9(&mut m, 2, 2, &sym(m2 + (m1 + d * half) * dt));
+    // N = F P Fᵀ = F L: block column i of N is F applied to block column i of L, the same
+    // `apply`. Only the blocks on and below the diagonal are kept (N_ki, k ≥ i; N is symmetric),
+    // in place of L_ki: block column i of L is read once, and later columns are untouched.
+    // N_3i = L_3i and N_4i = L_4i (identity rows of F) are already there.
+    for i in 0..3 {
+        let n = match block_column(l.as_slice(), i) {
+            Some(q) => fr.apply(q, i == 0),
+            None => continue,
+        };
+        for (k, n) in n.iter().enumerate().skip(i) {
+            set_blk_rc(&mut l, k, i, &if k == i { sym(n) } else { *n });
+        }
     }
     // F and P are finite, so N = F P Fᵀ can only fail by overflow, and for a positive
     // semi-definite N, |N_ij| ≤ √(N_ii N_jj): a finite diagonal bounds every entry.
-    if !(f_finite && new_x.is_finite_ins() && finite_vec(&m.fixed_view::<9, 9>(0, 0).diagonal())) {
+    // The diagonal of N is the diagonal of L's top 9 × 9.
+    let d_ok = (0..9).fold(true, |acc, k| {
+        acc & l.get((k, k)).is_some_and(|d| d.is_finite())
+    });
+    if !(f_finite && new_x.is_finite_ins() && d_ok) {
         return Err(EskfError::NonFinite);
     }
-    // Write the upper blocks and their transposes; P_33, P_34, P_44 are unchanged before Q.
-    unroll5!(j => {
-        for i in 0..3 {
-            if i <= j {
-                let n = blk9(&m, i, j);
-                set_blk(p, i, j, &n);
-                if i < j {
-                    set_blk(p, j, i, &n.transpose());
-                }
+    // Write the lower blocks and their transposes; P_33, P_34, P_44 are unchanged before Q.
+    for i in 0..3 {
+        for k in i..5 {
+            let n = blk_rc(&l, k, i);
+            set_blk(p, k, i, &n);
+            if k > i {
+                set_blk(p, i, k, &n.transpose());
             }
         }
-    });
+    }
     let n = &cfg.imu_noise;
     let qa = n.accelerometer_noise_density * n.accelerometer_noise_density * dt;
     add_diag(
@@ -439,30 +450,23 @@ pub(crate) fn greater<T: Real>(a: T, b: T) -> bool {
     a > b
 }
 
-/// `a · b` for 3×3 matrices, written out (nalgebra's generic product is not unrolled for a
-/// generic scalar).
-#[inline(always)]
+/// `a · b` for 3×3 matrices: `(a b)_rc = a_r0 b_0c + a_r1 b_1c + a_r2 b_2c`, column by column
+/// (nalgebra's generic product is not unrolled for a generic scalar). Loops, so that opt-level
+/// "s" keeps them small; opt-level 3 unrolls them completely. No inline hint: opt-level "s"
+/// then keeps one out-of-line copy, opt-level 3 still inlines it.
 pub(crate) fn mm<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
-    let r = |i: (T, T, T), j: (T, T, T)| i.0 * j.0 + i.1 * j.1 + i.2 * j.2;
-    let (a1, a2, a3) = (
-        (a.m11, a.m12, a.m13),
-        (a.m21, a.m22, a.m23),
-        (a.m31, a.m32, a.m33),
-    );
-    let (b1, b2, b3) = (
-        (b.m11, b.m21, b.m31),
-        (b.m12, b.m22, b.m32),
-        (b.m13, b.m23, b.m33),
-    );
-    Matrix3::new(
-        r(a1, b1),
-        r(a1, b2),
-        r(a1, b3),
-        r(a2, b1),
-        r(a2, b2),
-        r(a2, b3),
-        r(a3, b1),
-        r(a3, b2),
-        r(a3, b3),
-    )
+    let mut out = Matrix3::zeros();
+    let ga = |r: usize, k: usize| a.get((r, k)).copied().unwrap_or_else(T::zero);
+    for (oc, bc) in out
+        .as_mut_slice()
+        .chunks_exact_mut(3)
+        .zip(b.as_slice().chunks_exact(3))
+    {
+        if let [b0, b1, b2] = *bc {
+            for (r, o) in oc.iter_mut().enumerate() {
+                *o = ga(r, 0) * b0 + ga(r, 1) * b1 + ga(r, 2) * b2;
+            }
+        }
+    }
+    out
 }

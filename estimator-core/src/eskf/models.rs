@@ -5,7 +5,7 @@
 //! `R[−b]×`).
 
 use super::error::EskfError;
-use super::imu::{finite_vec, greater};
+use super::imu::{finite, greater};
 use super::state::{ErrorState, InsState};
 use super::update::{Linearization, Measurement};
 use crate::lie::{skew, LieGroup, Se3};
@@ -54,7 +54,7 @@ impl<T: Real> GnssPosition<T> {
 
 impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssPosition<T> {
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
-        if !(finite_vec(&self.position) && finite_vec(&self.lever_arm)) {
+        if !(finite(&self.position) && finite(&self.lever_arm)) {
             return Err(EskfError::NonFinite);
         }
         let (rl, d_att, _) = x.attitude.act_jac(&self.lever_arm);
@@ -94,7 +94,7 @@ impl<T: Real> GnssVelocity<T> {
 
 impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssVelocity<T> {
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
-        if !finite_vec(&self.velocity) {
+        if !finite(&self.velocity) {
             return Err(EskfError::NonFinite);
         }
         let mut h = SMatrix::<T, 3, 15>::zeros();
@@ -208,7 +208,7 @@ impl<T: Real> Magnetometer<T> {
 
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for Magnetometer<T> {
     fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
-        if !(finite_vec(&self.field) && finite_vec(&self.reference)) {
+        if !(finite(&self.field) && finite(&self.reference)) {
             return Err(EskfError::NonFinite);
         }
         if self.field.norm_squared() <= T::zero() || self.reference.norm_squared() <= T::zero() {
@@ -257,7 +257,7 @@ impl<T: Real> GravityDirection<T> {
 
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for GravityDirection<T> {
     fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
-        if !(finite_vec(&self.accel) && finite_vec(&self.up)) {
+        if !(finite(&self.accel) && finite(&self.up)) {
             return Err(EskfError::NonFinite);
         }
         let (na, nu) = (self.accel.norm(), self.up.norm());
@@ -303,7 +303,7 @@ impl<T: Real> AccelerometerAtRest<T> {
 
 impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
-        if !(finite_vec(&self.accel) && finite_vec(&self.gravity)) {
+        if !(finite(&self.accel) && finite(&self.gravity)) {
             return Err(EskfError::NonFinite);
         }
         if self.accel.norm_squared() <= T::zero() {
@@ -440,8 +440,8 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 2>, EskfError> {
         let k = &self.intrinsics;
         let all = [k.fx, k.fy, k.cx, k.cy, self.min_depth];
-        if !(finite_vec(&self.pixel)
-            && finite_vec(&self.landmark)
+        if !(finite(&self.pixel)
+            && finite(&self.landmark)
             && all.iter().all(|v| v.is_finite())
             && self.body_from_camera.is_finite())
         {

@@ -203,12 +203,13 @@ impl<T: Real> SolverOptions<T> {
     /// `true` when the loss is valid and the tolerances and damping are finite and non-negative.
     #[must_use]
     pub fn is_valid(&self) -> bool {
-        let ok = |x: T| x.is_finite() && x >= T::zero();
         self.loss.is_valid()
-            && ok(self.step_tolerance)
-            && ok(self.cost_tolerance)
-            && ok(self.information_step_tolerance)
-            && ok(self.initial_damping)
+            && super::all_non_negative(&[
+                self.step_tolerance,
+                self.cost_tolerance,
+                self.information_step_tolerance,
+                self.initial_damping,
+            ])
     }
 }
 

@@ -311,3 +311,22 @@ pub(crate) fn skew_poly<T: Real>(p: T, q: T, w: &Vector3<T>) -> Matrix3<T> {
         one - q * (xx + yy),
     )
 }
+
+/// `true` when every number is finite. One out-of-line loop shared by every `is_finite` and
+/// `try_from_matrix` of the groups (a per-element class test inlined at each call site costs
+/// more flash than the call; the check is never on a path where the call matters).
+#[inline(never)]
+pub(crate) fn all_finite<T: Real>(xs: &[T]) -> bool {
+    xs.iter().all(|x| x.is_finite())
+}
+
+/// `R[p]×`, row by row: row `i` is `rᵢᵀ[p]× = (rᵢ × p)ᵀ` for the row `rᵢ` of `R` (no zero
+/// products of a full 3×3 multiplication by the skew matrix, no 3×3 temporary).
+#[must_use]
+pub(crate) fn mul_skew<T: Real>(r: &Matrix3<T>, p: &Vector3<T>) -> Matrix3<T> {
+    let row = |a: T, b: T, c: T| (b * p.z - c * p.y, c * p.x - a * p.z, a * p.y - b * p.x);
+    let (a1, a2, a3) = row(r.m11, r.m12, r.m13);
+    let (b1, b2, b3) = row(r.m21, r.m22, r.m23);
+    let (c1, c2, c3) = row(r.m31, r.m32, r.m33);
+    Matrix3::new(a1, a2, a3, b1, b2, b3, c1, c2, c3)
+}

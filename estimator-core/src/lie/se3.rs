@@ -20,7 +20,7 @@
 
 use super::so3::So3;
 use super::trig::AngleCoeffs;
-use super::{skew, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, mul_skew, skew, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
 
 /// A rigid motion `T = (R, t) ∈ SE(3)`; `a_from_b` maps `b` coordinates into `a`.
@@ -209,7 +209,9 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     fn adjoint(&self) -> Matrix6<T> {
         let r = self.rotation.rotation_matrix();
-        upper_block(&r, &(skew(&self.translation) * r))
+        // [t]× R = (Rᵀ[−t]×)ᵀ, since [t]×ᵀ = −[t]×.
+        let tr = mul_skew(&r.transpose(), &-self.translation).transpose();
+        upper_block(&r, &tr)
     }
 
     fn right_jacobian(xi: &Vector6<T>) -> Matrix6<T> {
@@ -244,14 +246,14 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         }
         let r = So3::try_from_matrix(&m.fixed_view::<3, 3>(0, 0).into_owned())?;
         let t = Vector3::new(m.m14, m.m24, m.m34);
-        if !t.iter().all(|x| x.is_finite()) {
+        if !all_finite(t.as_slice()) {
             return None;
         }
         Some(Self::from_parts(r, t))
     }
 
     fn is_finite(&self) -> bool {
-        self.rotation.is_finite() && self.translation.iter().all(|x| x.is_finite())
+        self.rotation.is_finite() && all_finite(self.translation.as_slice())
     }
 
     fn exp_jac(xi: &Vector6<T>) -> (Self, Matrix6<T>) {
@@ -283,7 +285,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         let r = self.rotation.rotation_matrix();
         let mut j = Matrix3x6::zeros();
         j.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
-        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&-(r * skew(p)));
+        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&mul_skew(&r, &-p));
         (r * p + self.translation, j, r)
     }
 }

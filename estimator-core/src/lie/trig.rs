@@ -10,7 +10,7 @@
 //! | `h` (`half_sinc`) | `sin(θ/2)/θ = s/θ` | `1/2 − θ²/48 + θ⁴/3840` |
 //! | `a` | `sin θ / θ = 2hc` | (from `h`) |
 //! | `b` | `(1 − cos θ)/θ² = 2s²/θ² = 2h²` | (from `h`) |
-//! | `c` | `(θ − sin θ)/θ³ = (1 − a)/θ²` | `1/6 − θ²/120 + θ⁴/5040 − θ⁶/362880` |
+//! | `c` | `(θ − sin θ)/θ³ = (1 − a)/θ²` | `1/6 − θ²/120 + θ⁴/5040 − θ⁶/362880 + θ⁸/39916800 − θ¹⁰/6227020800` |
 //! | `d` | `1/θ² − (1 + cos θ)/(2θ sin θ) = (1 − (θ/2)·c/s)/θ²` | `1/12 + θ²/720 + θ⁴/30240 + θ⁶/1209600 + θ⁸/47900160` |
 //!
 //! and for SE(3)'s `Q` block ([`SeCoeffs`]):
@@ -20,13 +20,15 @@
 //! | `e` | `(1 − θ²/2 − cos θ)/θ⁴ = (b − 1/2)/θ²` | `−1/24 + θ²/720 − θ⁴/40320 + θ⁶/3628800` |
 //! | `f` | `e − 3(c − 1/6)/θ²` | `−1/60 + θ²/1260 − θ⁴/60480 + θ⁶/4989600` |
 //!
-//! `a` and `b` are products of `h` and `c = cos(θ/2)` (half-angle identities), so they need no
+//! `a` and `b` are products of `h` and `cos(θ/2)` (half-angle identities), so they need no
 //! branch of their own: `h` is exact to `ε/2` on both sides of its cutoff and each product adds
 //! one rounding. Each other coefficient switches to its series below its own cutoff `θ² < x*`, with
 //! `x* = `[`taylor_cutoff`]`(ε, t₀, t_omitted, terms)`: the series is then exact to `ε/2`. The
 //! cancelling closed forms (`c`, `d`, `e`, `f`) carry more series terms so that their cutoff sits
 //! where the cancellation has cost little; their error is relative to a term that is multiplied by
-//! `θ²` or `θ⁴` in every use, so the products stay accurate to a few ulps absolutely.
+//! `θ²` or `θ⁴` in every use, so the products stay accurate to a few ulps absolutely. `c` is
+//! the exception: SE(3)'s `Q` multiplies it by `θ‖v‖` only, so it carries six terms (its cutoff
+//! sits at `θ ≈ 0.4` in `f64`, where `1 − a` has lost only a few bits).
 
 use crate::scalar::{taylor_cutoff, Real};
 use core::marker::PhantomData;
@@ -35,7 +37,8 @@ use core::marker::PhantomData;
 pub(crate) struct Cutoff<T>(PhantomData<T>);
 
 impl<T: Real> Cutoff<T> {
-    pub(crate) const C: f64 = taylor_cutoff(T::EPSILON_F64, 1.0 / 6.0, 1.0 / 39_916_800.0, 4);
+    pub(crate) const C: f64 =
+        taylor_cutoff(T::EPSILON_F64, 1.0 / 6.0, 1.0 / 1_307_674_368_000.0, 6);
     pub(crate) const D: f64 = taylor_cutoff(T::EPSILON_F64, 1.0 / 12.0, 1.0 / 1_892_437_580.0, 5);
     pub(crate) const E: f64 = taylor_cutoff(T::EPSILON_F64, 1.0 / 24.0, 1.0 / 479_001_600.0, 4);
     pub(crate) const F: f64 = taylor_cutoff(T::EPSILON_F64, 1.0 / 60.0, 1.0 / 622_702_080.0, 4);
@@ -109,6 +112,8 @@ impl<T: Real> AngleCoeffs<T> {
                     T::lit(-1.0 / 120.0),
                     T::lit(1.0 / 5040.0),
                     T::lit(-1.0 / 362_880.0),
+                    T::lit(1.0 / 39_916_800.0),
+                    T::lit(-1.0 / 6_227_020_800.0),
                 ],
             )
         } else {

@@ -120,12 +120,35 @@ pub fn sincos_f32(x: f32) -> (f32, f32) {
     }
 }
 
-/// `x mod 2π` for the rare huge argument, kept out of line: inlined, LLVM hoists the `fmodf` out
-/// of its branch and every call would pay for it.
+/// `x mod 2π` (`x ≥ 0`; non-finite in gives non-finite out) for the rare huge argument: the
+/// exact `fmodf(x, 2π_f32)`, by binary long division on floats instead of `fmodf` itself
+/// (whose integer implementation links about 1.5 KB of 64-bit division into the firmware).
+///
+/// With `d = 2π·2^k` the largest such multiple `≤ x`, each step subtracts `d` when `r ≥ d` and
+/// halves `d`. The invariant `r < 2d` makes every subtraction exact (Sterbenz: `d ≤ r ≤ 2d`),
+/// and halving is exact, so the result is `x − m·2π` exactly, `0 ≤ r < 2π`. At most 128
+/// doublings and 128 halvings (the `f32` exponent range). Kept out of line and cold: the common
+/// path never pays for it.
 #[cold]
 #[inline(never)]
 fn reduce_large(x: f32) -> f32 {
-    x % core::f32::consts::TAU
+    const TAU: f32 = core::f32::consts::TAU;
+    if !x.is_finite() {
+        return x;
+    }
+    let mut d = TAU;
+    // `2d` overflows to infinity before it could exceed a finite `x`, which ends the loop.
+    while d * 2.0 <= x {
+        d *= 2.0;
+    }
+    let mut r = x;
+    while d >= TAU {
+        if r >= d {
+            r -= d;
+        }
+        d *= 0.5;
+    }
+    r
 }
 
 /// The largest `x = θ²` at which a truncated Taylor series is exact to half an epsilon.
@@ -214,6 +237,25 @@ mod tests {
             }
         }
         assert!(worst_rel <= f32::EPSILON as f64, "rel {worst_rel}");
+    }
+
+    /// The float long division of `reduce_large` is the exact `fmod` (`%`) it replaces.
+    #[test]
+    fn reduce_large_is_exact_fmod() {
+        let tau = core::f32::consts::TAU;
+        let mut x = 8192.0f32;
+        while x.is_finite() {
+            for k in 0..64 {
+                let y = x * (1.0 + k as f32 * 0.013_7);
+                if y.is_finite() {
+                    assert_eq!(reduce_large(y).to_bits(), (y % tau).to_bits(), "{y}");
+                }
+            }
+            x *= 1.9;
+        }
+        assert_eq!(reduce_large(f32::MAX).to_bits(), (f32::MAX % tau).to_bits());
+        assert!(reduce_large(f32::INFINITY).is_infinite());
+        assert!(reduce_large(f32::NAN).is_nan());
     }
 
     #[test]

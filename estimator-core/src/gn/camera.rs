@@ -26,11 +26,7 @@ impl<T: Real> PinholeCamera<T> {
     /// `true` when all four numbers are finite and both focal lengths positive.
     #[must_use]
     pub fn is_valid(&self) -> bool {
-        [self.fx, self.fy, self.cx, self.cy]
-            .iter()
-            .all(|x| x.is_finite())
-            && self.fx > T::zero()
-            && self.fy > T::zero()
+        super::all_positive(&[self.fx, self.fy]) && self.cx.is_finite() && self.cy.is_finite()
     }
 
     /// `K π(x)` for a point `x` in the camera frame; `None` unless `x.z > min_depth`.

@@ -35,7 +35,7 @@ impl<T: Real> Loss<T> {
     pub fn is_valid(&self) -> bool {
         match *self {
             Self::LeastSquares => true,
-            Self::Huber(k) | Self::Cauchy(k) => k.is_finite() && k > T::zero(),
+            Self::Huber(k) | Self::Cauchy(k) => super::all_positive(&[k]),
         }
     }
 

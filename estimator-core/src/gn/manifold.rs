@@ -76,10 +76,13 @@ impl<A, B, const NA: usize, const NB: usize> Product<A, B, NA, NB> {
     pub fn split<T: Real, const N: usize>(xi: &SVector<T, N>) -> (SVector<T, NA>, SVector<T, NB>) {
         let mut xa = SVector::<T, NA>::zeros();
         let mut xb = SVector::<T, NB>::zeros();
-        xa.iter_mut().zip(xi.iter()).for_each(|(d, s)| *d = *s);
-        xb.iter_mut()
-            .zip(xi.iter().skip(NA))
-            .for_each(|(d, s)| *d = *s);
+        // By index (`get` is `None` past the end): no iterator adapter to instantiate.
+        for (k, d) in xa.iter_mut().enumerate() {
+            *d = xi.get(k).copied().unwrap_or_else(T::zero);
+        }
+        for (k, d) in xb.iter_mut().enumerate() {
+            *d = xi.get(NA + k).copied().unwrap_or_else(T::zero);
+        }
         (xa, xb)
     }
 }

@@ -81,3 +81,17 @@ pub use solver::{
 pub use triangulation::{
     point_reprojection_error, triangulate, Triangulation, TriangulationOptions,
 };
+
+/// `true` when every `x` is finite and `x > 0` (`false` for NaN). One loop shared by the option
+/// checks of every solver, instead of an inlined class test per field (never on a hot path, so
+/// out of line at every opt-level).
+#[inline(never)]
+pub(crate) fn all_positive<T: crate::Real>(xs: &[T]) -> bool {
+    xs.iter().all(|&x| x > T::zero() && x.is_finite())
+}
+
+/// `true` when every `x` is finite and `x ≥ 0` (`false` for NaN); see [`all_positive`].
+#[inline(never)]
+pub(crate) fn all_non_negative<T: crate::Real>(xs: &[T]) -> bool {
+    xs.iter().all(|&x| x >= T::zero() && x.is_finite())
+}

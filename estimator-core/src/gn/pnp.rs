@@ -362,9 +362,7 @@ pub fn solve_pnp<T: Real>(
     if !camera.is_valid() {
         return Err(SolveError::InvalidCamera);
     }
-    let positive = |x: T| x.is_finite() && x > T::zero();
-    if !(positive(options.sigma_px)
-        && positive(options.inlier_chi2)
+    if !(super::all_positive(&[options.sigma_px, options.inlier_chi2])
         && options.min_depth.is_finite()
         && options.loss.is_valid())
     {

@@ -3,7 +3,7 @@
 //!
 //! See the [module docs](crate::gn) for how each step maps to the seed paper's equations.
 
-use super::linalg::Factor;
+use super::linalg;
 use super::{Loss, Manifold, SolveError};
 use crate::Real;
 use nalgebra::{SMatrix, SVector};
@@ -203,12 +203,13 @@ impl<T: Real> SolverOptions<T> {
     /// `true` when the loss is valid and the tolerances and damping are finite and non-negative.
     #[must_use]
     pub fn is_valid(&self) -> bool {
-        let ok = |x: T| x.is_finite() && x >= T::zero();
         self.loss.is_valid()
-            && ok(self.step_tolerance)
-            && ok(self.cost_tolerance)
-            && ok(self.information_step_tolerance)
-            && ok(self.initial_damping)
+            && super::all_non_negative(&[
+                self.step_tolerance,
+                self.cost_tolerance,
+                self.information_step_tolerance,
+                self.initial_damping,
+            ])
     }
 }
 
@@ -254,7 +255,7 @@ const MAX_DAMPING: f64 = 1e12;
 /// `S`, from `initial`.
 ///
 /// Each iteration accumulates the normal equations block by block ([`NormalEquations`], seed
-/// eq. 4.4 with IRLS weights), factorizes `A` (+ damping) by Cholesky ([`Factor`]), solves for
+/// eq. 4.4 with IRLS weights), factorizes `A` (+ damping) by Cholesky ([`Factor`](super::Factor)), solves for
 /// `ξ` and moves `a ← a ⊕ ξ` (seed eq. 4.5).
 ///
 /// # Errors
@@ -317,13 +318,79 @@ where
     if !initial.all_finite() {
         return Err(SolveError::NonFiniteGuess);
     }
-    let loss = options.loss;
-    let mut state = *initial;
+    let mut run = Run::<T, S, P, K> {
+        problem,
+        loss: options.loss,
+        state: *initial,
+        candidate: *initial,
+    };
     let mut ne = NormalEquations::zeros();
-    ne.rebuild(problem, &state, &loss)?;
+    ne.rebuild(problem, &run.state, &run.loss)?;
+    let initial_cost = ne.cost;
     // The trial linearization, reused across iterations.
     let mut trial = NormalEquations::zeros();
-    let initial_cost = ne.cost;
+    let (iterations, status) = iterate(&mut run, &mut ne, &mut trial, options)?;
+    let state = run.state;
+    if !state.all_finite() || !ne.cost.is_finite() {
+        return Err(SolveError::NonFiniteResidual);
+    }
+    finish(state, &ne, iterations, initial_cost, status, out)
+}
+
+/// The problem-dependent half of an iteration of [`solve_into`], behind `dyn` so that the
+/// iteration itself ([`iterate`]: damping, gain ratio, acceptance, convergence) is compiled once
+/// per dimension `N`, not once per problem.
+trait Candidate<T: Real, const N: usize> {
+    /// Forms the candidate `a ⊕ ξ` (seed eq. 4.5) from the current state; `true` when it is
+    /// finite.
+    fn propose(&mut self, step: &SVector<T, N>) -> bool;
+    /// The normal equations at the candidate, into `ne` ([`NormalEquations::rebuild`]).
+    fn linearize(&mut self, ne: &mut NormalEquations<T, N>) -> Result<(), SolveError>;
+    /// The candidate becomes the state.
+    fn accept(&mut self);
+}
+
+/// The state of [`solve_into`]: the problem, its loss, the current state and the candidate.
+struct Run<'a, T: Real, S, P: ?Sized, const K: usize> {
+    problem: &'a P,
+    loss: Loss<T>,
+    state: S,
+    candidate: S,
+}
+
+impl<T, S, P, const N: usize, const K: usize> Candidate<T, N> for Run<'_, T, S, P, K>
+where
+    T: Real,
+    S: Manifold<T, N>,
+    P: Problem<T, S, N, K> + ?Sized,
+{
+    fn propose(&mut self, step: &SVector<T, N>) -> bool {
+        self.candidate = self.state.oplus(step);
+        self.candidate.all_finite()
+    }
+
+    fn linearize(&mut self, ne: &mut NormalEquations<T, N>) -> Result<(), SolveError> {
+        ne.rebuild(self.problem, &self.candidate, &self.loss)
+    }
+
+    fn accept(&mut self) {
+        self.state = self.candidate;
+    }
+}
+
+/// The Gauss-Newton / Levenberg-Marquardt iteration of [`solve_into`] from the linearization
+/// `ne` at the current state of `run` (see the [module docs](crate::gn)): returns the iterations
+/// run and why it stopped, with `ne` the linearization at the final state (or just before a
+/// converged step, see [`Solution::final_cost`]). `trial` is scratch space.
+///
+/// # Errors
+/// As [`solve`], for the failures that happen during the iteration.
+fn iterate<T: Real, const N: usize>(
+    run: &mut dyn Candidate<T, N>,
+    ne: &mut NormalEquations<T, N>,
+    trial: &mut NormalEquations<T, N>,
+    options: &SolverOptions<T>,
+) -> Result<(usize, Status), SolveError> {
     let mut lambda = options.initial_damping;
     let mut nu = T::lit(2.0);
     let mut status = Status::MaxIterations;
@@ -336,7 +403,7 @@ where
             status = Status::CostConverged;
             break;
         }
-        let step = match damped_step(&ne, lambda, lm) {
+        let step = match damped_step(ne, lambda, lm) {
             Ok(s) => s,
             Err(StepError::Solve(e)) => return Err(e),
             Err(StepError::Factor(e)) if !lm => return Err(e),
@@ -354,21 +421,21 @@ where
         let step_info = step.dot(&(ne.information * step));
         let small_step =
             step_norm <= options.step_tolerance || step_info <= options.information_step_tolerance;
-        let candidate = state.oplus(&step);
+        let candidate_finite = run.propose(&step);
         // A converged step (Gauss-Newton, or Levenberg-Marquardt with little damping) is taken
         // without another pass over the residuals: it moves the state by at most
         // `√information_step_tolerance` standard deviations, so the information, cost and
         // covariance of the current linearization hold to that order.
         if step_info <= options.information_step_tolerance
             && (!lm || lambda <= T::one())
-            && candidate.all_finite()
+            && candidate_finite
         {
-            state = candidate;
+            run.accept();
             status = Status::StepConverged;
             break;
         }
-        let built = if candidate.all_finite() {
-            trial.rebuild(problem, &candidate, &loss)
+        let built = if candidate_finite {
+            run.linearize(trial)
         } else {
             Err(SolveError::NonFiniteResidual)
         };
@@ -398,8 +465,9 @@ where
         if accepted {
             let decrease = ne.cost - trial.cost;
             let old_cost = ne.cost;
-            state = candidate;
-            ne = trial;
+            run.accept();
+            // The trial becomes the linearization (the old one is scratch from here on).
+            core::mem::swap(ne, trial);
             if small_step {
                 status = Status::StepConverged;
                 break;
@@ -421,11 +489,7 @@ where
             }
         }
     }
-
-    if !state.all_finite() || !ne.cost.is_finite() {
-        return Err(SolveError::NonFiniteResidual);
-    }
-    finish(state, &ne, iterations, initial_cost, status, out)
+    Ok((iterations, status))
 }
 
 /// Writes the [`Solution`] at `state` into `out`, with the covariance `A⁻¹` of the last
@@ -433,7 +497,7 @@ where
 /// own frame, not in the iteration's.
 ///
 /// # Errors
-/// Those of [`Factor::new`] and [`Factor::inverse`] (then `out` may hold a partial result).
+/// Those of [`Factor::new`](super::Factor::new) and [`Factor::inverse`](super::Factor::inverse) (then `out` may hold a partial result).
 #[inline(never)]
 fn finish<T: Real, S, const N: usize>(
     state: S,
@@ -443,7 +507,10 @@ fn finish<T: Real, S, const N: usize>(
     status: Status,
     out: &mut Solution<T, S, N>,
 ) -> Result<(), SolveError> {
-    Factor::new(&ne.information)?.inverse_into(&mut out.covariance)?;
+    // `Factor::new` then `Factor::inverse_into`, on one local copy of `A` (the smallest frame).
+    let mut l = ne.information;
+    linalg::cholesky_in_place(l.as_mut_slice(), N)?;
+    linalg::inverse_in_place(l.as_slice(), N, out.covariance.as_mut_slice())?;
     out.state = state;
     out.iterations = iterations;
     out.initial_cost = initial_cost;
@@ -471,14 +538,38 @@ fn damped_step<T: Real, const N: usize>(
 ) -> Result<SVector<T, N>, StepError> {
     let mut damped = ne.information;
     if lm {
-        // Marquardt scaling: λ·diag(A), with a floor so a zero column still gets damped.
-        let floor = ne.information.diagonal().max() * T::lit(T::EPSILON_F64);
-        for (k, d) in ne.information.diagonal().iter().enumerate() {
-            if let Some(x) = damped.get_mut((k, k)) {
-                *x += lambda * (*d).max(floor);
+        damp(damped.as_mut_slice(), N, lambda);
+    }
+    // Factorized in place (what `Factor::new` and `Factor::solve` do, without a second
+    // `N × N` copy in this frame).
+    linalg::cholesky_in_place(damped.as_mut_slice(), N).map_err(StepError::Factor)?;
+    let mut step = -ne.gradient;
+    linalg::substitute(damped.as_slice(), N, step.as_mut_slice());
+    if linalg::all_finite(step.as_slice()) {
+        Ok(step)
+    } else {
+        Err(StepError::Solve(SolveError::NonFiniteResidual))
+    }
+}
+
+/// Marquardt scaling on the diagonal of the column-major `n × n` matrix `a`:
+/// `Aₖₖ += λ·max(Aₖₖ, ε·maxₖ Aₖₖ)`, the floor so that a zero column still gets damped. The
+/// dimension is a run-time number: one copy of the code for every `N`.
+#[inline(never)]
+fn damp<T: Real>(a: &mut [T], n: usize, lambda: T) {
+    let diagonal = |a: &[T], k: usize| a.get(k * n + k).copied();
+    let mut largest = diagonal(a, 0).unwrap_or_else(T::zero);
+    for k in 1..n {
+        if let Some(d) = diagonal(a, k) {
+            if d > largest {
+                largest = d;
             }
         }
     }
-    let factor = Factor::new(&damped).map_err(StepError::Factor)?;
-    factor.solve(&-ne.gradient).map_err(StepError::Solve)
+    let floor = largest * T::lit(T::EPSILON_F64);
+    for k in 0..n {
+        if let Some(x) = a.get_mut(k * n + k) {
+            *x += lambda * (*x).max(floor);
+        }
+    }
 }

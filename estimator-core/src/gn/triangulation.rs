@@ -130,8 +130,7 @@ pub fn triangulate<T: Real>(
     if !camera.is_valid() {
         return Err(SolveError::InvalidCamera);
     }
-    if !(options.sigma_px.is_finite()
-        && options.sigma_px > T::zero()
+    if !(super::all_positive(&[options.sigma_px])
         && options.min_depth.is_finite()
         && options.loss.is_valid())
     {

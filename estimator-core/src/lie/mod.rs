@@ -288,12 +288,45 @@ pub fn skew<T: Real>(w: &Vector3<T>) -> Matrix3<T> {
     Matrix3::new(z, -w.z, w.y, w.z, z, -w.x, -w.y, w.x, z)
 }
 
-/// `[ω]×² = ω ωᵀ − ‖ω‖² I`, without forming the product of two skew matrices.
-#[inline]
+/// `I + p[ω]× + q[ω]×²`, the shape of the SO(3) series (`J_r = I − b[ω]× + c[ω]×²`,
+/// `J_r⁻¹ = I + ½[ω]× + d[ω]×²`, see the SO(3) module docs), written out entry by entry with
+/// `[ω]×² = ωωᵀ − ‖ω‖² I` (diagonal `−(ω_y² + ω_z²)` etc., no cancellation): no product of skew
+/// matrices and no 3×3 temporaries.
 #[must_use]
-pub(crate) fn skew_sq<T: Real>(w: &Vector3<T>) -> Matrix3<T> {
+pub(crate) fn skew_poly<T: Real>(p: T, q: T, w: &Vector3<T>) -> Matrix3<T> {
     let (x, y, z) = (w.x, w.y, w.z);
     let (xx, yy, zz) = (x * x, y * y, z * z);
-    let (xy, xz, yz) = (x * y, x * z, y * z);
-    Matrix3::new(-(yy + zz), xy, xz, xy, -(xx + zz), yz, xz, yz, -(xx + yy))
+    let (qxy, qxz, qyz) = (q * x * y, q * x * z, q * y * z);
+    let (px, py, pz) = (p * x, p * y, p * z);
+    let one = T::one();
+    Matrix3::new(
+        one - q * (yy + zz),
+        qxy - pz,
+        qxz + py,
+        qxy + pz,
+        one - q * (xx + zz),
+        qyz - px,
+        qxz - py,
+        qyz + px,
+        one - q * (xx + yy),
+    )
+}
+
+/// `true` when every number is finite. One out-of-line loop shared by every `is_finite` and
+/// `try_from_matrix` of the groups (a per-element class test inlined at each call site costs
+/// more flash than the call; the check is never on a path where the call matters).
+#[inline(never)]
+pub(crate) fn all_finite<T: Real>(xs: &[T]) -> bool {
+    xs.iter().all(|x| x.is_finite())
+}
+
+/// `R[p]×`, row by row: row `i` is `rᵢᵀ[p]× = (rᵢ × p)ᵀ` for the row `rᵢ` of `R` (no zero
+/// products of a full 3×3 multiplication by the skew matrix, no 3×3 temporary).
+#[must_use]
+pub(crate) fn mul_skew<T: Real>(r: &Matrix3<T>, p: &Vector3<T>) -> Matrix3<T> {
+    let row = |a: T, b: T, c: T| (b * p.z - c * p.y, c * p.x - a * p.z, a * p.y - b * p.x);
+    let (a1, a2, a3) = row(r.m11, r.m12, r.m13);
+    let (b1, b2, b3) = row(r.m21, r.m22, r.m23);
+    let (c1, c2, c3) = row(r.m31, r.m32, r.m33);
+    Matrix3::new(a1, a2, a3, b1, b2, b3, c1, c2, c3)
 }

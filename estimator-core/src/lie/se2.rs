@@ -17,7 +17,7 @@
 
 use super::so2::So2;
 use super::trig::{half_cot, poly, AngleCoeffs, Cutoff};
-use super::{LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
 
 /// A planar rigid motion `T = (R, t) ∈ SE(2)`.
@@ -220,14 +220,14 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         }
         let r = So2::try_from_matrix(&m.fixed_view::<2, 2>(0, 0).into_owned())?;
         let t = Vector2::new(m.m13, m.m23);
-        if !t.iter().all(|x| x.is_finite()) {
+        if !all_finite(t.as_slice()) {
             return None;
         }
         Some(Self::from_parts(r, t))
     }
 
     fn is_finite(&self) -> bool {
-        self.rotation.is_finite() && self.translation.iter().all(|x| x.is_finite())
+        self.rotation.is_finite() && all_finite(self.translation.as_slice())
     }
 
     fn exp_jac(tau: &Vector3<T>) -> (Self, Matrix3<T>) {

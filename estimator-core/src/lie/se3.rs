@@ -13,13 +13,14 @@
 //! * `J_r(ξ) = [[J_r(ω), Q(−v, −ω)], [0, J_r(ω)]]`, and its inverse
 //!   `[[J_r⁻¹, −J_r⁻¹ Q J_r⁻¹], [0, J_r⁻¹]]`, where (Barfoot, *State Estimation for Robotics*,
 //!   eq. 7.86, with `V = [v]×`, `W = [ω]×`):
-//!   `Q(v, ω) = ½V + c(WV + VW + WVW) − e(W²V + VW² − 3WVW) − ½f(WVW² + W²VW)`.
+//!   `Q(v, ω) = ½V + c(WV + VW + WVW) − e(W²V + VW² − 3WVW) − ½f(WVW² + W²VW)`, evaluated in
+//!   a closed form without matrix products (see `q_block`).
 //! * `Ad_T = [[R, [t]×R], [0, R]]`.
 //! * `act_jac(p) = (R p + t, [R | −R[p]×], R)`: seed Theorem 5.1, `F = T [H(p) | I]`.
 
 use super::so3::So3;
 use super::trig::AngleCoeffs;
-use super::{skew, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, mul_skew, skew, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
 
 /// A rigid motion `T = (R, t) ∈ SE(3)`; `a_from_b` maps `b` coordinates into `a`.
@@ -53,18 +54,33 @@ fn upper_block<T: Real>(diag: &Matrix3<T>, upper: &Matrix3<T>) -> Matrix6<T> {
     m
 }
 
-/// Barfoot's `Q(v, ω)` (see the module docs) from the kernel of `ω`.
+/// Barfoot's `Q(v, ω)` (see the module docs) from the kernel of `ω`, in closed form.
+///
+/// With `V = [v]×`, `W = [ω]×`, `δ = ω·v`, `u = ω × v` and the identities
+/// `[a]×[b]× = b aᵀ − (a·b) I`, `ωᵀW = 0`, `a bᵀ − b aᵀ = [b × a]×`, the products of eq. 7.86
+/// reduce to `WV + VW + WVW = vωᵀ + ωvᵀ − 2δI − δW`, `W²V + VW² − 3WVW = [ω × u]× + δW`
+/// (`ω × u = δω − θ²v`) and `WVW² + W²VW = −2δW²`, so that, with `W² = ωωᵀ − θ²I` and
+/// `½ + eθ² = b`,
+///
+/// ```text
+/// Q = [b v − δ(c + 2e) ω]× + αωᵀ + ωαᵀ − δ(2c + fθ²) I,   α = c v + ½ f δ ω.
+/// ```
+///
+/// No 3×3 product at all (eq. 7.86 as written takes eight).
 fn q_block<T: Real>(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix3<T> {
     let se = k.se();
-    let vx = skew(v);
-    let wx = skew(w);
-    let wv = wx * vx;
-    let vw = vx * wx;
-    let wvw = wv * wx;
-    let half = T::lit(0.5);
-    vx * half + (wv + vw + wvw) * k.c
-        - (wx * wv + vw * wx - wvw * T::lit(3.0)) * se.e
-        - (wvw * wx + wx * wvw) * (half * se.f)
+    let dot = w.dot(v);
+    let s = v * k.b - w * (dot * (k.c + se.e + se.e));
+    let alpha = v * k.c + w * (T::lit(0.5) * se.f * dot);
+    let g = dot * (k.c + k.c + se.f * k.theta_sq);
+    let aw = alpha * w.transpose();
+    let mut q = aw + aw.transpose() + skew(&s);
+    for i in 0..3 {
+        if let Some(x) = q.get_mut((i, i)) {
+            *x -= g;
+        }
+    }
+    q
 }
 
 impl<T: Real> Se3<T> {
@@ -193,7 +209,9 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     fn adjoint(&self) -> Matrix6<T> {
         let r = self.rotation.rotation_matrix();
-        upper_block(&r, &(skew(&self.translation) * r))
+        // [t]× R = (Rᵀ[−t]×)ᵀ, since [t]×ᵀ = −[t]×.
+        let tr = mul_skew(&r.transpose(), &-self.translation).transpose();
+        upper_block(&r, &tr)
     }
 
     fn right_jacobian(xi: &Vector6<T>) -> Matrix6<T> {
@@ -228,14 +246,14 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         }
         let r = So3::try_from_matrix(&m.fixed_view::<3, 3>(0, 0).into_owned())?;
         let t = Vector3::new(m.m14, m.m24, m.m34);
-        if !t.iter().all(|x| x.is_finite()) {
+        if !all_finite(t.as_slice()) {
             return None;
         }
         Some(Self::from_parts(r, t))
     }
 
     fn is_finite(&self) -> bool {
-        self.rotation.is_finite() && self.translation.iter().all(|x| x.is_finite())
+        self.rotation.is_finite() && all_finite(self.translation.as_slice())
     }
 
     fn exp_jac(xi: &Vector6<T>) -> (Self, Matrix6<T>) {
@@ -267,7 +285,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         let r = self.rotation.rotation_matrix();
         let mut j = Matrix3x6::zeros();
         j.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
-        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&-(r * skew(p)));
+        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&mul_skew(&r, &-p));
         (r * p + self.translation, j, r)
     }
 }

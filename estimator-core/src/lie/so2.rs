@@ -4,7 +4,7 @@
 //! `exp(θ) = (cos θ, sin θ)`, `log = atan2(sin θ, cos θ) ∈ (−π, π]`. The group is commutative:
 //! `Ad = J_r = J_l = 1`. `act_jac(p) = (R p, R G¹ p, R)` (seed Theorem 5.1 with `H(p) = G¹p`).
 
-use super::{LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{Matrix1, Matrix2, Matrix2x1, Vector1, Vector2};
 
 /// A planar rotation `R ∈ SO(2)`.
@@ -156,7 +156,7 @@ impl<T: Real> LieGroup<T> for So2<T> {
 
     /// The nearest rotation of a 2×2 matrix is `((m₁₁ + m₂₂)/2, (m₂₁ − m₁₂)/2)` normalized.
     fn try_from_matrix(m: &Matrix2<T>) -> Option<Self> {
-        if !m.iter().all(|x| x.is_finite()) {
+        if !all_finite(m.as_slice()) {
             return None;
         }
         let err = (m.transpose() * m - Matrix2::identity()).norm_squared();

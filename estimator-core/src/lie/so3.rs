@@ -17,7 +17,7 @@
 //! `(1 − cos θ)/θ²`, `(θ − sin θ)/θ³`, `1/θ² − (1 + cos θ)/(2θ sin θ)`).
 
 use super::trig::{half_sinc, poly, AngleCoeffs, Cutoff};
-use super::{skew, skew_sq, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, mul_skew, skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 /// A 3-D rotation `R ∈ SO(3)`, stored as a unit Hamilton quaternion.
@@ -142,19 +142,19 @@ impl<T: Real> So3<T> {
     /// The SO(3) right Jacobian from precomputed coefficients: `I − b[ω]× + c[ω]×²`.
     #[inline]
     pub(crate) fn jr_from(k: &AngleCoeffs<T>, w: &Vector3<T>) -> Matrix3<T> {
-        Matrix3::identity() - skew(w) * k.b + skew_sq(w) * k.c
+        skew_poly(-k.b, k.c, w)
     }
 
     /// `J_r⁻¹ = I + ½[ω]× + d[ω]×²`.
     #[inline]
     pub(crate) fn jr_inv_from(k: &AngleCoeffs<T>, w: &Vector3<T>) -> Matrix3<T> {
-        Matrix3::identity() + skew(w) * T::lit(0.5) + skew_sq(w) * k.d()
+        skew_poly(T::lit(0.5), k.d(), w)
     }
 
     /// The unit quaternion `exp(ω)` from precomputed coefficients.
     #[inline]
     pub(crate) fn exp_from(k: &AngleCoeffs<T>, w: &Vector3<T>) -> Self {
-        let v = w * k.half_sinc();
+        let v = w * k.half_sinc;
         Self {
             q: UnitQuaternion::new_unchecked(Quaternion::new(k.cos_half, v.x, v.y, v.z)),
         }
@@ -286,7 +286,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn try_from_matrix(m: &Matrix3<T>) -> Option<Self> {
-        if !m.iter().all(|x| x.is_finite()) {
+        if !all_finite(m.as_slice()) {
             return None;
         }
         let err = (m.transpose() * m - Matrix3::identity()).norm_squared();
@@ -301,7 +301,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn is_finite(&self) -> bool {
-        self.q.coords.iter().all(|x| x.is_finite())
+        all_finite(self.q.coords.as_slice())
     }
 
     fn exp_jac(w: &Vector3<T>) -> (Self, Matrix3<T>) {
@@ -332,6 +332,6 @@ impl<T: Real> LieGroup<T> for So3<T> {
     /// `(R p, −R[p]×, R)`: seed Theorem 5.1 with `H(p) = [−p]×` (Example 5.2).
     fn act_jac(&self, p: &Vector3<T>) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {
         let r = self.rotation_matrix();
-        (r * p, -(r * skew(p)), r)
+        (r * p, mul_skew(&r, &-p), r)
     }
 }

@@ -7,9 +7,10 @@
 //!
 //! | field | closed form | series in `θ²` near 0 |
 //! |---|---|---|
-//! | `a` | `sin θ / θ` | `1 − θ²/6 + θ⁴/120` |
-//! | `b` | `(1 − cos θ)/θ² = 2s²/θ²` | `1/2 − θ²/24 + θ⁴/720` |
-//! | `c` | `(θ − sin θ)/θ³ = (1 − a)/θ²` | `1/6 − θ²/120 + θ⁴/5040 − θ⁶/362880` |
+//! | `h` (`half_sinc`) | `sin(θ/2)/θ = s/θ` | `1/2 − θ²/48 + θ⁴/3840` |
+//! | `a` | `sin θ / θ = 2hc` | (from `h`) |
+//! | `b` | `(1 − cos θ)/θ² = 2s²/θ² = 2h²` | (from `h`) |
+//! | `c` | `(θ − sin θ)/θ³ = (1 − a)/θ²` | `1/6 − θ²/120 + θ⁴/5040 − θ⁶/362880 + θ⁸/39916800 − θ¹⁰/6227020800` |
 //! | `d` | `1/θ² − (1 + cos θ)/(2θ sin θ) = (1 − (θ/2)·c/s)/θ²` | `1/12 + θ²/720 + θ⁴/30240 + θ⁶/1209600 + θ⁸/47900160` |
 //!
 //! and for SE(3)'s `Q` block ([`SeCoeffs`]):
@@ -19,11 +20,15 @@
 //! | `e` | `(1 − θ²/2 − cos θ)/θ⁴ = (b − 1/2)/θ²` | `−1/24 + θ²/720 − θ⁴/40320 + θ⁶/3628800` |
 //! | `f` | `e − 3(c − 1/6)/θ²` | `−1/60 + θ²/1260 − θ⁴/60480 + θ⁶/4989600` |
 //!
-//! Each coefficient switches to its series below its own cutoff `θ² < x*`, with
+//! `a` and `b` are products of `h` and `cos(θ/2)` (half-angle identities), so they need no
+//! branch of their own: `h` is exact to `ε/2` on both sides of its cutoff and each product adds
+//! one rounding. Each other coefficient switches to its series below its own cutoff `θ² < x*`, with
 //! `x* = `[`taylor_cutoff`]`(ε, t₀, t_omitted, terms)`: the series is then exact to `ε/2`. The
 //! cancelling closed forms (`c`, `d`, `e`, `f`) carry more series terms so that their cutoff sits
 //! where the cancellation has cost little; their error is relative to a term that is multiplied by
-//! `θ²` or `θ⁴` in every use, so the products stay accurate to a few ulps absolutely.
+//! `θ²` or `θ⁴` in every use, so the products stay accurate to a few ulps absolutely. `c` is
+//! the exception: SE(3)'s `Q` multiplies it by `θ‖v‖` only, so it carries six terms (its cutoff
+//! sits at `θ ≈ 0.4` in `f64`, where `1 − a` has lost only a few bits).
 
 use crate::scalar::{taylor_cutoff, Real};
 use core::marker::PhantomData;
@@ -32,9 +37,8 @@ use core::marker::PhantomData;
 pub(crate) struct Cutoff<T>(PhantomData<T>);
 
 impl<T: Real> Cutoff<T> {
-    pub(crate) const A: f64 = taylor_cutoff(T::EPSILON_F64, 1.0, 1.0 / 5040.0, 3);
-    pub(crate) const B: f64 = taylor_cutoff(T::EPSILON_F64, 0.5, 1.0 / 40320.0, 3);
-    pub(crate) const C: f64 = taylor_cutoff(T::EPSILON_F64, 1.0 / 6.0, 1.0 / 39_916_800.0, 4);
+    pub(crate) const C: f64 =
+        taylor_cutoff(T::EPSILON_F64, 1.0 / 6.0, 1.0 / 1_307_674_368_000.0, 6);
     pub(crate) const D: f64 = taylor_cutoff(T::EPSILON_F64, 1.0 / 12.0, 1.0 / 1_892_437_580.0, 5);
     pub(crate) const E: f64 = taylor_cutoff(T::EPSILON_F64, 1.0 / 24.0, 1.0 / 479_001_600.0, 4);
     pub(crate) const F: f64 = taylor_cutoff(T::EPSILON_F64, 1.0 / 60.0, 1.0 / 622_702_080.0, 4);
@@ -70,6 +74,8 @@ pub(crate) struct AngleCoeffs<T> {
     pub sin_half: T,
     /// `cos(θ/2)`.
     pub cos_half: T,
+    /// `sin(θ/2)/θ`, the vector coefficient of the unit quaternion `exp(θ)`.
+    pub half_sinc: T,
     /// `sin θ / θ`.
     pub a: T,
     /// `(1 − cos θ)/θ²`.
@@ -79,8 +85,8 @@ pub(crate) struct AngleCoeffs<T> {
 }
 
 impl<T: Real> AngleCoeffs<T> {
-    /// From `θ²` alone (one `sqrt` and one `sincos` of `θ/2`).
-    #[inline]
+    /// From `θ²` alone (one `sqrt` and one `sincos` of `θ/2`). Not `#[inline]` (see
+    /// [`Self::from_half_angle`]).
     pub fn from_theta_sq(theta_sq: T) -> Self {
         let theta = theta_sq.sqrt();
         let (sin_half, cos_half) = (theta * T::lit(0.5)).sincos();
@@ -89,25 +95,15 @@ impl<T: Real> AngleCoeffs<T> {
 
     /// From `θ` and the sine and cosine of `θ/2`, already known (for example the vector norm and
     /// scalar part of a unit quaternion): no trigonometric call at all.
-    #[inline]
+    ///
+    /// Not `#[inline]`: at opt-level 3 LLVM still inlines it where that pays, at opt-level "s"
+    /// every exponential and Jacobian of SO(3), SE(2) and SE(3) shares one copy.
     pub fn from_half_angle(theta_sq: T, theta: T, sin_half: T, cos_half: T) -> Self {
-        let two = T::lit(2.0);
-        let a = if theta_sq < T::lit(Cutoff::<T>::A) {
-            poly(
-                theta_sq,
-                [T::lit(1.0), T::lit(-1.0 / 6.0), T::lit(1.0 / 120.0)],
-            )
-        } else {
-            two * sin_half * cos_half / theta
-        };
-        let b = if theta_sq < T::lit(Cutoff::<T>::B) {
-            poly(
-                theta_sq,
-                [T::lit(0.5), T::lit(-1.0 / 24.0), T::lit(1.0 / 720.0)],
-            )
-        } else {
-            two * sin_half * sin_half / theta_sq
-        };
+        let half_sinc = half_sinc(theta_sq, theta, sin_half);
+        let two_h = half_sinc + half_sinc;
+        // sin θ = 2 sin(θ/2) cos(θ/2) and 1 − cos θ = 2 sin²(θ/2), divided by θ and θ².
+        let a = two_h * cos_half;
+        let b = two_h * half_sinc;
         let c = if theta_sq < T::lit(Cutoff::<T>::C) {
             poly(
                 theta_sq,
@@ -116,6 +112,8 @@ impl<T: Real> AngleCoeffs<T> {
                     T::lit(-1.0 / 120.0),
                     T::lit(1.0 / 5040.0),
                     T::lit(-1.0 / 362_880.0),
+                    T::lit(1.0 / 39_916_800.0),
+                    T::lit(-1.0 / 6_227_020_800.0),
                 ],
             )
         } else {
@@ -126,6 +124,7 @@ impl<T: Real> AngleCoeffs<T> {
             theta,
             sin_half,
             cos_half,
+            half_sinc,
             a,
             b,
             c,
@@ -134,7 +133,6 @@ impl<T: Real> AngleCoeffs<T> {
 
     /// `d = 1/θ² − (1 + cos θ)/(2θ sin θ)`, the coefficient of `[θ]×²` in `J_r⁻¹`; computed on
     /// demand, since only the inverse Jacobians need it.
-    #[inline]
     pub fn d(&self) -> T {
         let (theta_sq, theta) = (self.theta_sq, self.theta);
         if theta_sq < T::lit(Cutoff::<T>::D) {
@@ -163,12 +161,6 @@ impl<T: Real> AngleCoeffs<T> {
     #[inline]
     pub fn cos(&self) -> T {
         T::one() - self.one_minus_cos()
-    }
-
-    /// `sin(θ/2)/θ`, the vector coefficient of the unit quaternion `exp(θ)`.
-    #[inline]
-    pub fn half_sinc(&self) -> T {
-        half_sinc(self.theta_sq, self.theta, self.sin_half)
     }
 
     /// The SE(3) coefficients `e`, `f` of the `Q` block.
@@ -319,7 +311,7 @@ mod tests {
         // f32 cutoffs are wider than f64's; all are positive and inside every series' radius of
         // convergence (the smallest is d's: θ < 2π).
         for (c32, c64) in [
-            (Cutoff::<f32>::A, Cutoff::<f64>::A),
+            (Cutoff::<f32>::HALF_SINC, Cutoff::<f64>::HALF_SINC),
             (Cutoff::<f32>::C, Cutoff::<f64>::C),
             (Cutoff::<f32>::D, Cutoff::<f64>::D),
             (Cutoff::<f32>::F, Cutoff::<f64>::F),

@@ -580,23 +580,28 @@ where
         return Err(EskfError::NumericalFailure);
     }
     *x = new_x;
-    // Upper triangle (column j of P holds entries (0..=j, j)): P_ij += v_i k_j + k_i v_j for
-    // each active c, then mirrored; half of the N²·2M products of the full square.
+    // Rows and columns 3.. of P⁺ (rows 0..3 are `top`, written below). Upper triangle (column
+    // j of P holds entries (0..=j, j)): P_ij += v_i k_j + k_i v_j for each active c, 3 ≤ i ≤ j,
+    // then mirrored; half of the products of the full square.
     for (vc, kc) in columns::<T, N>(v.as_slice())
         .zip(columns::<T, N>(k.as_slice()))
         .take(m)
     {
         for (j, pc) in p.as_mut_slice().chunks_exact_mut(N.max(1)).enumerate() {
             let (vj, kj) = (at(vc, j), at(kc, j));
-            for (e, (vi, ki)) in pc.iter_mut().zip(vc.iter().zip(kc)).take(j + 1) {
+            let (Some(pc), Some(vs), Some(ks)) = (pc.get_mut(3..=j), vc.get(3..=j), kc.get(3..=j))
+            else {
+                continue;
+            };
+            for (e, (vi, ki)) in pc.iter_mut().zip(vs.iter().zip(ks)) {
                 *e += *vi * kj + *ki * vj;
             }
         }
     }
-    // Mirror the upper triangle; then rows 0..3 ← top, columns 0..3 ← topᵀ, block (0, 0) ← c00
+    // Mirror that triangle; then rows 0..3 ← top, columns 0..3 ← topᵀ, block (0, 0) ← c00
     // (element by element: no transposed temporary).
-    for j in 0..N {
-        for i in 0..j {
+    for j in 3..N {
+        for i in 3..j {
             let u = p.get((i, j)).copied().unwrap_or_else(T::zero);
             if let Some(e) = p.get_mut((j, i)) {
                 *e = u;

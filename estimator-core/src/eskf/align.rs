@@ -10,7 +10,7 @@
 //! * Initial gyro bias: the mean angular rate `ω̄` (the body does not rotate).
 
 use super::error::EskfError;
-use super::imu::finite;
+use super::imu::{finite, mm};
 use crate::lie::So3;
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
@@ -112,7 +112,8 @@ pub fn align_at_rest<T: Real>(
     };
     let b = Matrix3::from_columns(&[ub, hb, ub.cross(&hb)]);
     let wm = Matrix3::from_columns(&[uw, hw, uw.cross(&hw)]);
-    let attitude = So3::from_rotation_matrix(&(wm * b.transpose())).ok_or(EskfError::NonFinite)?;
+    let attitude =
+        So3::from_rotation_matrix(&mm(&wm, &b.transpose())).ok_or(EskfError::NonFinite)?;
     Ok(Alignment {
         attitude,
         gyro_bias: w,
@@ -161,7 +162,7 @@ impl<T: Real> InitialSigmas<T> {
         let y2 = self.yaw * self.yaw;
         // Σ_w = σ_t² I + (σ_ψ² − σ_t²) u uᵀ.
         let sw = Matrix3::identity() * t2 + up * up.transpose() * (y2 - t2);
-        r.transpose() * sw * r
+        mm(&mm(&r.transpose(), &sw), &r)
     }
 }
 

@@ -56,21 +56,30 @@ impl GateProbability {
             return T::zero();
         }
         // Each `T::lit` takes a literal, so it folds to a `T` constant: no run-time f64 → f32
-        // conversion (soft-float on a Cortex-M4F). Same numbers as `CHI_SQUARE_TABLE`.
-        let col = self.column();
-        let pick = |a: f64, b: f64, c: f64| match col {
-            0 => T::lit(a),
-            1 => T::lit(b),
-            _ => T::lit(c),
-        };
-        match dof {
-            1 => return pick(3.841_459, 6.634_897, 10.827_566),
-            2 => return pick(5.991_465, 9.210_340, 13.815_511),
-            3 => return pick(7.814_728, 11.344_867, 16.266_236),
-            4 => return pick(9.487_729, 13.276_704, 18.466_827),
-            5 => return pick(11.070_498, 15.086_272, 20.515_006),
-            6 => return pick(12.591_587, 16.811_894, 22.457_744),
-            _ => {}
+        // conversion (soft-float on a Cortex-M4F). Same numbers as `CHI_SQUARE_TABLE`, row
+        // `dof − 1`, column `p`; one `match` on the flat index, which the compiler turns into a
+        // table of constants.
+        if dof <= 6 {
+            return match (dof - 1) * 3 + self.column() {
+                0 => T::lit(3.841_459),
+                1 => T::lit(6.634_897),
+                2 => T::lit(10.827_566),
+                3 => T::lit(5.991_465),
+                4 => T::lit(9.210_340),
+                5 => T::lit(13.815_511),
+                6 => T::lit(7.814_728),
+                7 => T::lit(11.344_867),
+                8 => T::lit(16.266_236),
+                9 => T::lit(9.487_729),
+                10 => T::lit(13.276_704),
+                11 => T::lit(18.466_827),
+                12 => T::lit(11.070_498),
+                13 => T::lit(15.086_272),
+                14 => T::lit(20.515_006),
+                15 => T::lit(12.591_587),
+                16 => T::lit(16.811_894),
+                _ => T::lit(22.457_744),
+            };
         }
         // `dof` as a `T` without an integer-to-f64 conversion (software on a Cortex-M4F).
         let mut m = T::zero();

@@ -316,28 +316,36 @@ pub(crate) fn predict_ins<T: Real>(
     };
     let f_finite =
         finite_vec(&fr.f00) && finite_vec(&fr.f03) && finite_vec(&fr.b) && finite_vec(&fr.fx);
-    // L = (F P)ᵀ = P Fᵀ for the block columns 0..2 (a 15 × 9 temporary): block column j of P
-    // gives M_ij = (F P)_ij, i = 0..2, stored as L_ji = M_ijᵀ. Rows 3 and 4 of F are identity
-    // rows, so (F P)_3j = P_3j and (F P)_4j = P_4j need no storage.
+    // Two passes of the same kernel, `FRows::apply` (the nonzero blocks of F's rows θ, v, p
+    // applied to a 15 × 3 block column), from one call site, so that every opt-level inlines it
+    // exactly once:
+    // * t = 0..5, F P: block column j = t of P gives M_ij = (F P)_ij, i = 0..2, stored as
+    //   L_ji = M_ijᵀ in L = (F P)ᵀ = P Fᵀ (a 15 × 9 temporary). Rows 3 and 4 of F are identity
+    //   rows, so (F P)_3j = P_3j and (F P)_4j = P_4j need no storage.
+    // * t = 5..8, N = F P Fᵀ = F L: block column i = t − 5 of N is F applied to block column i of
+    //   L. Only the blocks on and below the diagonal are kept (N_ki, k ≥ i; N is symmetric), in
+    //   place of L_ki: block column i of L is read once, and later columns are untouched.
+    //   N_3i = L_3i and N_4i = L_4i (identity rows of F) are already there.
     let mut l = SMatrix::<T, 15, 9>::zeros();
-    for j in 0..5 {
-        if let Some(q) = block_column(p.as_slice(), j) {
-            for (i, m) in fr.apply(q, true).iter().enumerate() {
-                set_blk_rc(&mut l, j, i, &m.transpose());
-            }
-        }
-    }
-    // N = F P Fᵀ = F L: block column i of N is F applied to block column i of L, the same
-    // `apply`. Only the blocks on and below the diagonal are kept (N_ki, k ≥ i; N is symmetric),
-    // in place of L_ki: block column i of L is read once, and later columns are untouched.
-    // N_3i = L_3i and N_4i = L_4i (identity rows of F) are already there.
-    for i in 0..3 {
-        let n = match block_column(l.as_slice(), i) {
-            Some(q) => fr.apply(q, i == 0),
-            None => continue,
+    for t in 0..8 {
+        let (src, j) = if t < 5 {
+            (p.as_slice(), t)
+        } else {
+            (l.as_slice(), t - 5)
         };
-        for (k, n) in n.iter().enumerate().skip(i) {
-            set_blk_rc(&mut l, k, i, &if k == i { sym(n) } else { *n });
+        let Some(q) = block_column(src, j) else {
+            continue;
+        };
+        // (F00 Q₀ + F03 Q₃ is not needed below the diagonal: N_0i for i > 0.)
+        let out = fr.apply(q, t <= 5);
+        for (i, m) in out.iter().enumerate() {
+            if t < 5 {
+                set_blk_rc(&mut l, j, i, &m.transpose());
+            } else if i == j {
+                set_blk_rc(&mut l, i, j, &sym(m));
+            } else if i > j {
+                set_blk_rc(&mut l, i, j, m);
+            }
         }
     }
     // F and P are finite, so N = F P Fᵀ can only fail by overflow, and for a positive
@@ -407,25 +415,12 @@ pub(crate) fn predict_ahrs<T: Real>(
     // M0j = F00 P0j + F01 P1j; P⁺00 = M00 F00ᵀ + M01 F01ᵀ; P⁺01 = M01; P⁺11 = P11.
     let m00 = mm(&f00, &p00) + mm(&f01, &p01.transpose());
     let m01 = mm(&f00, &p01) + mm(&f01, &p11);
-    // N00 = M00 F00ᵀ + M01 F01ᵀ is symmetric: compute its upper triangle and mirror it (half
-    // the products, and exactly symmetric without a separate symmetrization).
-    let row = |m: &Matrix3<T>, i: usize| match i {
-        0 => (m.m11, m.m12, m.m13),
-        1 => (m.m21, m.m22, m.m23),
-        _ => (m.m31, m.m32, m.m33),
-    };
-    let dot = |a: (T, T, T), b: (T, T, T)| a.0 * b.0 + a.1 * b.1 + a.2 * b.2;
-    let entry =
-        |i: usize, j: usize| dot(row(&m00, i), row(&f00, j)) + dot(row(&m01, i), row(&f01, j));
-    let (n11, n12, n13, n22, n23, n33) = (
-        entry(0, 0),
-        entry(0, 1),
-        entry(0, 2),
-        entry(1, 1),
-        entry(1, 2),
-        entry(2, 2),
+    // N00 = M00 F00ᵀ + M01 F01ᵀ is symmetric: its upper triangle, mirrored (exactly symmetric
+    // without a separate symmetrization; at opt-level 3 the unused lower products are dead).
+    let n = mm(&m00, &f00.transpose()) + mm(&m01, &f01.transpose());
+    let n00 = Matrix3::new(
+        n.m11, n.m12, n.m13, n.m12, n.m22, n.m23, n.m13, n.m23, n.m33,
     );
-    let n00 = Matrix3::new(n11, n12, n13, n12, n22, n23, n13, n23, n33);
     let att = x.attitude.compose(&dr).renormalize();
     if !(finite_vec(&n00) && finite_vec(&m01) && att.is_finite()) {
         return Err(EskfError::NonFinite);

@@ -5,26 +5,43 @@
 //! `R[−b]×`).
 
 use super::error::EskfError;
-use super::imu::{finite, greater};
+use super::imu::{finite, greater, mm};
 use super::state::{ErrorState, InsState};
 use super::update::{Linearization, Measurement};
-use crate::lie::{skew, LieGroup, Se3};
+use crate::lie::{skew, LieGroup, Se3, So3};
 use crate::Real;
-use nalgebra::{Matrix1, Matrix2, Matrix2x3, Matrix3, SMatrix, Vector1, Vector2, Vector3};
+use nalgebra::{Matrix1, Matrix2, Matrix3, SMatrix, Vector1, Vector2, Vector3};
 
+/// `σ² I` (written out: nalgebra's `identity() * s` is a generic loop at opt-level "s").
 fn iso3<T: Real>(sigma: T) -> Matrix3<T> {
-    Matrix3::identity() * (sigma * sigma)
+    let (s, z) = (sigma * sigma, T::zero());
+    Matrix3::new(s, z, z, z, s, z, z, z, s)
 }
 
-/// `M × N` zero Jacobian with `block` in columns `0..3` (the attitude error).
-fn attitude_jacobian<T: Real, const M: usize, const N: usize>(
-    block: &SMatrix<T, M, 3>,
+/// The `M × N` Jacobian that is zero except for the given blocks: the first `M` rows of each
+/// `(column, block)` go to columns `column..column + 3`. One helper for every model, so that
+/// each shape has one copy of the loop.
+fn jacobian<T: Real, const M: usize, const N: usize>(
+    blocks: &[(usize, Matrix3<T>)],
 ) -> SMatrix<T, M, N> {
     let mut h = SMatrix::<T, M, N>::zeros();
-    for (mut dst, src) in h.column_iter_mut().zip(block.column_iter()) {
-        dst.copy_from(&src);
+    for (col, b) in blocks {
+        for c in 0..3 {
+            for r in 0..M {
+                if let (Some(d), Some(s)) = (h.get_mut((r, col + c)), b.get((r, c))) {
+                    *d = *s;
+                }
+            }
+        }
     }
     h
+}
+
+/// A world vector `v` seen in the body, `Rᵀ v`, and its attitude Jacobian `[Rᵀ v]×` (module
+/// docs: `(R exp(δθ^))ᵀ v ≈ Rᵀ v + [Rᵀ v]× δθ`). Shared by the direction models (one copy).
+fn in_body<T: Real>(attitude: &So3<T>, v: &Vector3<T>) -> (Vector3<T>, Matrix3<T>) {
+    let b = attitude.inverse().act(v);
+    (b, skew(&b))
 }
 
 /// GNSS antenna position in the world frame, with the antenna at `lever_arm` in the body frame.
@@ -58,13 +75,9 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssPosition<T> {
             return Err(EskfError::NonFinite);
         }
         let (rl, d_att, _) = x.attitude.act_jac(&self.lever_arm);
-        let mut h = SMatrix::<T, 3, 15>::zeros();
-        h.fixed_view_mut::<3, 3>(0, 0).copy_from(&d_att);
-        h.fixed_view_mut::<3, 3>(0, 6)
-            .copy_from(&Matrix3::identity());
         Ok(Linearization {
             residual: self.position - (x.position + rl),
-            jacobian: h,
+            jacobian: jacobian(&[(0, d_att), (6, Matrix3::identity())]),
         })
     }
     fn noise(&self) -> Matrix3<T> {
@@ -97,12 +110,9 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssVelocity<T> {
         if !finite(&self.velocity) {
             return Err(EskfError::NonFinite);
         }
-        let mut h = SMatrix::<T, 3, 15>::zeros();
-        h.fixed_view_mut::<3, 3>(0, 3)
-            .copy_from(&Matrix3::identity());
         Ok(Linearization {
             residual: self.velocity - x.velocity,
-            jacobian: h,
+            jacobian: jacobian(&[(3, Matrix3::identity())]),
         })
     }
     fn noise(&self) -> Matrix3<T> {
@@ -127,12 +137,9 @@ impl<T: Real> ZeroVelocity<T> {
 
 impl<T: Real> Measurement<T, InsState<T>, 15, 3> for ZeroVelocity<T> {
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
-        let mut h = SMatrix::<T, 3, 15>::zeros();
-        h.fixed_view_mut::<3, 3>(0, 3)
-            .copy_from(&Matrix3::identity());
         Ok(Linearization {
             residual: -x.velocity,
-            jacobian: h,
+            jacobian: jacobian(&[(3, Matrix3::identity())]),
         })
     }
     fn noise(&self) -> Matrix3<T> {
@@ -204,20 +211,27 @@ impl<T: Real> Magnetometer<T> {
             noise: iso3(sigma),
         }
     }
-}
 
-impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for Magnetometer<T> {
-    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
+    /// The residual `z − Rᵀ m_w` and the attitude block `[Rᵀ m_w]×`: the part that does not
+    /// depend on the filter (one copy for both).
+    fn attitude_parts(&self, attitude: &So3<T>) -> Result<(Vector3<T>, Matrix3<T>), EskfError> {
         if !(finite(&self.field) && finite(&self.reference)) {
             return Err(EskfError::NonFinite);
         }
         if self.field.norm_squared() <= T::zero() || self.reference.norm_squared() <= T::zero() {
             return Err(EskfError::ZeroNorm);
         }
-        let hx = x.attitude().inverse().act(&self.reference);
+        let (hx, h_att) = in_body(attitude, &self.reference);
+        Ok((self.field - hx, h_att))
+    }
+}
+
+impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for Magnetometer<T> {
+    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
+        let (residual, h_att) = self.attitude_parts(x.attitude())?;
         Ok(Linearization {
-            residual: self.field - hx,
-            jacobian: attitude_jacobian(&skew(&hx)),
+            residual,
+            jacobian: jacobian(&[(0, h_att)]),
         })
     }
     fn noise(&self) -> Matrix3<T> {
@@ -253,10 +267,10 @@ impl<T: Real> GravityDirection<T> {
             noise: iso3(sigma),
         }
     }
-}
 
-impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for GravityDirection<T> {
-    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
+    /// The residual `f_m/‖f_m‖ − Rᵀ u` and the attitude block `[Rᵀ u]×` (one copy for both
+    /// filters).
+    fn attitude_parts(&self, attitude: &So3<T>) -> Result<(Vector3<T>, Matrix3<T>), EskfError> {
         if !(finite(&self.accel) && finite(&self.up)) {
             return Err(EskfError::NonFinite);
         }
@@ -264,10 +278,17 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for G
         if !(na > T::zero() && nu > T::zero()) {
             return Err(EskfError::ZeroNorm);
         }
-        let hx = x.attitude().inverse().act(&(self.up / nu));
+        let (hx, h_att) = in_body(attitude, &(self.up / nu));
+        Ok((self.accel / na - hx, h_att))
+    }
+}
+
+impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for GravityDirection<T> {
+    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
+        let (residual, h_att) = self.attitude_parts(x.attitude())?;
         Ok(Linearization {
-            residual: self.accel / na - hx,
-            jacobian: attitude_jacobian(&skew(&hx)),
+            residual,
+            jacobian: jacobian(&[(0, h_att)]),
         })
     }
     fn noise(&self) -> Matrix3<T> {
@@ -309,14 +330,10 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
         if self.accel.norm_squared() <= T::zero() {
             return Err(EskfError::ZeroNorm);
         }
-        let f = x.attitude.inverse().act(&(-self.gravity));
-        let mut h = SMatrix::<T, 3, 15>::zeros();
-        h.fixed_view_mut::<3, 3>(0, 0).copy_from(&skew(&f));
-        h.fixed_view_mut::<3, 3>(0, 12)
-            .copy_from(&Matrix3::identity());
+        let (f, h_att) = in_body(&x.attitude, &(-self.gravity));
         Ok(Linearization {
             residual: self.accel - (f + x.accel_bias),
-            jacobian: h,
+            jacobian: jacobian(&[(0, h_att), (12, Matrix3::identity())]),
         })
     }
     fn noise(&self) -> Matrix3<T> {
@@ -346,26 +363,45 @@ impl<T: Real> Heading<T> {
             noise: Matrix1::new(sigma * sigma),
         }
     }
-}
 
-impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for Heading<T> {
-    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 1>, EskfError> {
+    /// The wrapped residual and the attitude row (row 0 of the returned block), one copy for
+    /// both filters. With `R e₁ = (c_x, c_y, ·)` and `∂(R e₁)/∂δθ = −R[e₁]× = [0, −R e₃, R e₂]`
+    /// (columns; `[e₁]× = [0, e₃, −e₂]`), the row `(c_x ∂c_y − c_y ∂c_x)/(c_x² + c_y²)` is
+    /// `(0, c_y R₁₃ − c_x R₂₃, c_x R₂₂ − c_y R₁₂)/(c_x² + c_y²)`.
+    fn attitude_parts(&self, attitude: &So3<T>) -> Result<(T, Matrix3<T>), EskfError> {
         if !self.yaw.is_finite() {
             return Err(EskfError::NonFinite);
         }
-        let r = x.attitude().rotation_matrix();
+        let r = attitude.rotation_matrix();
         let (cx, cy) = (r.m11, r.m21);
         let n2 = cx * cx + cy * cy;
         if !greater(n2, T::lit(1e-6)) {
             return Err(EskfError::SingularGeometry);
         }
-        let d = -(r * skew(&Vector3::x()));
-        let row = (d.row(1) * cx - d.row(0) * cy) / n2;
+        let z = T::zero();
+        let row = Matrix3::new(
+            z,
+            (cy * r.m13 - cx * r.m23) / n2,
+            (cx * r.m22 - cy * r.m12) / n2,
+            z,
+            z,
+            z,
+            z,
+            z,
+            z,
+        );
         let psi = cy.atan2(cx);
         let (s, c) = (self.yaw - psi).sincos();
+        Ok((s.atan2(c), row))
+    }
+}
+
+impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for Heading<T> {
+    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 1>, EskfError> {
+        let (residual, h_att) = self.attitude_parts(x.attitude())?;
         Ok(Linearization {
-            residual: Vector1::new(s.atan2(c)),
-            jacobian: attitude_jacobian(&row),
+            residual: Vector1::new(residual),
+            jacobian: jacobian(&[(0, h_att)]),
         })
     }
     fn noise(&self) -> Matrix1<T> {
@@ -400,6 +436,9 @@ pub struct CameraLandmark<T: Real> {
     pub min_depth: T,
 }
 
+/// The pixel `(u, v)`, the landmark in the camera `c` and in the body `q`.
+type Projection<T> = (Vector2<T>, Vector3<T>, Vector3<T>);
+
 impl<T: Real> CameraLandmark<T> {
     /// Isotropic pixel noise `σ² I`, minimum depth 1 cm.
     #[must_use]
@@ -422,6 +461,11 @@ impl<T: Real> CameraLandmark<T> {
 
     /// The predicted pixel and the landmark in the camera frame, or [`EskfError::BehindCamera`].
     pub fn project(&self, x: &InsState<T>) -> Result<(Vector2<T>, Vector3<T>), EskfError> {
+        self.project_parts(x).map(|(u, c, _)| (u, c))
+    }
+
+    /// [`Self::project`], and the landmark in the body `q` (the linearization needs it too).
+    fn project_parts(&self, x: &InsState<T>) -> Result<Projection<T>, EskfError> {
         let q = x.attitude.inverse().act(&(self.landmark - x.position));
         let rbc = self.body_from_camera.rotation();
         let c = rbc
@@ -432,7 +476,7 @@ impl<T: Real> CameraLandmark<T> {
         }
         let k = &self.intrinsics;
         let u = Vector2::new(k.fx * c.x / c.z + k.cx, k.fy * c.y / c.z + k.cy);
-        Ok((u, c))
+        Ok((u, c, q))
     }
 }
 
@@ -447,8 +491,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
         {
             return Err(EskfError::NonFinite);
         }
-        let (uv, c) = self.project(x)?;
-        let q = x.attitude.inverse().act(&(self.landmark - x.position));
+        let (uv, c, q) = self.project_parts(x)?;
         let rcb = self
             .body_from_camera
             .rotation()
@@ -456,21 +499,23 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
             .transpose();
         let rt = x.attitude.rotation_matrix().transpose();
         let iz = T::one() / c.z;
-        let jpi = Matrix2x3::new(
+        let z = T::zero();
+        // ∂π/∂c with a zero third row, so that the 3×3 `mm` serves (rows 0, 1 are used).
+        let jpi = Matrix3::new(
             k.fx * iz,
-            T::zero(),
+            z,
             -k.fx * c.x * iz * iz,
-            T::zero(),
+            z,
             k.fy * iz,
             -k.fy * c.y * iz * iz,
+            z,
+            z,
+            z,
         );
-        let jc = jpi * rcb;
-        let mut h = SMatrix::<T, 2, 15>::zeros();
-        h.fixed_view_mut::<2, 3>(0, 0).copy_from(&(jc * skew(&q)));
-        h.fixed_view_mut::<2, 3>(0, 6).copy_from(&(-(jc * rt)));
+        let jc = mm(&jpi, &rcb);
         Ok(Linearization {
             residual: self.pixel - uv,
-            jacobian: h,
+            jacobian: jacobian(&[(0, mm(&jc, &skew(&q))), (6, -mm(&jc, &rt))]),
         })
     }
     fn noise(&self) -> Matrix2<T> {

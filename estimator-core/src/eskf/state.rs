@@ -1,8 +1,9 @@
 //! Nominal states, their `⊕`, and the traits the generic update works on.
 
+use super::imu::finite_vec;
 use crate::lie::{LieGroup, So3};
 use crate::Real;
-use nalgebra::{SVector, Vector3};
+use nalgebra::{Matrix3x4, SVector, Vector3};
 
 /// A nominal state with an `N`-dimensional error state whose first three components are the
 /// right attitude error `δθ` (`R = R̂·exp(δθ^)`, seed eq. 4.5) and whose other components are
@@ -59,10 +60,6 @@ impl<T: Real> InsState<T> {
     }
 }
 
-fn finite3<T: Real>(v: &Vector3<T>) -> bool {
-    v.iter().all(|x| x.is_finite())
-}
-
 impl<T: Real> ErrorState<T, 15> for InsState<T> {
     fn oplus(&self, dx: &SVector<T, 15>) -> Self {
         Self {
@@ -78,11 +75,14 @@ impl<T: Real> ErrorState<T, 15> for InsState<T> {
     }
 
     fn is_finite(&self) -> bool {
+        // The four vectors side by side: one check (see `finite_vec`).
         self.attitude.is_finite()
-            && finite3(&self.velocity)
-            && finite3(&self.position)
-            && finite3(&self.gyro_bias)
-            && finite3(&self.accel_bias)
+            && finite_vec(&Matrix3x4::from_columns(&[
+                self.velocity,
+                self.position,
+                self.gyro_bias,
+                self.accel_bias,
+            ]))
     }
 
     fn attitude(&self) -> &So3<T> {
@@ -122,7 +122,7 @@ impl<T: Real> ErrorState<T, 6> for AhrsState<T> {
     }
 
     fn is_finite(&self) -> bool {
-        self.attitude.is_finite() && finite3(&self.gyro_bias)
+        self.attitude.is_finite() && finite_vec(&self.gyro_bias)
     }
 
     fn attitude(&self) -> &So3<T> {

@@ -45,7 +45,6 @@ fn join<T: Real>(v: &Vector3<T>, w: &Vector3<T>) -> Vector6<T> {
 }
 
 /// `[[a, b], [0, a]]` from 3×3 blocks (the shape of every SE(3) Jacobian).
-#[inline]
 fn upper_block<T: Real>(diag: &Matrix3<T>, upper: &Matrix3<T>) -> Matrix6<T> {
     let mut m = Matrix6::zeros();
     m.fixed_view_mut::<3, 3>(0, 0).copy_from(diag);
@@ -113,7 +112,6 @@ impl<T: Real> Se3<T> {
         self.translation
     }
 
-    #[inline]
     fn exp_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Self {
         let wv = w.cross(v);
         Self {
@@ -122,12 +120,10 @@ impl<T: Real> Se3<T> {
         }
     }
 
-    #[inline]
     fn jr_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix6<T> {
         upper_block(&So3::jr_from(k, w), &q_block(k, &-v, &-w))
     }
 
-    #[inline]
     fn jr_inv_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix6<T> {
         let jinv = So3::jr_inv_from(k, w);
         let q = q_block(k, &-v, &-w);
@@ -135,7 +131,6 @@ impl<T: Real> Se3<T> {
     }
 
     /// `log` and the kernel of its rotation angle.
-    #[inline]
     fn log_with_coeffs(&self) -> (Vector6<T>, AngleCoeffs<T>) {
         let (w, k) = self.rotation.log_with_coeffs();
         // J_l⁻¹(ω) t = t − ½ ω×t + d ω×(ω×t).

@@ -84,23 +84,39 @@ impl<T: Real> PnpOptions<T> {
 
 /// Which observations passed the inlier test, as a bitset of up to [`PNP_CAPACITY`] entries
 /// (bit `j` for observation `j`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+///
+/// Stored as four 32-bit words (bit `j` in word `j / 32`): on a 32-bit core a `u128` shift or
+/// population count is a multi-word routine; [`Inliers::bits`] assembles the `u128`.
+#[derive(Clone, Copy, PartialEq, Eq, Default)]
 pub struct Inliers {
-    bits: u128,
+    words: [u32; 4],
     len: usize,
+}
+
+impl core::fmt::Debug for Inliers {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Inliers")
+            .field("bits", &self.bits())
+            .field("len", &self.len)
+            .finish()
+    }
 }
 
 impl Inliers {
     /// `true` when observation `j` is an inlier (`false` beyond the length).
     #[must_use]
     pub fn contains(&self, j: usize) -> bool {
-        j < self.len && (self.bits >> j) & 1 == 1
+        j < self.len
+            && self
+                .words
+                .get(j / 32)
+                .is_some_and(|w| (w >> (j % 32)) & 1 == 1)
     }
 
     /// Number of inliers.
     #[must_use]
     pub fn count(&self) -> usize {
-        self.bits.count_ones() as usize
+        self.words.iter().map(|w| w.count_ones() as usize).sum()
     }
 
     /// Number of observations tested.
@@ -118,7 +134,10 @@ impl Inliers {
     /// The raw bitset.
     #[must_use]
     pub fn bits(&self) -> u128 {
-        self.bits
+        self.words
+            .iter()
+            .rev()
+            .fold(0, |acc, &w| (acc << 32) | u128::from(w))
     }
 
     /// One `bool` per observation, in order.
@@ -262,7 +281,7 @@ fn inlier_mask<T: Real>(
 ) -> Result<Inliers, SolveError> {
     let r = pose.rotation().rotation_matrix();
     let t = pose.translation();
-    let mut bits = 0u128;
+    let mut words = [0u32; 4];
     let pairs = problem.world_points.iter().zip(problem.pixels);
     for (k, (p, z)) in pairs.enumerate() {
         let uv = problem
@@ -271,11 +290,13 @@ fn inlier_mask<T: Real>(
             .ok_or(SolveError::PointBehindCamera)?;
         let e = (uv - z) * problem.inv_sigma;
         if e.norm_squared() <= chi2 {
-            bits |= 1u128 << (k % PNP_CAPACITY);
+            if let Some(w) = words.get_mut(k / 32) {
+                *w |= 1 << (k % 32);
+            }
         }
     }
     Ok(Inliers {
-        bits,
+        words,
         len: problem.world_points.len(),
     })
 }

@@ -84,39 +84,36 @@ impl<T: Real> PnpOptions<T> {
 
 /// Which observations passed the inlier test, as a bitset of up to [`PNP_CAPACITY`] entries
 /// (bit `j` for observation `j`).
-///
-/// Stored as four 32-bit words (bit `j` in word `j / 32`): on a 32-bit core a `u128` shift or
-/// population count is a multi-word routine; [`Inliers::bits`] assembles the `u128`.
-#[derive(Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct Inliers {
-    words: [u32; 4],
+    bits: u128,
     len: usize,
 }
 
-impl core::fmt::Debug for Inliers {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("Inliers")
-            .field("bits", &self.bits())
-            .field("len", &self.len)
-            .finish()
-    }
-}
-
 impl Inliers {
+    /// The 32-bit word `k` of the bitset (bits `32k .. 32k + 31`). Shifts by constants only: on a
+    /// 32-bit core a `u128` shift by a variable amount, or its population count, is a four-word
+    /// routine.
+    fn word(&self, k: usize) -> u32 {
+        // Truncating casts on purpose: each keeps one 32-bit word.
+        match k {
+            0 => self.bits as u32,
+            1 => (self.bits >> 32) as u32,
+            2 => (self.bits >> 64) as u32,
+            _ => (self.bits >> 96) as u32,
+        }
+    }
+
     /// `true` when observation `j` is an inlier (`false` beyond the length).
     #[must_use]
     pub fn contains(&self, j: usize) -> bool {
-        j < self.len
-            && self
-                .words
-                .get(j / 32)
-                .is_some_and(|w| (w >> (j % 32)) & 1 == 1)
+        j < self.len && (self.word(j / 32) >> (j % 32)) & 1 == 1
     }
 
     /// Number of inliers.
     #[must_use]
     pub fn count(&self) -> usize {
-        self.words.iter().map(|w| w.count_ones() as usize).sum()
+        (0..4).map(|k| self.word(k).count_ones() as usize).sum()
     }
 
     /// Number of observations tested.
@@ -134,10 +131,7 @@ impl Inliers {
     /// The raw bitset.
     #[must_use]
     pub fn bits(&self) -> u128 {
-        self.words
-            .iter()
-            .rev()
-            .fold(0, |acc, &w| (acc << 32) | u128::from(w))
+        self.bits
     }
 
     /// One `bool` per observation, in order.
@@ -281,6 +275,7 @@ fn inlier_mask<T: Real>(
 ) -> Result<Inliers, SolveError> {
     let r = pose.rotation().rotation_matrix();
     let t = pose.translation();
+    // Four 32-bit words, assembled into the `u128` at the end (see `Inliers::word`).
     let mut words = [0u32; 4];
     let pairs = problem.world_points.iter().zip(problem.pixels);
     for (k, (p, z)) in pairs.enumerate() {
@@ -295,8 +290,12 @@ fn inlier_mask<T: Real>(
             }
         }
     }
+    let bits = words
+        .iter()
+        .rev()
+        .fold(0u128, |acc, &w| (acc << 32) | u128::from(w));
     Ok(Inliers {
-        words,
+        bits,
         len: problem.world_points.len(),
     })
 }

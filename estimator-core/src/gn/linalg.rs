@@ -74,7 +74,8 @@ impl<T: Real, const N: usize> Factor<T, N> {
     }
 }
 
-/// `true` when every entry is finite.
+/// `true` when every entry is finite: one loop for every check of the solver (no inline
+/// attribute: one copy at opt-level "s", inlined where it pays at opt-level 3).
 pub(crate) fn all_finite<T: Real>(xs: &[T]) -> bool {
     xs.iter().all(|x| x.is_finite())
 }

@@ -91,16 +91,29 @@ pub struct Inliers {
 }
 
 impl Inliers {
+    /// The 32-bit word `k` of the bitset (bits `32k .. 32k + 31`). Shifts by constants only: on a
+    /// 32-bit core a `u128` shift by a variable amount, or its population count, is a four-word
+    /// routine.
+    fn word(&self, k: usize) -> u32 {
+        // Truncating casts on purpose: each keeps one 32-bit word.
+        match k {
+            0 => self.bits as u32,
+            1 => (self.bits >> 32) as u32,
+            2 => (self.bits >> 64) as u32,
+            _ => (self.bits >> 96) as u32,
+        }
+    }
+
     /// `true` when observation `j` is an inlier (`false` beyond the length).
     #[must_use]
     pub fn contains(&self, j: usize) -> bool {
-        j < self.len && (self.bits >> j) & 1 == 1
+        j < self.len && (self.word(j / 32) >> (j % 32)) & 1 == 1
     }
 
     /// Number of inliers.
     #[must_use]
     pub fn count(&self) -> usize {
-        self.bits.count_ones() as usize
+        (0..4).map(|k| self.word(k).count_ones() as usize).sum()
     }
 
     /// Number of observations tested.
@@ -262,7 +275,8 @@ fn inlier_mask<T: Real>(
 ) -> Result<Inliers, SolveError> {
     let r = pose.rotation().rotation_matrix();
     let t = pose.translation();
-    let mut bits = 0u128;
+    // Four 32-bit words, assembled into the `u128` at the end (see `Inliers::word`).
+    let mut words = [0u32; 4];
     let pairs = problem.world_points.iter().zip(problem.pixels);
     for (k, (p, z)) in pairs.enumerate() {
         let uv = problem
@@ -271,9 +285,15 @@ fn inlier_mask<T: Real>(
             .ok_or(SolveError::PointBehindCamera)?;
         let e = (uv - z) * problem.inv_sigma;
         if e.norm_squared() <= chi2 {
-            bits |= 1u128 << (k % PNP_CAPACITY);
+            if let Some(w) = words.get_mut(k / 32) {
+                *w |= 1 << (k % 32);
+            }
         }
     }
+    let bits = words
+        .iter()
+        .rev()
+        .fold(0u128, |acc, &w| (acc << 32) | u128::from(w));
     Ok(Inliers {
         bits,
         len: problem.world_points.len(),

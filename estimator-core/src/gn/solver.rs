@@ -134,8 +134,8 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
         *self = Self::zeros();
         problem.linearize(state, |e, j| self.add(loss, e, j))?;
         if self.cost.is_finite()
-            && self.gradient.iter().all(|x| x.is_finite())
-            && self.information.iter().all(|x| x.is_finite())
+            && linalg::all_finite(self.gradient.as_slice())
+            && linalg::all_finite(self.information.as_slice())
         {
             Ok(())
         } else {
@@ -334,7 +334,13 @@ where
     if !state.all_finite() || !ne.cost.is_finite() {
         return Err(SolveError::NonFiniteResidual);
     }
-    finish(state, &ne, iterations, initial_cost, status, out)
+    covariance_into(&ne.information, &mut out.covariance)?;
+    out.state = state;
+    out.iterations = iterations;
+    out.initial_cost = initial_cost;
+    out.final_cost = ne.cost;
+    out.status = status;
+    Ok(())
 }
 
 /// The problem-dependent half of an iteration of [`solve_into`], behind `dyn` so that the
@@ -492,31 +498,22 @@ fn iterate<T: Real, const N: usize>(
     Ok((iterations, status))
 }
 
-/// Writes the [`Solution`] at `state` into `out`, with the covariance `A⁻¹` of the last
-/// linearization `ne`. Out of line (see [`damped_step`]): the inverse's temporaries live in its
-/// own frame, not in the iteration's.
+/// The covariance `A⁻¹` of the last linearization, written into `cov`. Out of line (see
+/// [`damped_step`]): the factor's temporaries live in its own frame, not in the iteration's;
+/// per dimension `N`, not per problem.
 ///
 /// # Errors
-/// Those of [`Factor::new`](super::Factor::new) and [`Factor::inverse`](super::Factor::inverse) (then `out` may hold a partial result).
+/// Those of [`Factor::new`](super::Factor::new) and [`Factor::inverse`](super::Factor::inverse)
+/// (then `cov` may hold a partial result).
 #[inline(never)]
-fn finish<T: Real, S, const N: usize>(
-    state: S,
-    ne: &NormalEquations<T, N>,
-    iterations: usize,
-    initial_cost: T,
-    status: Status,
-    out: &mut Solution<T, S, N>,
+fn covariance_into<T: Real, const N: usize>(
+    information: &SMatrix<T, N, N>,
+    cov: &mut SMatrix<T, N, N>,
 ) -> Result<(), SolveError> {
     // `Factor::new` then `Factor::inverse_into`, on one local copy of `A` (the smallest frame).
-    let mut l = ne.information;
+    let mut l = *information;
     linalg::cholesky_in_place(l.as_mut_slice(), N)?;
-    linalg::inverse_in_place(l.as_slice(), N, out.covariance.as_mut_slice())?;
-    out.state = state;
-    out.iterations = iterations;
-    out.initial_cost = initial_cost;
-    out.final_cost = ne.cost;
-    out.status = status;
-    Ok(())
+    linalg::inverse_in_place(l.as_slice(), N, cov.as_mut_slice())
 }
 
 /// Why [`damped_step`] produced no step.

@@ -312,10 +312,11 @@ pub(crate) fn skew_poly<T: Real>(p: T, q: T, w: &Vector3<T>) -> Matrix3<T> {
     )
 }
 
-/// `true` when every number is finite. One out-of-line loop shared by every `is_finite` and
-/// `try_from_matrix` of the groups (a per-element class test inlined at each call site costs
-/// more flash than the call; the check is never on a path where the call matters).
-#[inline(never)]
+/// `true` when every number is finite: one loop for every `is_finite` and `try_from_matrix` of
+/// the groups. No inline attribute on purpose: at opt-level "s" it stays one out-of-line copy (a
+/// class test per element inlined at each call site costs more flash than the call), at
+/// opt-level 3 LLVM inlines it (a call inside the filter's state checks makes their callers
+/// spill registers).
 pub(crate) fn all_finite<T: Real>(xs: &[T]) -> bool {
     xs.iter().all(|x| x.is_finite())
 }

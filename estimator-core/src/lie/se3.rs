@@ -45,7 +45,6 @@ fn join<T: Real>(v: &Vector3<T>, w: &Vector3<T>) -> Vector6<T> {
 }
 
 /// `[[a, b], [0, a]]` from 3×3 blocks (the shape of every SE(3) Jacobian).
-#[inline]
 fn upper_block<T: Real>(diag: &Matrix3<T>, upper: &Matrix3<T>) -> Matrix6<T> {
     let mut m = Matrix6::zeros();
     m.fixed_view_mut::<3, 3>(0, 0).copy_from(diag);
@@ -113,7 +112,6 @@ impl<T: Real> Se3<T> {
         self.translation
     }
 
-    #[inline]
     fn exp_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Self {
         let wv = w.cross(v);
         Self {
@@ -122,20 +120,25 @@ impl<T: Real> Se3<T> {
         }
     }
 
-    #[inline]
     fn jr_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix6<T> {
         upper_block(&So3::jr_from(k, w), &q_block(k, &-v, &-w))
     }
 
-    #[inline]
     fn jr_inv_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix6<T> {
         let jinv = So3::jr_inv_from(k, w);
         let q = q_block(k, &-v, &-w);
         upper_block(&jinv, &-(jinv * q * jinv))
     }
 
+    /// `−Ad_T = [[−R, [−t]×R], [0, −R]]`, built negated (no negation pass over 36 entries);
+    /// `[−t]×R = (Rᵀ[t]×)ᵀ` since `[t]×ᵀ = −[t]×`.
+    fn neg_adjoint(&self) -> Matrix6<T> {
+        let r = self.rotation.rotation_matrix();
+        let tr = mul_skew(&r.transpose(), &self.translation).transpose();
+        upper_block(&-r, &tr)
+    }
+
     /// `log` and the kernel of its rotation angle.
-    #[inline]
     fn log_with_coeffs(&self) -> (Vector6<T>, AngleCoeffs<T>) {
         let (w, k) = self.rotation.log_with_coeffs();
         // J_l⁻¹(ω) t = t − ½ ω×t + d ω×(ω×t).
@@ -207,6 +210,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         self.rotation.act(p) + self.translation
     }
 
+    /// `[[R, [t]×R], [0, R]]`.
     fn adjoint(&self) -> Matrix6<T> {
         let r = self.rotation.rotation_matrix();
         // [t]× R = (Rᵀ[−t]×)ᵀ, since [t]×ᵀ = −[t]×.
@@ -266,6 +270,17 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         let (xi, k) = self.log_with_coeffs();
         let (v, w) = split(&xi);
         (xi, Self::jr_inv_from(&k, &v, &w))
+    }
+
+    /// `(a⁻¹, −Ad_a)`.
+    fn inverse_jac(&self) -> (Self, Matrix6<T>) {
+        (self.inverse(), self.neg_adjoint())
+    }
+
+    /// `(z = a⁻¹·b, −Ad_{z⁻¹}, I)`.
+    fn between_jac(&self, b: &Self) -> (Self, Matrix6<T>, Matrix6<T>) {
+        let z = self.between(b);
+        (z, z.inverse().neg_adjoint(), Matrix6::identity())
     }
 
     /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))` with one trigonometric kernel for the log and both

@@ -23,7 +23,9 @@ impl<T: Real> So2<T> {
     }
 
     /// From `(cos θ, sin θ)` of any non-zero finite norm (normalized); `None` otherwise.
+    /// Out of line: `normalize` and `try_from_matrix` share it (never on a hot path).
     #[must_use]
+    #[inline(never)]
     pub fn from_cos_sin(re: T, im: T) -> Option<Self> {
         let n2 = re * re + im * im;
         if !(n2.is_finite() && n2 > T::zero()) {

@@ -123,7 +123,6 @@ impl<T: Real> So3<T> {
     }
 
     /// `log` plus the half-angle sine and cosine it found, to build the kernel without trigonometry.
-    #[inline]
     fn log_parts(&self) -> (Vector3<T>, T, T, T) {
         let (w, v) = self.principal();
         let n2 = v.norm_squared();

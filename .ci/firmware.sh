@@ -133,13 +133,28 @@ else
     || { cat "$OUT/nopanic-selftest.log"; fail "no-panic self-test failed for another reason"; }
 fi
 
+# Single-purpose firmware (attitude filter, inertial filter, PnP): each must link (no panic path)
+# at opt-level "s" and 3; their flash is budgeted below.
+for b in fp_ahrs fp_ins fp_pnp; do
+  for profile in release-s release; do
+    rm -f "target/$TARGET/$profile/$b"
+    if cargo build --profile "$profile" --bin "$b" 2> "$OUT/$b-$profile.log"; then
+      echo "footprint binary $b ($profile): links, no panic path reachable"
+    else
+      grep -E 'undefined symbol|referenced by|^error' "$OUT/$b-$profile.log" | sed -n '1,5p' || true
+      fail "footprint binary $b ($profile) does not link"
+    fi
+  done
+done
+
 # Symbols of f64 soft-float routines (compiler-builtins / the ARM EABI): double-precision
 # arithmetic, comparisons and conversions.
 F64_RE='(__aeabi_d[a-z0-9]+|__aeabi_[a-z0-9]+2d|__aeabi_f2d|__[a-z]+df[23]|__fix(uns)?df[sd]i|__float(un)?[sd]idf|__extendsfdf2|__truncdfsf2)$'
 step "f32 paths free of f64 soft-float (symbols matching $F64_RE)"
 f64_found=0
 for elf in "$DEMO3" "$DEMOS" "target/$TARGET/release/nopanic" "target/$TARGET/release-s/nopanic" \
-  "target/locate/$TARGET/release/nopanic" "target/locate/$TARGET/release-s/nopanic"; do
+  "target/locate/$TARGET/release/nopanic" "target/locate/$TARGET/release-s/nopanic" \
+  target/$TARGET/release-s/fp_ahrs target/$TARGET/release-s/fp_ins target/$TARGET/release-s/fp_pnp; do
   [ -f "$elf" ] || continue
   syms=$(llvm-nm "$elf" | awk '{ print $NF }' | grep -E "$F64_RE" | sort -u | tr '\n' ' ' || true)
   if [ -n "$syms" ]; then
@@ -176,7 +191,9 @@ sect() { # elf section -> bytes
 }
 for v in demo3:$DEMO3 demo_s:$DEMOS nopanic3:target/$TARGET/release/nopanic \
   nopanic_s:target/$TARGET/release-s/nopanic \
-  nopanic3:target/locate/$TARGET/release/nopanic nopanic_s:target/locate/$TARGET/release-s/nopanic; do
+  nopanic3:target/locate/$TARGET/release/nopanic nopanic_s:target/locate/$TARGET/release-s/nopanic \
+  fp_ahrs_s:target/$TARGET/release-s/fp_ahrs fp_ins_s:target/$TARGET/release-s/fp_ins \
+  fp_pnp_s:target/$TARGET/release-s/fp_pnp; do
   name=${v%%:*} elf=${v#*:}
   [ -f "$elf" ] || continue
   grep -q "^flash.$name " "$OUT/extra.txt" && continue

@@ -1,0 +1,43 @@
+//! What the footprint binaries (`src/bin/fp_*.rs`) share: opaque sensor input, a sink for
+//! results, and the no-panic handler.
+//!
+//! Each footprint binary is the smallest realistic firmware for one use of estimator-core (an
+//! attitude filter, an inertial filter, a PnP solver): its loop reads opaque samples and calls
+//! only what such firmware calls. Their flash at opt-level "s" is what a user of that part
+//! alone pays, next to the `nopanic` binary that links the whole public API. Like `nopanic`,
+//! they link only if no panic path is reachable.
+
+use core::hint::black_box;
+
+/// An opaque `f32`: the optimizer knows nothing of it (a sensor register, in real firmware).
+#[inline(always)]
+pub fn input(i: usize) -> f32 {
+    static SAMPLES: [f32; 8] = [0.01, -0.02, 0.03, 9.81, 0.2, 0.4, 1.5, 0.005];
+    let s = black_box(&SAMPLES);
+    s.get(i % 8).copied().unwrap_or(0.0)
+}
+
+/// Keeps a result alive: its address goes to `black_box`.
+#[inline(always)]
+pub fn keep<X>(x: &X) {
+    black_box(x);
+}
+
+#[cfg(not(feature = "locate-panics"))]
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    extern "C" {
+        /// Defined nowhere: referencing it makes the link fail if a panic is reachable.
+        fn __estimator_core_panic_path_reachable() -> !;
+    }
+    // SAFETY: never executed when the binary links (the symbol does not exist).
+    unsafe { __estimator_core_panic_path_reachable() }
+}
+
+#[cfg(feature = "locate-panics")]
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    loop {
+        cortex_m::asm::nop();
+    }
+}

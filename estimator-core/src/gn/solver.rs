@@ -581,11 +581,32 @@ fn damped_step<T: Real, const N: usize>(
     if !linalg::all_finite(step.as_slice()) {
         return Err(StepError::Solve(SolveError::NonFiniteResidual));
     }
-    Ok(StepStats {
-        norm: step.norm(),
-        info: step.dot(&(ne.information * *step)),
-        gradient: step.dot(&ne.gradient),
-    })
+    Ok(step_stats(
+        ne.information.as_slice(),
+        ne.gradient.as_slice(),
+        step.as_slice(),
+    ))
+}
+
+/// `‖ξ‖`, `ξᵀAξ` and `ξᵀg` for the column-major `n × n` matrix `a` (`n` the length of `step`):
+/// one copy of the code for every dimension.
+#[inline(never)]
+fn step_stats<T: Real>(a: &[T], g: &[T], step: &[T]) -> StepStats<T> {
+    let dot = |x: &[T], y: &[T]| x.iter().zip(y).fold(T::zero(), |acc, (&p, &q)| acc + p * q);
+    let n = step.len();
+    // ξᵀAξ = Σ_c ξ_c (A ξ)_c, with (A ξ)_c = Σ_r A_rc ξ_r for the symmetric A (column c of A).
+    let info = if n == 0 {
+        T::zero()
+    } else {
+        a.chunks_exact(n)
+            .zip(step)
+            .fold(T::zero(), |acc, (col, &x)| acc + x * dot(col, step))
+    };
+    StepStats {
+        norm: dot(step, step).sqrt(),
+        info,
+        gradient: dot(step, g),
+    }
 }
 
 /// Marquardt scaling on the diagonal of the column-major `n × n` matrix `a`:

@@ -73,6 +73,21 @@ fn unit<T: Real>(v: &Vector3<T>) -> Option<Vector3<T>> {
     }
 }
 
+/// The orthonormal triad `(u, u×v/‖u×v‖, u×(u×v)/‖u×v‖)` of the unit vector `u` and a second
+/// direction `v`, as the columns of a matrix; `None` when they are parallel. Out of line: both
+/// frames of [`triad`] share it.
+#[inline(never)]
+fn triad_frame<T: Real>(u: &Vector3<T>, v: &Vector3<T>) -> Option<Matrix3<T>> {
+    let n = u.cross(v);
+    let nn = n.norm();
+    let not_parallel = nn > T::lit(PARALLEL_REL);
+    if !not_parallel {
+        return None;
+    }
+    let s = n / nn;
+    Some(Matrix3::from_columns(&[*u, s, u.cross(&s)]))
+}
+
 /// The TRIAD rotation `W Bᵀ` from two body/world pairs of unit vectors.
 fn triad<T: Real>(
     b1: &Vector3<T>,
@@ -80,18 +95,8 @@ fn triad<T: Real>(
     w1: &Vector3<T>,
     w2: &Vector3<T>,
 ) -> Option<So3<T>> {
-    let frame = |u: &Vector3<T>, v: &Vector3<T>| -> Option<Matrix3<T>> {
-        let n = u.cross(v);
-        let nn = n.norm();
-        let not_parallel = nn > T::lit(PARALLEL_REL);
-        if !not_parallel {
-            return None;
-        }
-        let s = n / nn;
-        Some(Matrix3::from_columns(&[*u, s, u.cross(&s)]))
-    };
-    let b = frame(b1, b2)?;
-    let w = frame(w1, w2)?;
+    let b = triad_frame(b1, b2)?;
+    let w = triad_frame(w1, w2)?;
     So3::from_rotation_matrix(&(w * b.transpose()))
 }
 

@@ -318,19 +318,21 @@ where
     if !initial.all_finite() {
         return Err(SolveError::NonFiniteGuess);
     }
-    let mut run = Run::<T, S, P, K> {
+    let mut run = Run::<T, S, P, N, K> {
         problem,
         loss: options.loss,
         state: *initial,
         candidate: *initial,
+        ne: NormalEquations::zeros(),
+        // The trial linearization, reused across iterations.
+        trial: NormalEquations::zeros(),
+        step: SVector::zeros(),
     };
-    let mut ne = NormalEquations::zeros();
-    ne.rebuild(problem, &run.state, &run.loss)?;
-    let initial_cost = ne.cost;
-    // The trial linearization, reused across iterations.
-    let mut trial = NormalEquations::zeros();
-    let (iterations, status) = iterate(&mut run, &mut ne, &mut trial, options)?;
+    run.ne.rebuild(problem, &run.state, &run.loss)?;
+    let initial_cost = run.ne.cost;
+    let (iterations, status) = iterate(&mut run, options)?;
     let state = run.state;
+    let ne = &run.ne;
     if !state.all_finite() || !ne.cost.is_finite() {
         return Err(SolveError::NonFiniteResidual);
     }
@@ -343,58 +345,93 @@ where
     Ok(())
 }
 
-/// The problem-dependent half of an iteration of [`solve_into`], behind `dyn` so that the
-/// iteration itself ([`iterate`]: damping, gain ratio, acceptance, convergence) is compiled once
-/// per dimension `N`, not once per problem.
-trait Candidate<T: Real, const N: usize> {
-    /// Forms the candidate `a ⊕ ξ` (seed eq. 4.5) from the current state; `true` when it is
-    /// finite.
-    fn propose(&mut self, step: &SVector<T, N>) -> bool;
-    /// The normal equations at the candidate, into `ne` ([`NormalEquations::rebuild`]).
-    fn linearize(&mut self, ne: &mut NormalEquations<T, N>) -> Result<(), SolveError>;
-    /// The candidate becomes the state.
-    fn accept(&mut self);
+/// What [`iterate`] needs of a step `ξ`: `‖ξ‖`, the model decrease terms `ξᵀAξ` and `ξᵀg`.
+#[derive(Clone, Copy)]
+struct StepStats<T> {
+    norm: T,
+    info: T,
+    gradient: T,
 }
 
-/// The state of [`solve_into`]: the problem, its loss, the current state and the candidate.
-struct Run<'a, T: Real, S, P: ?Sized, const K: usize> {
+/// The problem- and dimension-dependent half of an iteration of [`solve_into`], behind `dyn`, so
+/// that the iteration itself ([`iterate`]: damping, gain ratio, acceptance, convergence) is
+/// compiled once, not once per problem or per dimension.
+trait Candidate<T: Real> {
+    /// The cost `F` of the current linearization.
+    fn cost(&self) -> T;
+    /// The cost of the trial linearization.
+    fn trial_cost(&self) -> T;
+    /// Solves for the step `ξ` from the current linearization with damping `λ` (see
+    /// [`damped_step`]) and keeps it.
+    fn solve_step(&mut self, lambda: T, lm: bool) -> Result<StepStats<T>, StepError>;
+    /// Forms the candidate `a ⊕ ξ` (seed eq. 4.5) from the current state and the kept step;
+    /// `true` when it is finite.
+    fn propose(&mut self) -> bool;
+    /// The normal equations at the candidate, into the trial ([`NormalEquations::rebuild`]).
+    fn linearize(&mut self) -> Result<(), SolveError>;
+    /// The candidate becomes the state; with `adopt_trial` the trial linearization becomes the
+    /// current one (the old one is scratch from then on).
+    fn accept(&mut self, adopt_trial: bool);
+}
+
+/// The state of [`solve_into`]: the problem, its loss, the current state and the candidate, the
+/// linearization at the state and the trial one, and the last step.
+struct Run<'a, T: Real, S, P: ?Sized, const N: usize, const K: usize> {
     problem: &'a P,
     loss: Loss<T>,
     state: S,
     candidate: S,
+    ne: NormalEquations<T, N>,
+    trial: NormalEquations<T, N>,
+    step: SVector<T, N>,
 }
 
-impl<T, S, P, const N: usize, const K: usize> Candidate<T, N> for Run<'_, T, S, P, K>
+impl<T, S, P, const N: usize, const K: usize> Candidate<T> for Run<'_, T, S, P, N, K>
 where
     T: Real,
     S: Manifold<T, N>,
     P: Problem<T, S, N, K> + ?Sized,
 {
-    fn propose(&mut self, step: &SVector<T, N>) -> bool {
-        self.candidate = self.state.oplus(step);
+    fn cost(&self) -> T {
+        self.ne.cost
+    }
+
+    fn trial_cost(&self) -> T {
+        self.trial.cost
+    }
+
+    fn solve_step(&mut self, lambda: T, lm: bool) -> Result<StepStats<T>, StepError> {
+        damped_step(&self.ne, lambda, lm, &mut self.step)
+    }
+
+    fn propose(&mut self) -> bool {
+        self.candidate = self.state.oplus(&self.step);
         self.candidate.all_finite()
     }
 
-    fn linearize(&mut self, ne: &mut NormalEquations<T, N>) -> Result<(), SolveError> {
-        ne.rebuild(self.problem, &self.candidate, &self.loss)
+    fn linearize(&mut self) -> Result<(), SolveError> {
+        self.trial
+            .rebuild(self.problem, &self.candidate, &self.loss)
     }
 
-    fn accept(&mut self) {
+    fn accept(&mut self, adopt_trial: bool) {
         self.state = self.candidate;
+        if adopt_trial {
+            core::mem::swap(&mut self.ne, &mut self.trial);
+        }
     }
 }
 
-/// The Gauss-Newton / Levenberg-Marquardt iteration of [`solve_into`] from the linearization
-/// `ne` at the current state of `run` (see the [module docs](crate::gn)): returns the iterations
-/// run and why it stopped, with `ne` the linearization at the final state (or just before a
-/// converged step, see [`Solution::final_cost`]). `trial` is scratch space.
+/// The Gauss-Newton / Levenberg-Marquardt iteration of [`solve_into`] from the linearization at
+/// the current state of `run` (see the [module docs](crate::gn)): returns the iterations run and
+/// why it stopped, with `run`'s linearization the one at the final state (or just before a
+/// converged step, see [`Solution::final_cost`]).
 ///
 /// # Errors
 /// As [`solve`], for the failures that happen during the iteration.
-fn iterate<T: Real, const N: usize>(
-    run: &mut dyn Candidate<T, N>,
-    ne: &mut NormalEquations<T, N>,
-    trial: &mut NormalEquations<T, N>,
+#[inline(never)]
+fn iterate<T: Real>(
+    run: &mut dyn Candidate<T>,
     options: &SolverOptions<T>,
 ) -> Result<(usize, Status), SolveError> {
     let mut lambda = options.initial_damping;
@@ -405,11 +442,12 @@ fn iterate<T: Real, const N: usize>(
 
     while iterations < options.max_iterations {
         iterations += 1;
-        if ne.cost <= T::zero() {
+        let cost = run.cost();
+        if cost <= T::zero() {
             status = Status::CostConverged;
             break;
         }
-        let step = match damped_step(ne, lambda, lm) {
+        let step = match run.solve_step(lambda, lm) {
             Ok(s) => s,
             Err(StepError::Solve(e)) => return Err(e),
             Err(StepError::Factor(e)) if !lm => return Err(e),
@@ -423,35 +461,34 @@ fn iterate<T: Real, const N: usize>(
                 continue;
             }
         };
-        let step_norm = step.norm();
-        let step_info = step.dot(&(ne.information * step));
         let small_step =
-            step_norm <= options.step_tolerance || step_info <= options.information_step_tolerance;
-        let candidate_finite = run.propose(&step);
+            step.norm <= options.step_tolerance || step.info <= options.information_step_tolerance;
+        let candidate_finite = run.propose();
         // A converged step (Gauss-Newton, or Levenberg-Marquardt with little damping) is taken
         // without another pass over the residuals: it moves the state by at most
         // `√information_step_tolerance` standard deviations, so the information, cost and
         // covariance of the current linearization hold to that order.
-        if step_info <= options.information_step_tolerance
+        if step.info <= options.information_step_tolerance
             && (!lm || lambda <= T::one())
             && candidate_finite
         {
-            run.accept();
+            run.accept(false);
             status = Status::StepConverged;
             break;
         }
         let built = if candidate_finite {
-            run.linearize(trial)
+            run.linearize()
         } else {
             Err(SolveError::NonFiniteResidual)
         };
+        let trial_cost = run.trial_cost();
         let accepted = match built {
             Ok(()) => {
                 if lm {
                     // Gain ratio of the actual to the predicted decrease of the weighted model
                     // F(ξ) ≈ F + 2ξᵀg + ξᵀAξ: predicted = −2ξᵀg − ξᵀAξ.
-                    let actual = ne.cost - trial.cost;
-                    let predicted = -(step.dot(&ne.gradient) * T::lit(2.0)) - step_info;
+                    let actual = cost - trial_cost;
+                    let predicted = -(step.gradient * T::lit(2.0)) - step.info;
                     if actual > T::zero() && predicted > T::zero() {
                         let r = actual / predicted;
                         let c = T::lit(2.0) * r - T::one();
@@ -469,16 +506,13 @@ fn iterate<T: Real, const N: usize>(
             Err(_) => false,
         };
         if accepted {
-            let decrease = ne.cost - trial.cost;
-            let old_cost = ne.cost;
-            run.accept();
-            // The trial becomes the linearization (the old one is scratch from here on).
-            core::mem::swap(ne, trial);
+            let decrease = cost - trial_cost;
+            run.accept(true);
             if small_step {
                 status = Status::StepConverged;
                 break;
             }
-            if decrease >= T::zero() && decrease <= options.cost_tolerance * old_cost {
+            if decrease >= T::zero() && decrease <= options.cost_tolerance * cost {
                 status = Status::CostConverged;
                 break;
             }
@@ -524,15 +558,17 @@ enum StepError {
     Solve(SolveError),
 }
 
-/// The step `ξ` of one iteration: `(A + λ diag A) ξ = −g` (Levenberg-Marquardt, `lm`) or
-/// `A ξ = −g` (Gauss-Newton). Kept out of line so its `N × N` temporaries (the damped matrix,
-/// its factor) do not share a frame with the linearization.
+/// The step `ξ` of one iteration, into `step`: `(A + λ diag A) ξ = −g` (Levenberg-Marquardt,
+/// `lm`) or `A ξ = −g` (Gauss-Newton), with the figures [`iterate`] needs. Kept out of line so
+/// its `N × N` temporary (the damped matrix and its factor) does not share a frame with the
+/// linearization; one copy per dimension `N`.
 #[inline(never)]
 fn damped_step<T: Real, const N: usize>(
     ne: &NormalEquations<T, N>,
     lambda: T,
     lm: bool,
-) -> Result<SVector<T, N>, StepError> {
+    step: &mut SVector<T, N>,
+) -> Result<StepStats<T>, StepError> {
     let mut damped = ne.information;
     if lm {
         damp(damped.as_mut_slice(), N, lambda);
@@ -540,12 +576,36 @@ fn damped_step<T: Real, const N: usize>(
     // Factorized in place (what `Factor::new` and `Factor::solve` do, without a second
     // `N × N` copy in this frame).
     linalg::cholesky_in_place(damped.as_mut_slice(), N).map_err(StepError::Factor)?;
-    let mut step = -ne.gradient;
+    *step = -ne.gradient;
     linalg::substitute(damped.as_slice(), N, step.as_mut_slice());
-    if linalg::all_finite(step.as_slice()) {
-        Ok(step)
+    if !linalg::all_finite(step.as_slice()) {
+        return Err(StepError::Solve(SolveError::NonFiniteResidual));
+    }
+    Ok(step_stats(
+        ne.information.as_slice(),
+        ne.gradient.as_slice(),
+        step.as_slice(),
+    ))
+}
+
+/// `‖ξ‖`, `ξᵀAξ` and `ξᵀg` for the column-major `n × n` matrix `a` (`n` the length of `step`):
+/// one copy of the code for every dimension.
+#[inline(never)]
+fn step_stats<T: Real>(a: &[T], g: &[T], step: &[T]) -> StepStats<T> {
+    let dot = |x: &[T], y: &[T]| x.iter().zip(y).fold(T::zero(), |acc, (&p, &q)| acc + p * q);
+    let n = step.len();
+    // ξᵀAξ = Σ_c ξ_c (A ξ)_c, with (A ξ)_c = Σ_r A_rc ξ_r for the symmetric A (column c of A).
+    let info = if n == 0 {
+        T::zero()
     } else {
-        Err(StepError::Solve(SolveError::NonFiniteResidual))
+        a.chunks_exact(n)
+            .zip(step)
+            .fold(T::zero(), |acc, (col, &x)| acc + x * dot(col, step))
+    };
+    StepStats {
+        norm: dot(step, step).sqrt(),
+        info,
+        gradient: dot(step, g),
     }
 }
 

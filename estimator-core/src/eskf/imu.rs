@@ -144,35 +144,40 @@ fn sum_times_zero_is_zero<T: Real>(s: &[T]) -> bool {
     s.iter().fold(z, |acc, x| acc + *x * z) == z
 }
 
-/// Block `(i, j)` (3×3, offsets `3i, 3j`) of an `R × C` matrix, read element by element (zero
-/// outside the matrix; with `i, j` known, the bounds checks fold away).
+/// Block `(i, j)` (3×3, offsets `3i, 3j`) of an `R × C` matrix (zero outside the matrix),
+/// read as three column pieces of the column-major storage.
 pub(crate) fn blk_rc<T: Real, const R: usize, const C: usize>(
     m: &SMatrix<T, R, C>,
     i: usize,
     j: usize,
 ) -> Matrix3<T> {
-    let mut b = Matrix3::zeros();
-    for c in 0..3 {
-        for r in 0..3 {
-            if let (Some(d), Some(s)) = (b.get_mut((r, c)), m.get((3 * i + r, 3 * j + c))) {
-                *d = *s;
-            }
+    let col = |c: usize| {
+        let s = R * (3 * j + c) + 3 * i;
+        match m.as_slice().get(s..s + 3) {
+            Some(&[a, b, c]) if 3 * i + 3 <= R => [a, b, c],
+            _ => [T::zero(); 3],
         }
-    }
-    b
+    };
+    let ([a0, a1, a2], [b0, b1, b2], [c0, c1, c2]) = (col(0), col(1), col(2));
+    Matrix3::new(a0, b0, c0, a1, b1, c1, a2, b2, c2)
 }
 
-/// Writes block `(i, j)` of an `R × C` matrix element by element.
+/// Writes block `(i, j)` of an `R × C` matrix, column piece by column piece (nothing outside
+/// the matrix).
 pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
     m: &mut SMatrix<T, R, C>,
     i: usize,
     j: usize,
     v: &Matrix3<T>,
 ) {
-    for c in 0..3 {
-        for r in 0..3 {
-            if let (Some(d), Some(s)) = (m.get_mut((3 * i + r, 3 * j + c)), v.get((r, c))) {
-                *d = *s;
+    if 3 * i + 3 > R {
+        return;
+    }
+    for (c, src) in v.as_slice().chunks_exact(3).enumerate() {
+        let s = R * (3 * j + c) + 3 * i;
+        if let Some(dst) = m.as_mut_slice().get_mut(s..s + 3) {
+            for (d, x) in dst.iter_mut().zip(src) {
+                *d = *x;
             }
         }
     }
@@ -446,21 +451,25 @@ pub(crate) fn greater<T: Real>(a: T, b: T) -> bool {
 }
 
 /// `a · b` for 3×3 matrices: `(a b)_rc = a_r0 b_0c + a_r1 b_1c + a_r2 b_2c`, column by column
-/// (nalgebra's generic product is not unrolled for a generic scalar). Loops, so that opt-level
-/// "s" keeps them small; opt-level 3 unrolls them completely. No inline hint: opt-level "s"
-/// then keeps one out-of-line copy, opt-level 3 still inlines it.
+/// (nalgebra's generic product is not unrolled for a generic scalar). A loop over the columns
+/// of `b`, so that opt-level "s" keeps it small; opt-level 3 unrolls it completely. No inline
+/// hint: opt-level "s" then keeps one out-of-line copy, opt-level 3 still inlines it.
 pub(crate) fn mm<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    let (r0, r1, r2) = (
+        (a.m11, a.m12, a.m13),
+        (a.m21, a.m22, a.m23),
+        (a.m31, a.m32, a.m33),
+    );
     let mut out = Matrix3::zeros();
-    let ga = |r: usize, k: usize| a.get((r, k)).copied().unwrap_or_else(T::zero);
     for (oc, bc) in out
         .as_mut_slice()
         .chunks_exact_mut(3)
         .zip(b.as_slice().chunks_exact(3))
     {
-        if let [b0, b1, b2] = *bc {
-            for (r, o) in oc.iter_mut().enumerate() {
-                *o = ga(r, 0) * b0 + ga(r, 1) * b1 + ga(r, 2) * b2;
-            }
+        if let ([o0, o1, o2], [b0, b1, b2]) = (oc, bc) {
+            *o0 = r0.0 * *b0 + r0.1 * *b1 + r0.2 * *b2;
+            *o1 = r1.0 * *b0 + r1.1 * *b1 + r1.2 * *b2;
+            *o2 = r2.0 * *b0 + r2.1 * *b1 + r2.2 * *b2;
         }
     }
     out

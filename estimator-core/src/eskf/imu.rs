@@ -299,23 +299,24 @@ pub(crate) fn predict_ins<T: Real>(
     check_dt(dt, cfg.max_dt)?;
     let half = T::lit(0.5);
 
-    let omega = imu.gyro - x.gyro_bias;
-    let f = imu.accel - x.accel_bias;
+    // `a + b·(−1)` is `a − b` exactly (IEEE 754 negation is exact).
+    let omega = axpy(&imu.gyro, &x.gyro_bias, -T::one());
+    let f = axpy(&imu.accel, &x.accel_bias, -T::one());
     let (dr, jr) = So3::exp_jac(&(omega * dt));
     let r = x.attitude.rotation_matrix();
     let a = r * f + cfg.gravity;
     let new_x = InsState {
         attitude: x.attitude.compose(&dr).renormalize(),
-        velocity: x.velocity + a * dt,
-        position: x.position + x.velocity * dt + a * (half * dt * dt),
+        velocity: axpy(&x.velocity, &a, dt),
+        position: axpy(&axpy(&x.position, &x.velocity, dt), &a, half * dt * dt),
         gyro_bias: x.gyro_bias,
         accel_bias: x.accel_bias,
     };
 
     let fr = FRows {
         f00: dr.rotation_matrix().transpose(),
-        f03: jr * (-dt),
-        b: r * (-dt),
+        f03: scaled(jr, -dt),
+        b: scaled(r, -dt),
         fx: skew(&f),
         dt,
     };
@@ -411,9 +412,9 @@ pub(crate) fn predict_ahrs<T: Real>(
         return Err(EskfError::NonFinite);
     }
     check_dt(dt, cfg.max_dt)?;
-    let (dr, jr) = So3::exp_jac(&((gyro - x.gyro_bias) * dt));
+    let (dr, jr) = So3::exp_jac(&(axpy(gyro, &x.gyro_bias, -T::one()) * dt));
     let f00 = dr.rotation_matrix().transpose();
-    let f01 = jr * (-dt);
+    let f01 = scaled(jr, -dt);
     let p00 = blk(p, 0, 0);
     let p01 = blk(p, 0, 1);
     let p11 = blk(p, 1, 1);
@@ -442,6 +443,19 @@ pub(crate) fn predict_ahrs<T: Real>(
     add_diag(p, 1, n.gyroscope_random_walk * n.gyroscope_random_walk * dt);
     x.attitude = att;
     Ok(())
+}
+
+/// `m·s`, entry by entry over the storage (one small loop at opt-level "s").
+fn scaled<T: Real>(mut m: Matrix3<T>, s: T) -> Matrix3<T> {
+    for x in m.as_mut_slice() {
+        *x *= s;
+    }
+    m
+}
+
+/// `y + x·a`, entry by entry (one small function for the nominal integration).
+fn axpy<T: Real>(y: &Vector3<T>, x: &Vector3<T>, a: T) -> Vector3<T> {
+    Vector3::new(y.x + x.x * a, y.y + x.y * a, y.z + x.z * a)
 }
 
 /// `a > b`, false for NaN (named so that `!greater(a, b)` reads as "not above, or NaN").

@@ -342,7 +342,8 @@ pub(crate) fn predict_ins<T: Real>(
         let Some(q) = block_column(src, j) else {
             continue;
         };
-        // (F00 Q₀ + F03 Q₃ is not needed below the diagonal: N_0i for i > 0.)
+        // Row θ of F Q: for every column of F P, but of F L only N_00 (N_0i, i > 0, lies above
+        // the diagonal).
         let out = fr.apply(q, t <= 5);
         for (i, m) in out.iter().enumerate() {
             if t < 5 {

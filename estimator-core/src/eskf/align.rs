@@ -62,6 +62,12 @@ fn horizontal<T: Real>(v: &Vector3<T>, u: &Vector3<T>) -> Option<Vector3<T>> {
     }
 }
 
+/// Without a magnetometer: the horizontal direction of the `x` axis, or of the `y` axis when
+/// `x` is along `u` (module docs).
+fn level_axis<T: Real>(u: &Vector3<T>) -> Option<Vector3<T>> {
+    horizontal(&Vector3::x(), u).or_else(|| horizontal(&Vector3::y(), u))
+}
+
 /// Static alignment from samples at rest.
 ///
 /// `accel`, `gyro`: the IMU window (body frame, same length not required); `gravity`: the
@@ -90,26 +96,20 @@ pub fn align_at_rest<T: Real>(
     }
     let ub = f / nf;
     let uw = -gravity / ng;
-    let (hb, hw, from_mag) = match mag {
+    let (hb, hw) = match mag {
         Some(m) => {
             let mb = mean(m.samples)?;
             if !finite(&m.reference) {
                 return Err(EskfError::NonFinite);
             }
-            let hb = horizontal(&mb, &ub).ok_or(EskfError::ZeroNorm)?;
-            let hw = horizontal(&m.reference, &uw).ok_or(EskfError::ZeroNorm)?;
-            (hb, hw, true)
+            (horizontal(&mb, &ub), horizontal(&m.reference, &uw))
         }
-        None => {
-            let hb = horizontal(&Vector3::x(), &ub)
-                .or_else(|| horizontal(&Vector3::y(), &ub))
-                .ok_or(EskfError::ZeroNorm)?;
-            let hw = horizontal(&Vector3::x(), &uw)
-                .or_else(|| horizontal(&Vector3::y(), &uw))
-                .ok_or(EskfError::ZeroNorm)?;
-            (hb, hw, false)
-        }
+        None => (level_axis(&ub), level_axis(&uw)),
     };
+    let (Some(hb), Some(hw)) = (hb, hw) else {
+        return Err(EskfError::ZeroNorm);
+    };
+    let from_mag = mag.is_some();
     let b = Matrix3::from_columns(&[ub, hb, ub.cross(&hb)]);
     let wm = Matrix3::from_columns(&[uw, hw, uw.cross(&hw)]);
     let attitude =

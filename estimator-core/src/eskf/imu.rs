@@ -144,35 +144,40 @@ fn sum_times_zero_is_zero<T: Real>(s: &[T]) -> bool {
     s.iter().fold(z, |acc, x| acc + *x * z) == z
 }
 
-/// Block `(i, j)` (3×3, offsets `3i, 3j`) of an `R × C` matrix, read element by element (zero
-/// outside the matrix; with `i, j` known, the bounds checks fold away).
+/// Block `(i, j)` (3×3, offsets `3i, 3j`) of an `R × C` matrix (zero outside the matrix),
+/// read as three column pieces of the column-major storage.
 pub(crate) fn blk_rc<T: Real, const R: usize, const C: usize>(
     m: &SMatrix<T, R, C>,
     i: usize,
     j: usize,
 ) -> Matrix3<T> {
-    let mut b = Matrix3::zeros();
-    for c in 0..3 {
-        for r in 0..3 {
-            if let (Some(d), Some(s)) = (b.get_mut((r, c)), m.get((3 * i + r, 3 * j + c))) {
-                *d = *s;
-            }
+    let col = |c: usize| {
+        let s = R * (3 * j + c) + 3 * i;
+        match m.as_slice().get(s..s + 3) {
+            Some(&[a, b, c]) if 3 * i + 3 <= R => [a, b, c],
+            _ => [T::zero(); 3],
         }
-    }
-    b
+    };
+    let ([a0, a1, a2], [b0, b1, b2], [c0, c1, c2]) = (col(0), col(1), col(2));
+    Matrix3::new(a0, b0, c0, a1, b1, c1, a2, b2, c2)
 }
 
-/// Writes block `(i, j)` of an `R × C` matrix element by element.
+/// Writes block `(i, j)` of an `R × C` matrix, column piece by column piece (nothing outside
+/// the matrix).
 pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
     m: &mut SMatrix<T, R, C>,
     i: usize,
     j: usize,
     v: &Matrix3<T>,
 ) {
-    for c in 0..3 {
-        for r in 0..3 {
-            if let (Some(d), Some(s)) = (m.get_mut((3 * i + r, 3 * j + c)), v.get((r, c))) {
-                *d = *s;
+    if 3 * i + 3 > R {
+        return;
+    }
+    for (c, src) in v.as_slice().chunks_exact(3).enumerate() {
+        let s = R * (3 * j + c) + 3 * i;
+        if let Some(dst) = m.as_mut_slice().get_mut(s..s + 3) {
+            for (d, x) in dst.iter_mut().zip(src) {
+                *d = *x;
             }
         }
     }
@@ -294,23 +299,24 @@ pub(crate) fn predict_ins<T: Real>(
     check_dt(dt, cfg.max_dt)?;
     let half = T::lit(0.5);
 
-    let omega = imu.gyro - x.gyro_bias;
-    let f = imu.accel - x.accel_bias;
+    // `a + b·(−1)` is `a − b` exactly (IEEE 754 negation is exact).
+    let omega = axpy(&imu.gyro, &x.gyro_bias, -T::one());
+    let f = axpy(&imu.accel, &x.accel_bias, -T::one());
     let (dr, jr) = So3::exp_jac(&(omega * dt));
     let r = x.attitude.rotation_matrix();
     let a = r * f + cfg.gravity;
     let new_x = InsState {
         attitude: x.attitude.compose(&dr).renormalize(),
-        velocity: x.velocity + a * dt,
-        position: x.position + x.velocity * dt + a * (half * dt * dt),
+        velocity: axpy(&x.velocity, &a, dt),
+        position: axpy(&axpy(&x.position, &x.velocity, dt), &a, half * dt * dt),
         gyro_bias: x.gyro_bias,
         accel_bias: x.accel_bias,
     };
 
     let fr = FRows {
         f00: dr.rotation_matrix().transpose(),
-        f03: jr * (-dt),
-        b: r * (-dt),
+        f03: scaled(jr, -dt),
+        b: scaled(r, -dt),
         fx: skew(&f),
         dt,
     };
@@ -336,7 +342,8 @@ pub(crate) fn predict_ins<T: Real>(
         let Some(q) = block_column(src, j) else {
             continue;
         };
-        // (F00 Q₀ + F03 Q₃ is not needed below the diagonal: N_0i for i > 0.)
+        // Row θ of F Q: for every column of F P, but of F L only N_00 (N_0i, i > 0, lies above
+        // the diagonal).
         let out = fr.apply(q, t <= 5);
         for (i, m) in out.iter().enumerate() {
             if t < 5 {
@@ -406,9 +413,9 @@ pub(crate) fn predict_ahrs<T: Real>(
         return Err(EskfError::NonFinite);
     }
     check_dt(dt, cfg.max_dt)?;
-    let (dr, jr) = So3::exp_jac(&((gyro - x.gyro_bias) * dt));
+    let (dr, jr) = So3::exp_jac(&(axpy(gyro, &x.gyro_bias, -T::one()) * dt));
     let f00 = dr.rotation_matrix().transpose();
-    let f01 = jr * (-dt);
+    let f01 = scaled(jr, -dt);
     let p00 = blk(p, 0, 0);
     let p01 = blk(p, 0, 1);
     let p11 = blk(p, 1, 1);
@@ -439,6 +446,19 @@ pub(crate) fn predict_ahrs<T: Real>(
     Ok(())
 }
 
+/// `m·s`, entry by entry over the storage (one small loop at opt-level "s").
+fn scaled<T: Real>(mut m: Matrix3<T>, s: T) -> Matrix3<T> {
+    for x in m.as_mut_slice() {
+        *x *= s;
+    }
+    m
+}
+
+/// `y + x·a`, entry by entry (one small function for the nominal integration).
+fn axpy<T: Real>(y: &Vector3<T>, x: &Vector3<T>, a: T) -> Vector3<T> {
+    Vector3::new(y.x + x.x * a, y.y + x.y * a, y.z + x.z * a)
+}
+
 /// `a > b`, false for NaN (named so that `!greater(a, b)` reads as "not above, or NaN").
 #[inline(always)]
 pub(crate) fn greater<T: Real>(a: T, b: T) -> bool {
@@ -446,21 +466,25 @@ pub(crate) fn greater<T: Real>(a: T, b: T) -> bool {
 }
 
 /// `a · b` for 3×3 matrices: `(a b)_rc = a_r0 b_0c + a_r1 b_1c + a_r2 b_2c`, column by column
-/// (nalgebra's generic product is not unrolled for a generic scalar). Loops, so that opt-level
-/// "s" keeps them small; opt-level 3 unrolls them completely. No inline hint: opt-level "s"
-/// then keeps one out-of-line copy, opt-level 3 still inlines it.
+/// (nalgebra's generic product is not unrolled for a generic scalar). A loop over the columns
+/// of `b`, so that opt-level "s" keeps it small; opt-level 3 unrolls it completely. No inline
+/// hint: opt-level "s" then keeps one out-of-line copy, opt-level 3 still inlines it.
 pub(crate) fn mm<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    let (r0, r1, r2) = (
+        (a.m11, a.m12, a.m13),
+        (a.m21, a.m22, a.m23),
+        (a.m31, a.m32, a.m33),
+    );
     let mut out = Matrix3::zeros();
-    let ga = |r: usize, k: usize| a.get((r, k)).copied().unwrap_or_else(T::zero);
     for (oc, bc) in out
         .as_mut_slice()
         .chunks_exact_mut(3)
         .zip(b.as_slice().chunks_exact(3))
     {
-        if let [b0, b1, b2] = *bc {
-            for (r, o) in oc.iter_mut().enumerate() {
-                *o = ga(r, 0) * b0 + ga(r, 1) * b1 + ga(r, 2) * b2;
-            }
+        if let ([o0, o1, o2], [b0, b1, b2]) = (oc, bc) {
+            *o0 = r0.0 * *b0 + r0.1 * *b1 + r0.2 * *b2;
+            *o1 = r1.0 * *b0 + r1.1 * *b1 + r1.2 * *b2;
+            *o2 = r2.0 * *b0 + r2.1 * *b1 + r2.2 * *b2;
         }
     }
     out

@@ -37,6 +37,17 @@ fn jacobian<T: Real, const M: usize, const N: usize>(
     h
 }
 
+/// `h` with the identity block in columns `col..col + 3` (the models that observe a vector
+/// state directly).
+fn with_identity<T: Real, const N: usize>(mut h: SMatrix<T, 3, N>, col: usize) -> SMatrix<T, 3, N> {
+    for k in 0..3 {
+        if let Some(e) = h.get_mut((k, col + k)) {
+            *e = T::one();
+        }
+    }
+    h
+}
+
 /// A world vector `v` seen in the body, `Rᵀ v`, and its attitude Jacobian `[Rᵀ v]×` (module
 /// docs: `(R exp(δθ^))ᵀ v ≈ Rᵀ v + [Rᵀ v]× δθ`). Shared by the direction models (one copy).
 fn in_body<T: Real>(attitude: &So3<T>, v: &Vector3<T>) -> (Vector3<T>, Matrix3<T>) {
@@ -77,7 +88,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssPosition<T> {
         let (rl, d_att, _) = x.attitude.act_jac(&self.lever_arm);
         Ok(Linearization {
             residual: self.position - (x.position + rl),
-            jacobian: jacobian(&[(0, d_att), (6, Matrix3::identity())]),
+            jacobian: with_identity(jacobian(&[(0, d_att)]), 6),
         })
     }
     fn noise(&self) -> Matrix3<T> {
@@ -112,7 +123,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssVelocity<T> {
         }
         Ok(Linearization {
             residual: self.velocity - x.velocity,
-            jacobian: jacobian(&[(3, Matrix3::identity())]),
+            jacobian: with_identity(SMatrix::zeros(), 3),
         })
     }
     fn noise(&self) -> Matrix3<T> {
@@ -139,7 +150,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for ZeroVelocity<T> {
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
         Ok(Linearization {
             residual: -x.velocity,
-            jacobian: jacobian(&[(3, Matrix3::identity())]),
+            jacobian: with_identity(SMatrix::zeros(), 3),
         })
     }
     fn noise(&self) -> Matrix3<T> {
@@ -333,7 +344,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
         let (f, h_att) = in_body(&x.attitude, &(-self.gravity));
         Ok(Linearization {
             residual: self.accel - (f + x.accel_bias),
-            jacobian: jacobian(&[(0, h_att), (12, Matrix3::identity())]),
+            jacobian: with_identity(jacobian(&[(0, h_att)]), 12),
         })
     }
     fn noise(&self) -> Matrix3<T> {

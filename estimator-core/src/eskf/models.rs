@@ -37,15 +37,14 @@ fn jacobian<T: Real, const M: usize, const N: usize>(
     h
 }
 
-/// `h` with the identity block in columns `col..col + 3` (the models that observe a vector
+/// Sets the identity block in columns `col..col + 3` of `h` (the models that observe a vector
 /// state directly).
-fn with_identity<T: Real, const N: usize>(mut h: SMatrix<T, 3, N>, col: usize) -> SMatrix<T, 3, N> {
+fn set_identity<T: Real, const N: usize>(h: &mut SMatrix<T, 3, N>, col: usize) {
     for k in 0..3 {
         if let Some(e) = h.get_mut((k, col + k)) {
             *e = T::one();
         }
     }
-    h
 }
 
 /// A world vector `v` seen in the body, `Rᵀ v`, and its attitude Jacobian `[Rᵀ v]×` (module
@@ -86,10 +85,12 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssPosition<T> {
             return Err(EskfError::NonFinite);
         }
         let (rl, d_att, _) = x.attitude.act_jac(&self.lever_arm);
-        Ok(Linearization {
+        let mut lin = Linearization {
             residual: self.position - (x.position + rl),
-            jacobian: with_identity(jacobian(&[(0, d_att)]), 6),
-        })
+            jacobian: jacobian(&[(0, d_att)]),
+        };
+        set_identity(&mut lin.jacobian, 6);
+        Ok(lin)
     }
     fn noise(&self) -> Matrix3<T> {
         self.noise
@@ -121,10 +122,12 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssVelocity<T> {
         if !finite(&self.velocity) {
             return Err(EskfError::NonFinite);
         }
-        Ok(Linearization {
+        let mut lin = Linearization {
             residual: self.velocity - x.velocity,
-            jacobian: with_identity(SMatrix::zeros(), 3),
-        })
+            jacobian: SMatrix::zeros(),
+        };
+        set_identity(&mut lin.jacobian, 3);
+        Ok(lin)
     }
     fn noise(&self) -> Matrix3<T> {
         self.noise
@@ -148,10 +151,12 @@ impl<T: Real> ZeroVelocity<T> {
 
 impl<T: Real> Measurement<T, InsState<T>, 15, 3> for ZeroVelocity<T> {
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
-        Ok(Linearization {
+        let mut lin = Linearization {
             residual: -x.velocity,
-            jacobian: with_identity(SMatrix::zeros(), 3),
-        })
+            jacobian: SMatrix::zeros(),
+        };
+        set_identity(&mut lin.jacobian, 3);
+        Ok(lin)
     }
     fn noise(&self) -> Matrix3<T> {
         self.noise
@@ -342,10 +347,12 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
             return Err(EskfError::ZeroNorm);
         }
         let (f, h_att) = in_body(&x.attitude, &(-self.gravity));
-        Ok(Linearization {
+        let mut lin = Linearization {
             residual: self.accel - (f + x.accel_bias),
-            jacobian: with_identity(jacobian(&[(0, h_att)]), 12),
-        })
+            jacobian: jacobian(&[(0, h_att)]),
+        };
+        set_identity(&mut lin.jacobian, 12);
+        Ok(lin)
     }
     fn noise(&self) -> Matrix3<T> {
         self.noise

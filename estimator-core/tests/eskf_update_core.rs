@@ -8,32 +8,22 @@
 //! with every column of `H` used and a correlated `P` and `R`, so every block of the core (and
 //! every padded row) is exercised.
 
+mod eskf_common;
+
+use eskf_common::Rng;
 use estimator_core::eskf::*;
 use estimator_core::lie::{LieGroup, So3};
 use nalgebra::{SMatrix, SVector, Vector3};
 
-/// A deterministic generator (splitmix64) of values in `[-1, 1)`.
-struct Rng(u64);
+/// A matrix of uniform entries in `[-scale, scale)`.
+fn matrix<const R: usize, const C: usize>(rng: &mut Rng, scale: f64) -> SMatrix<f64, R, C> {
+    SMatrix::from_fn(|_, _| (2.0 * rng.uniform() - 1.0) * scale)
+}
 
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
-
-    fn matrix<const R: usize, const C: usize>(&mut self, scale: f64) -> SMatrix<f64, R, C> {
-        SMatrix::from_fn(|_, _| self.next() * scale)
-    }
-
-    /// `A Aᵀ + d I`: symmetric positive definite with correlated entries.
-    fn spd<const D: usize>(&mut self, scale: f64, d: f64) -> SMatrix<f64, D, D> {
-        let a = self.matrix::<D, D>(scale);
-        a * a.transpose() + SMatrix::identity() * d
-    }
+/// `A Aᵀ + d I`: symmetric positive definite with correlated entries.
+fn spd<const D: usize>(rng: &mut Rng, scale: f64, d: f64) -> SMatrix<f64, D, D> {
+    let a = matrix::<D, D>(rng, scale);
+    a * a.transpose() + SMatrix::identity() * d
 }
 
 /// A measurement that returns a fixed residual and Jacobian (the update uses nothing else of
@@ -77,9 +67,9 @@ fn textbook<const N: usize, const M: usize>(
 
 fn model<const N: usize, const M: usize>(rng: &mut Rng) -> Fixed<N, M> {
     Fixed {
-        r: rng.matrix::<M, 1>(0.2),
-        h: rng.matrix::<M, N>(1.0),
-        noise: rng.spd::<M>(0.1, 0.05),
+        r: matrix::<M, 1>(rng, 0.2),
+        h: matrix::<M, N>(rng, 1.0),
+        noise: spd::<M>(rng, 0.1, 0.05),
     }
 }
 
@@ -96,8 +86,8 @@ fn ins_with(p: SMatrix<f64, 15, 15>) -> Ins<f64> {
 
 /// Updates `Ins<f64>` with a random `M`-row model and compares with [`textbook`].
 fn check_ins<const M: usize>(seed: u64) {
-    let mut rng = Rng(seed);
-    let p = rng.spd::<15>(0.1, 0.01);
+    let mut rng = Rng::new(seed);
+    let p = spd::<15>(&mut rng, 0.1, 0.01);
     let m = model::<15, M>(&mut rng);
     let mut f = ins_with(p);
     let x0 = *f.state();
@@ -140,8 +130,8 @@ fn ins_update_equals_the_dense_textbook_update_for_every_row_count() {
 #[test]
 fn ahrs_update_equals_the_dense_textbook_update() {
     fn check<const M: usize>(seed: u64) {
-        let mut rng = Rng(seed);
-        let p = rng.spd::<6>(0.1, 0.01);
+        let mut rng = Rng::new(seed);
+        let p = spd::<6>(&mut rng, 0.1, 0.01);
         let m = model::<6, M>(&mut rng);
         let x0 = AhrsState {
             attitude: So3::exp(&Vector3::new(-0.4, 0.2, 2.0)),
@@ -177,10 +167,10 @@ fn ahrs_update_equals_the_dense_textbook_update() {
 fn the_gate_uses_the_model_dimension_not_the_core_capacity() {
     // A residual far outside: NIS ≫ any threshold; the reported threshold is χ²_M(0.99).
     fn threshold<const M: usize>() -> f64 {
-        let mut rng = Rng(99);
+        let mut rng = Rng::new(99);
         let mut m = model::<15, M>(&mut rng);
         m.r = SVector::repeat(1e3);
-        let mut f = ins_with(rng.spd::<15>(0.1, 0.01));
+        let mut f = ins_with(spd::<15>(&mut rng, 0.1, 0.01));
         let before = f;
         let out = f
             .update(

@@ -8,8 +8,8 @@ mod footprint;
 
 use cortex_m_rt::entry;
 use estimator_core::eskf::{
-    BaroAltitude, FilterConfig, GnssPosition, GnssVelocity, ImuSample, Ins, InsState,
-    Magnetometer, UpdateOptions,
+    BaroAltitude, FilterConfig, GnssPosition, GnssVelocity, ImuSample, Ins, InsState, Magnetometer,
+    UpdateOptions,
 };
 use footprint::{input, keep};
 use nalgebra::{SMatrix, Vector3};

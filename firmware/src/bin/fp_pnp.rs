@@ -23,7 +23,10 @@ fn main() -> ! {
         let pixels: [Vector2<f32>; 12] =
             core::array::from_fn(|i| Vector2::new(input(i) * 100.0, input(i + 3) * 100.0));
         let n = (input(4) as usize).min(12);
-        let (points, pixels) = (points.get(..n).unwrap_or(&[]), pixels.get(..n).unwrap_or(&[]));
+        let (points, pixels) = (
+            points.get(..n).unwrap_or(&[]),
+            pixels.get(..n).unwrap_or(&[]),
+        );
         if let Ok(solution) = solve_pnp(points, pixels, &camera, &pose, &options) {
             pose = solution.camera_from_world;
         }

@@ -23,21 +23,5 @@ pub fn keep<X>(x: &X) {
     black_box(x);
 }
 
-#[cfg(not(feature = "locate-panics"))]
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    extern "C" {
-        /// Defined nowhere: referencing it makes the link fail if a panic is reachable.
-        fn __estimator_core_panic_path_reachable() -> !;
-    }
-    // SAFETY: never executed when the binary links (the symbol does not exist).
-    unsafe { __estimator_core_panic_path_reachable() }
-}
-
-#[cfg(feature = "locate-panics")]
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    loop {
-        cortex_m::asm::nop();
-    }
-}
+#[path = "../no_panic_handler.rs"]
+mod no_panic_handler;

@@ -19,6 +19,15 @@ mod sealed {
     impl Sealed for f64 {}
 }
 
+/// `true` when every number is finite: the one loop behind the `is_finite` and
+/// `try_from_matrix` checks of the groups, the solver's checks and the update's SPD test. No
+/// inline attribute on purpose: at opt-level "s" it stays one out-of-line copy (a class test per
+/// element inlined at each call site costs more flash than the call); at opt-level 3 LLVM
+/// inlines it where it pays (a call inside the filter's state checks makes callers spill).
+pub(crate) fn all_finite<T: Real>(xs: &[T]) -> bool {
+    xs.iter().all(|x| x.is_finite())
+}
+
 /// A real scalar: `f32` or `f64` (sealed).
 pub trait Real: RealField + Copy + sealed::Sealed {
     /// Machine epsilon of `Self` (`2⁻²³` for `f32`, `2⁻⁵²` for `f64`), widened to `f64` so that

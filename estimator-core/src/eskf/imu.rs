@@ -139,7 +139,7 @@ fn all_finite<T: Real>(s: &[T]) -> bool {
 /// instructions per element and no branch. Over the contiguous storage: nalgebra's strided
 /// `iter()` costs ~170 instructions per element on a Cortex-M4.
 #[inline(always)]
-fn sum_times_zero_is_zero<T: Real>(s: &[T]) -> bool {
+pub(crate) fn sum_times_zero_is_zero<T: Real>(s: &[T]) -> bool {
     let z = T::zero();
     s.iter().fold(z, |acc, x| acc + *x * z) == z
 }

@@ -3,7 +3,7 @@
 
 use super::error::{EskfError, UpdateOutcome};
 use super::gate::{Gate, GateProbability};
-use super::imu::{finite_vec, greater};
+use super::imu::{finite_vec, greater, sum_times_zero_is_zero};
 use super::state::ErrorState;
 use crate::lie::{LieGroup, So3};
 use crate::Real;
@@ -385,55 +385,83 @@ where
     Ok(())
 }
 
-/// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`; returns `S⁻¹`.
-///
-/// Column by column over contiguous storage (`N × C` matrices: column `c` is entries
-/// `c·N .. c·N + N`), for the `m` active columns only.
-#[inline(never)]
+/// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`; returns `S⁻¹`. The per-size entry of
+/// [`gain_shared`] (see [`commit`] for the two builds).
+#[cfg_attr(estimator_compact, inline(always))]
+#[cfg_attr(not(estimator_compact), inline(never))]
 fn gain_into<T: Real, const N: usize, const C: usize>(
     p: &SMatrix<T, N, N>,
     r_noise: &SMatrix<T, C, C>,
     w: &mut Work<T, N, C>,
 ) -> Result<SMatrix<T, C, C>, EskfError> {
-    let m = w.m;
+    gain_shared(
+        p.as_slice(),
+        N,
+        w.m,
+        r_noise,
+        w.ht.as_slice(),
+        w.u.as_mut_slice(),
+        &mut w.s,
+        w.k.as_mut_slice(),
+    )
+}
+
+/// [`gain_into`] on the column-major storage of an `n × n` covariance `p` and of the `n × C`
+/// matrices `ht`, `u`, `k` (column `c` is entries `c·n .. c·n + n`), for the `m` active
+/// columns only.
+#[cfg_attr(estimator_compact, inline(never))]
+#[cfg_attr(not(estimator_compact), inline(always))]
+#[allow(clippy::too_many_arguments)] // the working set, lent field by field
+fn gain_shared<T: Real, const C: usize>(
+    p: &[T],
+    n: usize,
+    m: usize,
+    r_noise: &SMatrix<T, C, C>,
+    ht: &[T],
+    u: &mut [T],
+    s: &mut SMatrix<T, C, C>,
+    k: &mut [T],
+) -> Result<SMatrix<T, C, C>, EskfError> {
     // Column c of U = Σ_j P e_j H_cj over the nonzero entries of row c of H only (most models
     // touch 3–6 of the 15 error components).
-    w.u.fill(T::zero());
-    for (uc, hc) in columns_mut::<T, N>(w.u.as_mut_slice())
-        .zip(columns::<T, N>(w.ht.as_slice()))
+    u.fill(T::zero());
+    for (uc, hc) in u
+        .chunks_exact_mut(n.max(1))
+        .zip(ht.chunks_exact(n.max(1)))
         .take(m)
     {
-        for (pc, h) in columns::<T, N>(p.as_slice()).zip(hc) {
+        for (pc, h) in p.chunks_exact(n.max(1)).zip(hc) {
             if *h != T::zero() {
                 axpy(uc, *h, pc);
             }
         }
     }
     // S_ij = R_ij + (row i of H)·(column j of U) for i, j < m; the identity padding stays.
-    w.s.copy_from(r_noise);
-    for (j, uc) in columns::<T, N>(w.u.as_slice()).enumerate().take(m) {
-        for (i, hc) in columns::<T, N>(w.ht.as_slice()).enumerate().take(m) {
-            if let Some(e) = w.s.get_mut((i, j)) {
+    s.copy_from(r_noise);
+    for (j, uc) in u.chunks_exact(n.max(1)).enumerate().take(m) {
+        for (i, hc) in ht.chunks_exact(n.max(1)).enumerate().take(m) {
+            if let Some(e) = s.get_mut((i, j)) {
                 *e += dot(hc, uc);
             }
         }
     }
-    let st = w.s.transpose();
-    w.s += st;
-    w.s *= T::lit(0.5);
-    let chol = Cholesky::new(w.s).ok_or(EskfError::SingularInnovation)?;
+    let st = s.transpose();
+    *s += st;
+    *s *= T::lit(0.5);
+    let chol = Cholesky::new(*s).ok_or(EskfError::SingularInnovation)?;
     // K = U S⁻¹ with S⁻¹ from the Cholesky factor (C × C, small); the columns past m stay zero.
     let s_inv = chol.inverse();
-    w.k.fill(T::zero());
-    for (kc, sc) in columns_mut::<T, N>(w.k.as_mut_slice())
+    k.fill(T::zero());
+    for (kc, sc) in k
+        .chunks_exact_mut(n.max(1))
         .zip(s_inv.column_iter())
         .take(m)
     {
-        for (uc, s) in columns::<T, N>(w.u.as_slice()).zip(sc.iter()).take(m) {
+        for (uc, s) in u.chunks_exact(n.max(1)).zip(sc.iter()).take(m) {
             axpy(kc, *s, uc);
         }
     }
-    if !finite_vec(&w.k) {
+    if !sum_times_zero_is_zero(k) {
         return Err(EskfError::SingularInnovation);
     }
     Ok(s_inv)
@@ -443,12 +471,6 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
 #[inline]
 fn columns<T: Real, const N: usize>(m: &[T]) -> core::slice::ChunksExact<'_, T> {
     m.chunks_exact(N.max(1))
-}
-
-/// [`columns`], mutable.
-#[inline]
-fn columns_mut<T: Real, const N: usize>(m: &mut [T]) -> core::slice::ChunksExactMut<'_, T> {
-    m.chunks_exact_mut(N.max(1))
 }
 
 /// `out = K y` over the `m` active columns of `K` (`N × C`).
@@ -522,9 +544,16 @@ where
     iterations
 }
 
-/// Steps 3–4: Joseph-form covariance, injection and reset; writes only when every check passed.
-/// Overwrites `w.u` (with `V`, below).
-#[inline(never)]
+/// Steps 3–4: Joseph-form covariance, injection and reset; writes `x` and `P` only when every
+/// check passed. Overwrites `w.u` (with `V`, see [`commit_shared`]).
+///
+/// The covariance part is [`commit_shared`], written over a run-time dimension. At opt-level 2
+/// or 3 it is inlined here, into one copy per filter where `n = N` is a constant (the
+/// instruction counts are budgeted there); in a build for size (`cfg(estimator_compact)`, see
+/// `build.rs`) this entry is inlined into its caller and the body is one out-of-line copy shared
+/// by both filters.
+#[cfg_attr(estimator_compact, inline(always))]
+#[cfg_attr(not(estimator_compact), inline(never))]
 fn commit<T, S, const N: usize, const C: usize>(
     x: &mut S,
     p: &mut SMatrix<T, N, N>,
@@ -534,60 +563,95 @@ where
     T: Real,
     S: ErrorState<T, N>,
 {
-    let m = w.m;
+    let new_x = x.oplus(&w.dx);
+    commit_shared(
+        p.as_mut_slice(),
+        N,
+        w.m,
+        w.u.as_mut_slice(),
+        w.k.as_slice(),
+        &w.s,
+        w.dx.as_slice(),
+        new_x.is_finite(),
+    )?;
+    *x = new_x;
+    Ok(())
+}
+
+/// Rows of the covariance buffer of [`commit_shared`]: the largest error state.
+const MAX_STATE: usize = 15;
+
+/// The covariance of steps 3–4 on the column-major storage of the `n × n` covariance `p` and
+/// the `n × C` matrices `u` (`U`, overwritten by `V`), `k` (`K`); `s` is `S`, `dx` the
+/// correction. Writes `p` only when `state_ok` and every check passes.
+#[cfg_attr(estimator_compact, inline(never))]
+#[cfg_attr(not(estimator_compact), inline(always))]
+#[allow(clippy::too_many_arguments)] // the working set, lent field by field
+fn commit_shared<T: Real, const C: usize>(
+    p: &mut [T],
+    n: usize,
+    m: usize,
+    u: &mut [T],
+    k: &[T],
+    s: &SMatrix<T, C, C>,
+    dx: &[T],
+    state_ok: bool,
+) -> Result<(), EskfError> {
+    if !(3..=MAX_STATE).contains(&n) {
+        return Err(EskfError::NumericalFailure); // no filter has such a state
+    }
     // Joseph form, expanded and written as m symmetric rank-2 corrections:
     //   P⁺ = P − K Uᵀ − U Kᵀ + K S Kᵀ = P + V Kᵀ + K Vᵀ = P + Σ_c (v_c k_cᵀ + k_c v_cᵀ),
     //   V = ½ K S − U (columns v_c, k_c of V and K): exactly symmetric, computed in place
     // without an N × N temporary. The checks below need only its diagonal and attitude rows.
-    w.u.gemm(T::lit(0.5), &w.k, &w.s, -T::one());
-    let (v, k) = (&w.u, &w.k);
+    for (c, vc) in u.chunks_exact_mut(n.max(1)).enumerate().take(m) {
+        vc.iter_mut().for_each(|e| *e = -*e);
+        for (j, kj) in k.chunks_exact(n.max(1)).enumerate().take(m) {
+            let sjc = s.get((j, c)).copied().unwrap_or_else(T::zero);
+            axpy(vc, sjc * T::lit(0.5), kj);
+        }
+    }
+    let v: &[T] = u;
+    let pairs = || {
+        v.chunks_exact(n.max(1))
+            .zip(k.chunks_exact(n.max(1)))
+            .take(m)
+    };
     // Attitude rows of P⁺ (column j: P[0..3, j] + Σ_c (v_c[0..3] k_c[j] + k_c[0..3] v_c[j])),
     // then the reset P⁺ ← G P⁺ Gᵀ, G = blockdiag(J_r(δθ), I): only the attitude rows and
     // columns change.
-    let dth: SVector<T, 3> = w.dx.fixed_rows::<3>(0).into_owned();
+    let dth = Vector3::new(at(dx, 0), at(dx, 1), at(dx, 2));
     let gr: Matrix3<T> = So3::right_jacobian(&dth);
-    let mut top = p.fixed_rows::<3>(0).into_owned();
-    for (j, mut col) in top.column_iter_mut().enumerate() {
-        let mut c0 = Vector3::<T>::zeros();
-        c0.copy_from(&col);
-        for (vc, kc) in columns::<T, N>(v.as_slice())
-            .zip(columns::<T, N>(k.as_slice()))
-            .take(m)
-        {
+    let mut top = [Vector3::<T>::zeros(); MAX_STATE];
+    for (j, (t, pc)) in top.iter_mut().zip(p.chunks_exact(n.max(1))).enumerate() {
+        let mut c0 = Vector3::new(at(pc, 0), at(pc, 1), at(pc, 2));
+        for (vc, kc) in pairs() {
             let (vj, kj) = (at(vc, j), at(kc, j));
             for (e, (a, b)) in c0.iter_mut().zip(vc.iter().zip(kc)) {
                 *e += *a * kj + *b * vj;
             }
         }
-        let c1 = gr * c0;
-        col.copy_from(&c1);
+        *t = gr * c0;
     }
-    let c00 = top.fixed_columns::<3>(0) * gr.transpose();
+    let [t0, t1, t2, ..] = top;
+    let c00 = Matrix3::from_columns(&[t0, t1, t2]) * gr.transpose();
     let c00 = (c00 + c00.transpose()) * T::lit(0.5);
-    let new_x = x.oplus(&w.dx);
     // K, U, S and P are finite, so P⁺ can only fail by overflow; for a positive semi-definite
     // P⁺, |P⁺_ij| ≤ √(P⁺_ii P⁺_jj), so a finite positive diagonal bounds every entry.
     let ok = |d: T| d.is_finite() && d > T::zero();
     let two = T::lit(2.0);
-    let diag_ok = p.diagonal().iter().enumerate().skip(3).all(|(i, pii)| {
-        let d = columns::<T, N>(v.as_slice())
-            .zip(columns::<T, N>(k.as_slice()))
-            .take(m)
-            .fold(T::zero(), |acc, (vc, kc)| acc + at(vc, i) * at(kc, i));
-        ok(*pii + d * two)
+    let diag_ok = (3..n).all(|i| {
+        let d = pairs().fold(T::zero(), |acc, (vc, kc)| acc + at(vc, i) * at(kc, i));
+        ok(at(p, i * n + i) + d * two)
     }) && c00.diagonal().iter().all(|d| ok(*d));
-    if !(new_x.is_finite() && diag_ok) {
+    if !(state_ok && diag_ok) {
         return Err(EskfError::NumericalFailure);
     }
-    *x = new_x;
     // Rows and columns 3.. of P⁺ (rows 0..3 are `top`, written below). Upper triangle (column
     // j of P holds entries (0..=j, j)): P_ij += v_i k_j + k_i v_j for each active c, 3 ≤ i ≤ j,
     // then mirrored; half of the products of the full square.
-    for (vc, kc) in columns::<T, N>(v.as_slice())
-        .zip(columns::<T, N>(k.as_slice()))
-        .take(m)
-    {
-        for (j, pc) in p.as_mut_slice().chunks_exact_mut(N.max(1)).enumerate() {
+    for (vc, kc) in pairs() {
+        for (j, pc) in p.chunks_exact_mut(n.max(1)).enumerate() {
             let (vj, kj) = (at(vc, j), at(kc, j));
             let (Some(pc), Some(vs), Some(ks)) = (pc.get_mut(3..=j), vc.get(3..=j), kc.get(3..=j))
             else {
@@ -600,25 +664,25 @@ where
     }
     // Mirror that triangle; then rows 0..3 ← top, columns 0..3 ← topᵀ, block (0, 0) ← c00
     // (element by element: no transposed temporary).
-    for j in 3..N {
+    for j in 3..n {
         for i in 3..j {
-            let u = p.get((i, j)).copied().unwrap_or_else(T::zero);
-            if let Some(e) = p.get_mut((j, i)) {
+            let u = at(p, j * n + i);
+            if let Some(e) = p.get_mut(i * n + j) {
                 *e = u;
             }
         }
     }
-    for (j, col) in top.column_iter().enumerate() {
+    for (j, col) in top.iter().enumerate().take(n) {
         for (a, v) in col.iter().enumerate() {
             let v = if j < 3 {
                 c00.get((a, j)).copied().unwrap_or(*v)
             } else {
                 *v
             };
-            if let Some(e) = p.get_mut((a, j)) {
+            if let Some(e) = p.get_mut(j * n + a) {
                 *e = v;
             }
-            if let Some(e) = p.get_mut((j, a)) {
+            if let Some(e) = p.get_mut(a * n + j) {
                 *e = v;
             }
         }

@@ -74,11 +74,7 @@ impl<T: Real, const N: usize> Factor<T, N> {
     }
 }
 
-/// `true` when every entry is finite: one loop for every check of the solver (no inline
-/// attribute: one copy at opt-level "s", inlined where it pays at opt-level 3).
-pub(crate) fn all_finite<T: Real>(xs: &[T]) -> bool {
-    xs.iter().all(|x| x.is_finite())
-}
+pub(crate) use crate::scalar::all_finite;
 
 /// `A = L Lᵀ` in place on the column-major `n × n` storage `a` (the lower triangle becomes `L`),
 /// with the checks of [`Factor::new`]. Left-looking (see the module docs): at step `j` column `j`

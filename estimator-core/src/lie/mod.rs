@@ -312,14 +312,7 @@ pub(crate) fn skew_poly<T: Real>(p: T, q: T, w: &Vector3<T>) -> Matrix3<T> {
     )
 }
 
-/// `true` when every number is finite: one loop for every `is_finite` and `try_from_matrix` of
-/// the groups. No inline attribute on purpose: at opt-level "s" it stays one out-of-line copy (a
-/// class test per element inlined at each call site costs more flash than the call), at
-/// opt-level 3 LLVM inlines it (a call inside the filter's state checks makes their callers
-/// spill registers).
-pub(crate) fn all_finite<T: Real>(xs: &[T]) -> bool {
-    xs.iter().all(|x| x.is_finite())
-}
+pub(crate) use crate::scalar::all_finite;
 
 /// `R[p]×`, row by row: row `i` is `rᵢᵀ[p]× = (rᵢ × p)ᵀ` for the row `rᵢ` of `R` (no zero
 /// products of a full 3×3 multiplication by the skew matrix, no 3×3 temporary).

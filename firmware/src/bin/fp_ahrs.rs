@@ -10,12 +10,8 @@ use cortex_m_rt::entry;
 use estimator_core::eskf::{
     Ahrs, AhrsState, FilterConfig, GravityDirection, Magnetometer, UpdateOptions,
 };
-use footprint::{input, keep};
+use footprint::{input, input3, keep};
 use nalgebra::{SMatrix, Vector3};
-
-fn v3(i: usize) -> Vector3<f32> {
-    Vector3::new(input(i), input(i + 1), input(i + 2))
-}
 
 #[entry]
 fn main() -> ! {
@@ -29,9 +25,9 @@ fn main() -> ! {
     let options = UpdateOptions::default();
     let reference = Vector3::new(0.2, 0.0, -0.4);
     loop {
-        keep(&ahrs.predict(&v3(0), input(7)));
-        keep(&ahrs.update(&GravityDirection::new(v3(1), input(7)), &options));
-        keep(&ahrs.update(&Magnetometer::new(v3(2), reference, input(7)), &options));
+        keep(&ahrs.predict(&input3(0), input(7)));
+        keep(&ahrs.update(&GravityDirection::new(input3(1), input(7)), &options));
+        keep(&ahrs.update(&Magnetometer::new(input3(2), reference, input(7)), &options));
         keep(ahrs.state());
     }
 }

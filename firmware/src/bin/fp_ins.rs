@@ -11,12 +11,8 @@ use estimator_core::eskf::{
     BaroAltitude, FilterConfig, GnssPosition, GnssVelocity, ImuSample, Ins, InsState, Magnetometer,
     UpdateOptions,
 };
-use footprint::{input, keep};
+use footprint::{input, input3, keep};
 use nalgebra::{SMatrix, Vector3};
-
-fn v3(i: usize) -> Vector3<f32> {
-    Vector3::new(input(i), input(i + 1), input(i + 2))
-}
 
 #[entry]
 fn main() -> ! {
@@ -32,15 +28,15 @@ fn main() -> ! {
     let lever_arm = Vector3::new(0.1, 0.0, 0.05);
     loop {
         let imu = ImuSample {
-            gyro: v3(0),
-            accel: v3(1),
+            gyro: input3(0),
+            accel: input3(1),
             dt: input(7),
         };
         keep(&ins.predict(&imu));
-        keep(&ins.update(&GnssPosition::new(v3(2), lever_arm, input(6)), &options));
-        keep(&ins.update(&GnssVelocity::new(v3(3), input(4)), &options));
+        keep(&ins.update(&GnssPosition::new(input3(2), lever_arm, input(6)), &options));
+        keep(&ins.update(&GnssVelocity::new(input3(3), input(4)), &options));
         keep(&ins.update(&BaroAltitude::new(input(5), input(6)), &options));
-        keep(&ins.update(&Magnetometer::new(v3(4), reference, input(7)), &options));
+        keep(&ins.update(&Magnetometer::new(input3(4), reference, input(7)), &options));
         keep(ins.state());
     }
 }

@@ -9,7 +9,7 @@ mod footprint;
 use cortex_m_rt::entry;
 use estimator_core::gn::{solve_pnp, PinholeCamera, PnpOptions};
 use estimator_core::lie::{LieGroup, Se3};
-use footprint::{input, keep};
+use footprint::{input, input3, keep};
 use nalgebra::{Vector2, Vector3};
 
 #[entry]
@@ -19,7 +19,7 @@ fn main() -> ! {
     let mut pose = Se3::identity();
     loop {
         let points: [Vector3<f32>; 12] =
-            core::array::from_fn(|i| Vector3::new(input(i), input(i + 1), input(i + 2) + 4.0));
+            core::array::from_fn(|i| input3(i) + Vector3::new(0.0, 0.0, 4.0));
         let pixels: [Vector2<f32>; 12] =
             core::array::from_fn(|i| Vector2::new(input(i) * 100.0, input(i + 3) * 100.0));
         let n = (input(4) as usize).min(12);

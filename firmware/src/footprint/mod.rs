@@ -17,6 +17,12 @@ pub fn input(i: usize) -> f32 {
     s.get(i % 8).copied().unwrap_or(0.0)
 }
 
+/// Three opaque numbers from `i` on, as a vector (a sensor's three axes).
+#[inline(always)]
+pub fn input3(i: usize) -> nalgebra::Vector3<f32> {
+    nalgebra::Vector3::new(input(i), input(i + 1), input(i + 2))
+}
+
 /// Keeps a result alive: its address goes to `black_box`.
 #[inline(always)]
 pub fn keep<X>(x: &X) {

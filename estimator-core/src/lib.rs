@@ -12,6 +12,11 @@
 //! Nothing allocates and nothing panics: every entry point that takes outside data returns a
 //! `Result` with a typed error.
 //!
+//! Built for size (opt-level `"s"` or `"z"`, or the `compact` feature), a few kernels are
+//! compiled once and called instead of being inlined at every use: the same source and the same
+//! results, only the inlining differs (`build.rs` sets `cfg(estimator_compact)`). Opt-level 2 and
+//! 3 keep the specialised, faster copies.
+//!
 //! The mathematics follows the seed paper on Lie groups for state estimation; equation numbers in
 //! the docs refer to it.
 #![no_std]

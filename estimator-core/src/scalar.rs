@@ -24,6 +24,7 @@ mod sealed {
 /// inline attribute on purpose: at opt-level "s" it stays one out-of-line copy (a class test per
 /// element inlined at each call site costs more flash than the call); at opt-level 3 LLVM
 /// inlines it where it pays (a call inside the filter's state checks makes callers spill).
+#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn all_finite<T: Real>(xs: &[T]) -> bool {
     xs.iter().all(|x| x.is_finite())
 }

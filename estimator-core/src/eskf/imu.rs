@@ -138,7 +138,8 @@ fn all_finite<T: Real>(s: &[T]) -> bool {
 /// invalid operation), and NaN propagates through the sum (`−0 = +0` in the comparison): two
 /// instructions per element and no branch. Over the contiguous storage: nalgebra's strided
 /// `iter()` costs ~170 instructions per element on a Cortex-M4.
-#[inline(always)]
+#[cfg_attr(not(estimator_compact), inline(always))]
+#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn sum_times_zero_is_zero<T: Real>(s: &[T]) -> bool {
     let z = T::zero();
     s.iter().fold(z, |acc, x| acc + *x * z) == z
@@ -164,6 +165,7 @@ pub(crate) fn blk_rc<T: Real, const R: usize, const C: usize>(
 
 /// Writes block `(i, j)` of an `R × C` matrix, column piece by column piece (nothing outside
 /// the matrix).
+#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
     m: &mut SMatrix<T, R, C>,
     i: usize,
@@ -184,7 +186,8 @@ pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
 }
 
 /// Block `(i, j)` of a square matrix.
-#[inline]
+#[cfg_attr(not(estimator_compact), inline)]
+#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn blk<T: Real, const N: usize>(m: &SMatrix<T, N, N>, i: usize, j: usize) -> Matrix3<T> {
     blk_rc(m, i, j)
 }
@@ -201,6 +204,7 @@ pub(crate) fn set_blk<T: Real, const N: usize>(
 }
 
 /// Adds `s` to the diagonal of block `(i, i)`.
+#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn add_diag<T: Real, const N: usize>(m: &mut SMatrix<T, N, N>, i: usize, s: T) {
     add_cross(m, i, i, s);
 }
@@ -232,6 +236,7 @@ fn block_column<T: Real>(s: &[T], j: usize) -> Option<&[T; 45]> {
 }
 
 /// Block `k` (rows `3k..3k+3`) of a block column.
+#[cfg_attr(estimator_compact, inline(never))]
 fn col_blk<T: Real>(q: &[T; 45], k: usize) -> Matrix3<T> {
     let g = |r: usize, c: usize| q.get(15 * c + 3 * k + r).copied().unwrap_or_else(T::zero);
     Matrix3::new(
@@ -455,6 +460,7 @@ fn scaled<T: Real>(mut m: Matrix3<T>, s: T) -> Matrix3<T> {
 }
 
 /// `y + x·a`, entry by entry (one small function for the nominal integration).
+#[cfg_attr(estimator_compact, inline(never))]
 fn axpy<T: Real>(y: &Vector3<T>, x: &Vector3<T>, a: T) -> Vector3<T> {
     Vector3::new(y.x + x.x * a, y.y + x.y * a, y.z + x.z * a)
 }

@@ -80,6 +80,7 @@ impl<T: Real> GnssPosition<T> {
 }
 
 impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssPosition<T> {
+    #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
         if !(finite(&self.position) && finite(&self.lever_arm)) {
             return Err(EskfError::NonFinite);
@@ -118,6 +119,7 @@ impl<T: Real> GnssVelocity<T> {
 }
 
 impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssVelocity<T> {
+    #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
         if !finite(&self.velocity) {
             return Err(EskfError::NonFinite);
@@ -150,6 +152,7 @@ impl<T: Real> ZeroVelocity<T> {
 }
 
 impl<T: Real> Measurement<T, InsState<T>, 15, 3> for ZeroVelocity<T> {
+    #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
         let mut lin = Linearization {
             residual: -x.velocity,
@@ -187,6 +190,7 @@ impl<T: Real> BaroAltitude<T> {
 }
 
 impl<T: Real> Measurement<T, InsState<T>, 15, 1> for BaroAltitude<T> {
+    #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 1>, EskfError> {
         if !(self.altitude.is_finite() && self.offset.is_finite()) {
             return Err(EskfError::NonFinite);
@@ -243,6 +247,7 @@ impl<T: Real> Magnetometer<T> {
 }
 
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for Magnetometer<T> {
+    #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
         let (residual, h_att) = self.attitude_parts(x.attitude())?;
         Ok(Linearization {
@@ -300,6 +305,7 @@ impl<T: Real> GravityDirection<T> {
 }
 
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for GravityDirection<T> {
+    #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
         let (residual, h_att) = self.attitude_parts(x.attitude())?;
         Ok(Linearization {
@@ -339,6 +345,7 @@ impl<T: Real> AccelerometerAtRest<T> {
 }
 
 impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
+    #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
         if !(finite(&self.accel) && finite(&self.gravity)) {
             return Err(EskfError::NonFinite);
@@ -415,6 +422,7 @@ impl<T: Real> Heading<T> {
 }
 
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for Heading<T> {
+    #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &S) -> Result<Linearization<T, N, 1>, EskfError> {
         let (residual, h_att) = self.attitude_parts(x.attitude())?;
         Ok(Linearization {
@@ -499,6 +507,7 @@ impl<T: Real> CameraLandmark<T> {
 }
 
 impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
+    #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 2>, EskfError> {
         let k = &self.intrinsics;
         let all = [k.fx, k.fy, k.cx, k.cy, self.min_depth];

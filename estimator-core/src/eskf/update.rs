@@ -221,6 +221,7 @@ fn rows_into<T: Real>(h: &[T], r_in: &[T], ht: &mut [T], r: &mut [T]) {
 }
 
 /// `R` (`M × M`) padded to `C × C` with the identity.
+#[cfg_attr(estimator_compact, inline(never))]
 fn pad_noise<T: Real, const M: usize, const C: usize>(r: &SMatrix<T, M, M>) -> SMatrix<T, C, C> {
     let mut out = SMatrix::<T, C, C>::identity();
     pad_into(r.as_slice(), M, out.as_mut_slice(), C);
@@ -487,7 +488,8 @@ fn gain_times<T: Real, const N: usize, const C: usize>(
 }
 
 /// `y += a x` over two equally long slices.
-#[inline]
+#[cfg_attr(not(estimator_compact), inline)]
+#[cfg_attr(estimator_compact, inline(never))]
 fn axpy<T: Real>(y: &mut [T], a: T, x: &[T]) {
     for (y, x) in y.iter_mut().zip(x) {
         *y += a * *x;
@@ -495,7 +497,8 @@ fn axpy<T: Real>(y: &mut [T], a: T, x: &[T]) {
 }
 
 /// `a · b` over two equally long slices.
-#[inline]
+#[cfg_attr(not(estimator_compact), inline)]
+#[cfg_attr(estimator_compact, inline(never))]
 fn dot<T: Real>(a: &[T], b: &[T]) -> T {
     a.iter().zip(b).fold(T::zero(), |acc, (x, y)| acc + *x * *y)
 }

@@ -47,7 +47,8 @@ impl<T: Real> PinholeCamera<T> {
     /// `(K π(x), ∂(K π)/∂x)` with
     /// `∂(K π)/∂x = [[fx/z, 0, −fx x/z²], [0, fy/z, −fy y/z²]]`; `None` unless `x.z > min_depth`.
     #[must_use]
-    #[inline]
+    #[cfg_attr(not(estimator_compact), inline)]
+    #[cfg_attr(estimator_compact, inline(never))]
     pub fn project_jac(&self, x: &Vector3<T>, min_depth: T) -> Option<(Vector2<T>, Matrix2x3<T>)> {
         let in_front = x.z > min_depth;
         if !in_front {

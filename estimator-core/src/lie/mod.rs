@@ -178,18 +178,21 @@ pub trait LieGroup<T: Real>: Copy + core::fmt::Debug + PartialEq + Sized {
 
     /// `a⁻¹·b`.
     #[must_use]
+    #[cfg_attr(estimator_compact, inline(never))]
     fn between(&self, b: &Self) -> Self {
         self.inverse().compose(b)
     }
 
     /// `a ⊕ τ = a·exp(τ)` (seed eq. 4.5).
     #[must_use]
+    #[cfg_attr(estimator_compact, inline(never))]
     fn rplus(&self, tau: &Self::Tangent) -> Self {
         self.compose(&Self::exp(tau))
     }
 
     /// `a ⊖ b = log(b⁻¹·a)`, so that `b ⊕ (a ⊖ b) = a`.
     #[must_use]
+    #[cfg_attr(estimator_compact, inline(never))]
     fn rminus(&self, b: &Self) -> Self::Tangent {
         b.between(self).log()
     }
@@ -281,7 +284,8 @@ impl<T: Real, G, const N: usize, const D: usize, const M: usize> MatrixLieGroup<
 pub const ORTHOGONALITY_TOLERANCE: f64 = 1e-3;
 
 /// `[ω]×`, the skew-symmetric matrix with `[ω]× p = ω × p` (SO(3) hat, seed Example 5.2).
-#[inline]
+#[cfg_attr(not(estimator_compact), inline)]
+#[cfg_attr(estimator_compact, inline(never))]
 #[must_use]
 pub fn skew<T: Real>(w: &Vector3<T>) -> Matrix3<T> {
     let z = T::zero();

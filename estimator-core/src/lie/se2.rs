@@ -76,6 +76,7 @@ impl<T: Real> Se2<T> {
         }
     }
 
+    #[cfg_attr(estimator_compact, inline(never))]
     fn jr_from(k: &AngleCoeffs<T>, tau: &Vector3<T>) -> Matrix3<T> {
         let (vx, vy, w) = (tau.x, tau.y, tau.z);
         let wb = w * k.b;
@@ -186,6 +187,7 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         self.rotation.act(p) + self.translation
     }
 
+    #[cfg_attr(estimator_compact, inline(never))]
     fn adjoint(&self) -> Matrix3<T> {
         let (c, s) = (self.rotation.cos(), self.rotation.sin());
         let t = &self.translation;

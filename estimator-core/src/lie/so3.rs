@@ -277,6 +277,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
         self.rotation_matrix()
     }
 
+    #[cfg_attr(estimator_compact, inline(never))]
     fn normalize(&self) -> Self {
         match Self::from_quaternion(self.q.as_ref()) {
             Some(r) => r,

@@ -191,7 +191,13 @@ where
         ht: &mut SMatrix<T, N, C>,
         r: &mut SVector<T, C>,
     ) -> Result<(), EskfError> {
-        let lin = self.0.linearize(x)?;
+        // Borrowed inside the `Result`, not moved out of it: one copy of the linearization on
+        // the stack instead of two (this frame is on the deepest path of the update).
+        let lin = self.0.linearize(x);
+        let lin = match &lin {
+            Ok(lin) => lin,
+            Err(e) => return Err(*e),
+        };
         rows_into(
             lin.jacobian.as_slice(),
             lin.residual.as_slice(),

@@ -99,8 +99,13 @@ pub(crate) fn check_spd<T: Real, const M: usize>(r: &SMatrix<T, M, M>) -> bool {
     }
 }
 
-/// Largest dimension whose Cholesky test uses the packed lower triangle.
-const PACKED_MAX_DIM: usize = 15;
+/// The largest error state (`Ins`, 15): the size of the fixed buffers of the shared update
+/// steps ([`commit_shared`]).
+const MAX_STATE: usize = 15;
+
+/// Largest dimension whose Cholesky test uses the packed lower triangle: every covariance of
+/// a filter.
+const PACKED_MAX_DIM: usize = MAX_STATE;
 
 /// [`check_spd`] on the column-major storage `a` of an `n × n` matrix (`n ≤ 15`): the
 /// symmetry test, then the Cholesky recurrence `L_ij = (A_ij − Σ_k<j L_ik L_jk) / L_jj`,
@@ -586,9 +591,6 @@ where
     *x = new_x;
     Ok(())
 }
-
-/// Rows of the covariance buffer of [`commit_shared`]: the largest error state.
-const MAX_STATE: usize = 15;
 
 /// The covariance of steps 3–4 on the column-major storage of the `n × n` covariance `p` and
 /// the `n × C` matrices `u` (`U`, overwritten by `V`), `k` (`K`); `s` is `S`, `dx` the

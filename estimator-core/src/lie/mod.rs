@@ -318,6 +318,23 @@ pub(crate) fn skew_poly<T: Real>(p: T, q: T, w: &Vector3<T>) -> Matrix3<T> {
 
 pub(crate) use crate::scalar::all_finite;
 
+/// `‖MᵀM − I‖²_F`, the orthogonality error of [`LieGroup::try_from_matrix`]: entry `(i, j)` of
+/// `MᵀM` is the dot product of columns `i` and `j`. The same operations in the same order as
+/// `(m.transpose() * m - I).norm_squared()`, without the two `N × N` temporaries.
+#[must_use]
+pub(crate) fn orthogonality_error<T: Real, const N: usize>(m: &SMatrix<T, N, N>) -> T {
+    let mut err = T::zero();
+    for (j, cj) in m.column_iter().enumerate() {
+        let mut col = T::zero();
+        for (i, ci) in m.column_iter().enumerate() {
+            let d = ci.dot(&cj) - if i == j { T::one() } else { T::zero() };
+            col += d * d;
+        }
+        err += col;
+    }
+    err
+}
+
 /// `R[p]×`, row by row: row `i` is `rᵢᵀ[p]× = (rᵢ × p)ᵀ` for the row `rᵢ` of `R` (no zero
 /// products of a full 3×3 multiplication by the skew matrix, no 3×3 temporary).
 #[must_use]
@@ -327,4 +344,159 @@ pub(crate) fn mul_skew<T: Real>(r: &Matrix3<T>, p: &Vector3<T>) -> Matrix3<T> {
     let (b1, b2, b3) = row(r.m21, r.m22, r.m23);
     let (c1, c2, c3) = row(r.m31, r.m32, r.m33);
     Matrix3::new(a1, a2, a3, b1, b2, b3, c1, c2, c3)
+}
+
+/// The size-driven rewrites (scalar forms, one-path Shepperd, shared helpers) against the
+/// straightforward nalgebra expressions they replace: the same bits, `f32` and `f64`.
+#[cfg(test)]
+mod rewrites {
+    use super::*;
+    use nalgebra::{Matrix2, Quaternion, UnitQuaternion};
+
+    /// Deterministic numbers in `[-1, 1)` (64-bit LCG).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((self.0 >> 11) as f64) / ((1u64 << 52) as f64) - 1.0
+        }
+    }
+
+    /// Bit-for-bit equality (so `NaN`s of the same payload compare equal, `0.0` and `−0.0` not).
+    fn same<T: Real>(a: &[T], b: &[T]) -> bool {
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .all(|(x, y)| x.to_f64().to_bits() == y.to_f64().to_bits())
+    }
+
+    /// Rotation matrices of every Shepperd branch (angles up to and at π about each axis and
+    /// random axes), perturbed ones, and arbitrary matrices.
+    fn for_each_matrix<T: Real>(mut f: impl FnMut(&Matrix3<T>)) {
+        let mut rng = Lcg(7);
+        for i in 0..400 {
+            let axis = match i % 4 {
+                0 => Vector3::new(1.0, 0.0, 0.0),
+                1 => Vector3::new(0.0, 1.0, 0.0),
+                2 => Vector3::new(0.0, 0.0, 1.0),
+                _ => Vector3::new(rng.next(), rng.next(), rng.next()),
+            };
+            let angle = core::f64::consts::PI * (1.0 - (f64::from(i) / 400.0).powi(3));
+            let r = UnitQuaternion::from_scaled_axis(axis.normalize() * angle);
+            let m = *r.to_rotation_matrix().matrix();
+            let noise = if i % 3 == 0 { 1e-4 } else { 0.0 };
+            f(&m.map(|x| T::lit(x + noise * rng.next())));
+            f(&Matrix3::from_fn(|_, _| T::lit(rng.next())));
+        }
+    }
+
+    /// Vectors of magnitudes from `1e-6` to `100`.
+    fn for_each_vector<T: Real>(seed: u64, mut f: impl FnMut(&Vector3<T>)) {
+        let mut rng = Lcg(seed);
+        for i in 0..100 {
+            let s = [1e-6, 1e-2, 1.0, 3.0, 100.0][i % 5];
+            f(&Vector3::new(rng.next(), rng.next(), rng.next()).map(|x| T::lit(s * x)));
+        }
+    }
+
+    fn for_each_quaternion<T: Real>(mut f: impl FnMut(&UnitQuaternion<T>)) {
+        let mut rng = Lcg(13);
+        for _ in 0..100 {
+            let q = Quaternion::new(rng.next(), rng.next(), rng.next(), rng.next());
+            let q = Quaternion::from(q.coords.map(T::lit));
+            f(&UnitQuaternion::new_unchecked(q * (T::one() / q.norm())));
+        }
+    }
+
+    /// The four written-out branches of Shepperd's method (before the one-path form).
+    fn shepperd_branches<T: Real>(m: &Matrix3<T>) -> Option<So3<T>> {
+        let one = T::one();
+        let quarter = T::lit(0.25);
+        let trace = m.m11 + m.m22 + m.m33;
+        let (w, x, y, z);
+        if trace > T::zero() {
+            let s = (trace + one).sqrt() * T::lit(2.0);
+            w = quarter * s;
+            x = (m.m32 - m.m23) / s;
+            y = (m.m13 - m.m31) / s;
+            z = (m.m21 - m.m12) / s;
+        } else if m.m11 > m.m22 && m.m11 > m.m33 {
+            let s = (one + m.m11 - m.m22 - m.m33).sqrt() * T::lit(2.0);
+            w = (m.m32 - m.m23) / s;
+            x = quarter * s;
+            y = (m.m12 + m.m21) / s;
+            z = (m.m13 + m.m31) / s;
+        } else if m.m22 > m.m33 {
+            let s = (one + m.m22 - m.m11 - m.m33).sqrt() * T::lit(2.0);
+            w = (m.m13 - m.m31) / s;
+            x = (m.m12 + m.m21) / s;
+            y = quarter * s;
+            z = (m.m23 + m.m32) / s;
+        } else {
+            let s = (one + m.m33 - m.m11 - m.m22).sqrt() * T::lit(2.0);
+            w = (m.m21 - m.m12) / s;
+            x = (m.m13 + m.m31) / s;
+            y = (m.m23 + m.m32) / s;
+            z = quarter * s;
+        }
+        So3::from_wxyz(w, x, y, z)
+    }
+
+    fn so3_try_from_matrix_before<T: Real>(m: &Matrix3<T>) -> Option<So3<T>> {
+        if !all_finite(m.as_slice()) {
+            return None;
+        }
+        let err = (m.transpose() * m - Matrix3::<T>::identity()).norm_squared();
+        let tol = T::lit(ORTHOGONALITY_TOLERANCE);
+        if !(err <= tol * tol && m.determinant() > T::zero()) {
+            return None;
+        }
+        shepperd_branches(m)
+    }
+
+    fn so3_matrices<T: Real>() {
+        let mut accepted = 0;
+        let mut branch = [0usize; 4];
+        for_each_matrix::<T>(|m| {
+            let err = (m.transpose() * m - Matrix3::<T>::identity()).norm_squared();
+            assert!(same(&[orthogonality_error(m)], &[err]));
+            let m2 = m.fixed_view::<2, 2>(0, 0).into_owned();
+            let err2 = (m2.transpose() * m2 - Matrix2::<T>::identity()).norm_squared();
+            assert!(same(&[orthogonality_error(&m2)], &[err2]));
+            let got = So3::try_from_matrix(m).map(|r| r.quaternion().coords);
+            let want = so3_try_from_matrix_before(m).map(|r| r.quaternion().coords);
+            assert_eq!(got.is_some(), want.is_some());
+            if let (Some(g), Some(w)) = (got, want) {
+                assert!(same(g.as_slice(), w.as_slice()), "{m}");
+                accepted += 1;
+                // Which component Shepperd took by the square root: the largest here.
+                let k = g.iamax();
+                if let Some(b) = branch.get_mut((k + 1) % 4) {
+                    *b += 1;
+                }
+            }
+        });
+        assert!(accepted > 300, "{accepted}");
+        assert!(branch.iter().all(|&n| n > 20), "{branch:?}");
+    }
+
+    fn so3_act<T: Real>() {
+        for_each_quaternion::<T>(|q| {
+            let r = So3::from_unit_quaternion(*q);
+            for_each_vector::<T>(17, |p| {
+                assert!(same(r.act(p).as_slice(), q.transform_vector(p).as_slice()));
+            });
+        });
+    }
+
+    #[test]
+    fn so3_rewrites_are_bit_identical() {
+        so3_matrices::<f32>();
+        so3_matrices::<f64>();
+        so3_act::<f32>();
+        so3_act::<f64>();
+    }
 }

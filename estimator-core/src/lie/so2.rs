@@ -4,7 +4,7 @@
 //! `exp(θ) = (cos θ, sin θ)`, `log = atan2(sin θ, cos θ) ∈ (−π, π]`. The group is commutative:
 //! `Ad = J_r = J_l = 1`. `act_jac(p) = (R p, R G¹ p, R)` (seed Theorem 5.1 with `H(p) = G¹p`).
 
-use super::{all_finite, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, orthogonality_error, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{Matrix1, Matrix2, Matrix2x1, Vector1, Vector2};
 
 /// A planar rotation `R ∈ SO(2)`.
@@ -161,7 +161,7 @@ impl<T: Real> LieGroup<T> for So2<T> {
         if !all_finite(m.as_slice()) {
             return None;
         }
-        let err = (m.transpose() * m - Matrix2::identity()).norm_squared();
+        let err = orthogonality_error(m);
         let tol = T::lit(ORTHOGONALITY_TOLERANCE);
         // Written so that NaN (which compares false) is rejected too.
         let orthogonal = err <= tol * tol;

@@ -17,7 +17,10 @@
 //! `(1 − cos θ)/θ²`, `(θ − sin θ)/θ³`, `1/θ² − (1 + cos θ)/(2θ sin θ)`).
 
 use super::trig::{half_sinc, poly, AngleCoeffs, Cutoff};
-use super::{all_finite, mul_skew, skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{
+    all_finite, mul_skew, orthogonality_error, skew, skew_poly, LieGroup, Real,
+    ORTHOGONALITY_TOLERANCE,
+};
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 /// A 3-D rotation `R ∈ SO(3)`, stored as a unit Hamilton quaternion.
@@ -78,36 +81,42 @@ impl<T: Real> So3<T> {
     /// Shepperd's method: the largest of `w², x², y², z²` (from the trace and the diagonal) sets
     /// which component is computed by a square root, the others by division, so no branch loses
     /// precision near `θ = π`. The result is normalized.
+    ///
+    /// One path for the four cases: the branch picks the radicand `4q_i²` and, per component, which
+    /// of the six off-diagonal combinations `4q_iq_j` it divides (the component `i` itself is
+    /// `s/4`); the same operations as four written-out branches.
     fn quaternion_from_matrix(m: &Matrix3<T>) -> Option<Self> {
+        /// Marks the component computed by the square root.
+        const SELF: u8 = 6;
         let one = T::one();
-        let quarter = T::lit(0.25);
         let trace = m.m11 + m.m22 + m.m33;
-        let (w, x, y, z);
-        if trace > T::zero() {
-            let s = (trace + one).sqrt() * T::lit(2.0);
-            w = quarter * s;
-            x = (m.m32 - m.m23) / s;
-            y = (m.m13 - m.m31) / s;
-            z = (m.m21 - m.m12) / s;
+        // 4·q_i·q_j for the pairs (w,x) (w,y) (w,z) (x,y) (x,z) (y,z).
+        let pairs = [
+            m.m32 - m.m23,
+            m.m13 - m.m31,
+            m.m21 - m.m12,
+            m.m12 + m.m21,
+            m.m13 + m.m31,
+            m.m23 + m.m32,
+        ];
+        let (radicand, from): (T, [u8; 4]) = if trace > T::zero() {
+            (trace + one, [SELF, 0, 1, 2])
         } else if m.m11 > m.m22 && m.m11 > m.m33 {
-            let s = (one + m.m11 - m.m22 - m.m33).sqrt() * T::lit(2.0);
-            w = (m.m32 - m.m23) / s;
-            x = quarter * s;
-            y = (m.m12 + m.m21) / s;
-            z = (m.m13 + m.m31) / s;
+            (one + m.m11 - m.m22 - m.m33, [0, SELF, 3, 4])
         } else if m.m22 > m.m33 {
-            let s = (one + m.m22 - m.m11 - m.m33).sqrt() * T::lit(2.0);
-            w = (m.m13 - m.m31) / s;
-            x = (m.m12 + m.m21) / s;
-            y = quarter * s;
-            z = (m.m23 + m.m32) / s;
+            (one + m.m22 - m.m11 - m.m33, [1, 3, SELF, 5])
         } else {
-            let s = (one + m.m33 - m.m11 - m.m22).sqrt() * T::lit(2.0);
-            w = (m.m21 - m.m12) / s;
-            x = (m.m13 + m.m31) / s;
-            y = (m.m23 + m.m32) / s;
-            z = quarter * s;
+            (one + m.m33 - m.m11 - m.m22, [2, 4, 5, SELF])
+        };
+        let s = radicand.sqrt() * T::lit(2.0);
+        let mut q = [T::zero(); 4];
+        for (qi, &j) in q.iter_mut().zip(from.iter()) {
+            *qi = match pairs.get(usize::from(j)) {
+                Some(p) => *p / s,
+                None => T::lit(0.25) * s,
+            };
         }
+        let [w, x, y, z] = q;
         Self::from_wxyz(w, x, y, z)
     }
 
@@ -249,8 +258,21 @@ impl<T: Real> LieGroup<T> for So3<T> {
         }
     }
 
+    /// `q p q*`, nalgebra's formula written out per component (the same operations in the same
+    /// order, so the same result; no temporary vectors at opt-level "s"): `t = 2 v × p`,
+    /// `p' = w t + v × t + p`.
     fn act(&self, p: &Vector3<T>) -> Vector3<T> {
-        self.q.transform_vector(p)
+        let q = self.q.quaternion();
+        let (w, x, y, z) = (q.w, q.i, q.j, q.k);
+        let two = T::lit(2.0);
+        let tx = (y * p.z - z * p.y) * two;
+        let ty = (z * p.x - x * p.z) * two;
+        let tz = (x * p.y - y * p.x) * two;
+        Vector3::new(
+            tx * w + (y * tz - z * ty) + p.x,
+            ty * w + (z * tx - x * tz) + p.y,
+            tz * w + (x * ty - y * tx) + p.z,
+        )
     }
 
     fn adjoint(&self) -> Matrix3<T> {
@@ -289,7 +311,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
         if !all_finite(m.as_slice()) {
             return None;
         }
-        let err = (m.transpose() * m - Matrix3::identity()).norm_squared();
+        let err = orthogonality_error(m);
         let tol = T::lit(ORTHOGONALITY_TOLERANCE);
         // Written so that NaN (which compares false) is rejected too.
         let orthogonal = err <= tol * tol;

@@ -350,6 +350,7 @@ pub(crate) fn mul_skew<T: Real>(r: &Matrix3<T>, p: &Vector3<T>) -> Matrix3<T> {
 /// straightforward nalgebra expressions they replace: the same bits, `f32` and `f64`.
 #[cfg(test)]
 mod rewrites {
+    use super::trig::AngleCoeffs;
     use super::*;
     use nalgebra::{Matrix2, Quaternion, UnitQuaternion};
 
@@ -365,12 +366,14 @@ mod rewrites {
         }
     }
 
-    /// Bit-for-bit equality (so `NaN`s of the same payload compare equal, `0.0` and `−0.0` not).
+    /// The same numbers: equal bits, except that `0.0` and `−0.0` count as equal (the old
+    /// `−(…)` of a whole block also negated its structural zeros) and any two `NaN`s do.
     fn same<T: Real>(a: &[T], b: &[T]) -> bool {
         a.len() == b.len()
-            && a.iter()
-                .zip(b)
-                .all(|(x, y)| x.to_f64().to_bits() == y.to_f64().to_bits())
+            && a.iter().zip(b).all(|(x, y)| {
+                let (x, y) = (x.to_f64(), y.to_f64());
+                x.to_bits() == y.to_bits() || x == y || (x.is_nan() && y.is_nan())
+            })
     }
 
     /// Rotation matrices of every Shepperd branch (angles up to and at π about each axis and
@@ -490,6 +493,83 @@ mod rewrites {
                 assert!(same(r.act(p).as_slice(), q.transform_vector(p).as_slice()));
             });
         });
+    }
+
+    /// SE(3)'s `Q` block as it was: nalgebra vectors and an outer product.
+    fn q_block_before<T: Real>(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix3<T> {
+        let se = k.se();
+        let dot = w.dot(v);
+        let s = v * k.b - w * (dot * (k.c + se.e + se.e));
+        let alpha = v * k.c + w * (T::lit(0.5) * se.f * dot);
+        let g = dot * (k.c + k.c + se.f * k.theta_sq);
+        let aw = alpha * w.transpose();
+        aw + aw.transpose() + skew(&s) - Matrix3::from_diagonal_element(g)
+    }
+
+    fn upper_before<T: Real>(diag: &Matrix3<T>, upper: &Matrix3<T>) -> SMatrix<T, 6, 6> {
+        let mut m = SMatrix::<T, 6, 6>::zeros();
+        m.fixed_view_mut::<3, 3>(0, 0).copy_from(diag);
+        m.fixed_view_mut::<3, 3>(0, 3).copy_from(upper);
+        m.fixed_view_mut::<3, 3>(3, 3).copy_from(diag);
+        m
+    }
+
+    fn split<T: Real>(xi: &SVector<T, 6>) -> (Vector3<T>, Vector3<T>) {
+        (
+            xi.fixed_rows::<3>(0).into_owned(),
+            xi.fixed_rows::<3>(3).into_owned(),
+        )
+    }
+
+    fn se3_jr_before<T: Real>(k: &AngleCoeffs<T>, xi: &SVector<T, 6>) -> SMatrix<T, 6, 6> {
+        let (v, w) = split(xi);
+        upper_before(&skew_poly(-k.b, k.c, &w), &q_block_before(k, &-v, &-w))
+    }
+
+    fn se3_jr_inv_before<T: Real>(k: &AngleCoeffs<T>, xi: &SVector<T, 6>) -> SMatrix<T, 6, 6> {
+        let (v, w) = split(xi);
+        let jinv = skew_poly(T::lit(0.5), k.d(), &w);
+        let q = q_block_before(k, &-v, &-w);
+        upper_before(&jinv, &-(jinv * q * jinv))
+    }
+
+    fn se3_jacobians<T: Real>() {
+        let mut rng = Lcg(19);
+        for_each_vector::<T>(23, |v| {
+            // Rotation angles from the series range to beyond π.
+            let scale = [1e-5, 1e-3, 0.1, 0.5, 1.0, 2.0, 3.1, 3.2, 5.0][rng.0 as usize % 9];
+            let w = Vector3::new(rng.next(), rng.next(), rng.next()).map(|x| T::lit(scale * x));
+            let xi = SVector::<T, 6>::new(v.x, v.y, v.z, w.x, w.y, w.z);
+            let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+            let m = |a: &SMatrix<T, 6, 6>, b: &SMatrix<T, 6, 6>| same(a.as_slice(), b.as_slice());
+            assert!(m(&Se3::right_jacobian(&xi), &se3_jr_before(&k, &xi)));
+            assert!(m(&Se3::left_jacobian(&xi), &se3_jr_before(&k, &-xi)));
+            assert!(m(
+                &Se3::right_jacobian_inv(&xi),
+                &se3_jr_inv_before(&k, &xi)
+            ));
+            assert!(m(
+                &Se3::left_jacobian_inv(&xi),
+                &se3_jr_inv_before(&k, &-xi)
+            ));
+            assert!(m(&Se3::exp_jac(&xi).1, &se3_jr_before(&k, &xi)));
+            // log_jac and rminus_jac: the kernel of the logarithm's angle.
+            let a = Se3::exp(&xi);
+            let b = Se3::exp(&(xi * T::lit(0.3)));
+            let (tau, j) = a.log_jac();
+            let kl = a.rotation().log_with_coeffs().1;
+            assert!(m(&j, &se3_jr_inv_before(&kl, &tau)));
+            let (tau, jr, jl) = a.rminus_jac(&b);
+            let kl = b.between(&a).rotation().log_with_coeffs().1;
+            assert!(m(&jr, &se3_jr_inv_before(&kl, &tau)));
+            assert!(m(&jl, &-se3_jr_inv_before(&kl, &-tau)));
+        });
+    }
+
+    #[test]
+    fn se3_rewrites_are_bit_identical() {
+        se3_jacobians::<f32>();
+        se3_jacobians::<f64>();
     }
 
     #[test]

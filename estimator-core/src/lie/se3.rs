@@ -65,21 +65,57 @@ fn upper_block<T: Real>(diag: &Matrix3<T>, upper: &Matrix3<T>) -> Matrix6<T> {
 /// Q = [b v − δ(c + 2e) ω]× + αωᵀ + ωαᵀ − δ(2c + fθ²) I,   α = c v + ½ f δ ω.
 /// ```
 ///
-/// No 3×3 product at all (eq. 7.86 as written takes eight).
-fn q_block<T: Real>(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix3<T> {
+/// No 3×3 product at all (eq. 7.86 as written takes eight). Returned as
+/// `sym·(αωᵀ + ωαᵀ − δ(2c + fθ²) I) + skew·[b v − δ(c + 2e) ω]×` for signs `sym`, `skew` = ±1,
+/// which covers every use: `Q` is even in `(v, ω)` in its symmetric part and odd in its skew
+/// part, so `Q(−v, −ω)` is `sym = 1, skew = −1`, and `−Q(−v, −ω)` is `sym = −1, skew = 1` (the
+/// signs are exact, so each is bit for bit the negated-argument or negated-result form).
+/// Written entry by entry (no 3-vector temporaries at opt-level "s").
+fn q_block<T: Real>(
+    k: &AngleCoeffs<T>,
+    v: &Vector3<T>,
+    w: &Vector3<T>,
+    sym: T,
+    skew: T,
+) -> Matrix3<T> {
     let se = k.se();
     let dot = w.dot(v);
-    let s = v * k.b - w * (dot * (k.c + se.e + se.e));
-    let alpha = v * k.c + w * (T::lit(0.5) * se.f * dot);
-    let g = dot * (k.c + k.c + se.f * k.theta_sq);
-    let aw = alpha * w.transpose();
-    let mut q = aw + aw.transpose() + skew(&s);
-    for i in 0..3 {
-        if let Some(x) = q.get_mut((i, i)) {
-            *x -= g;
-        }
-    }
-    q
+    let sc = dot * (k.c + se.e + se.e);
+    let fa = T::lit(0.5) * se.f * dot;
+    let g = dot * (k.c + k.c + se.f * k.theta_sq) * sym;
+    // α (times `sym`) and s = b v − δ(c + 2e) ω (times `skew`).
+    let (ax, ay, az) = (
+        (v.x * k.c + w.x * fa) * sym,
+        (v.y * k.c + w.y * fa) * sym,
+        (v.z * k.c + w.z * fa) * sym,
+    );
+    let (sx, sy, sz) = (
+        (v.x * k.b - w.x * sc) * skew,
+        (v.y * k.b - w.y * sc) * skew,
+        (v.z * k.b - w.z * sc) * skew,
+    );
+    let (xy, xz, yz) = (
+        ax * w.y + ay * w.x,
+        ax * w.z + az * w.x,
+        ay * w.z + az * w.y,
+    );
+    Matrix3::new(
+        ax * w.x + ax * w.x - g,
+        xy - sz,
+        xz + sy,
+        xy + sz,
+        ay * w.y + ay * w.y - g,
+        yz - sx,
+        xz - sy,
+        yz + sx,
+        az * w.z + az * w.z - g,
+    )
+}
+
+/// `a·b` for 3×3 matrices: one out-of-line copy when built for size.
+#[cfg_attr(estimator_compact, inline(never))]
+fn mul3<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    a * b
 }
 
 impl<T: Real> Se3<T> {
@@ -120,14 +156,42 @@ impl<T: Real> Se3<T> {
         }
     }
 
-    fn jr_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix6<T> {
-        upper_block(&So3::jr_from(k, w), &q_block(k, &-v, &-w))
+    /// `J_r(σξ)` for `σ = ±1` (`σ = −1`: `J_l(ξ)`), from the kernel of `ω`: the SO(3) block of
+    /// `σω` and `Q(−σv, −σω)`.
+    fn jr_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>, sigma: T) -> Matrix6<T> {
+        upper_block(
+            &So3::jr_from(k, &(w * sigma)),
+            &q_block(k, v, w, T::one(), -sigma),
+        )
     }
 
-    fn jr_inv_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix6<T> {
-        let jinv = So3::jr_inv_from(k, w);
-        let q = q_block(k, &-v, &-w);
-        upper_block(&jinv, &-(jinv * q * jinv))
+    /// `ρ·J_r⁻¹(σξ)` for `σ, ρ = ±1`: `[[ρJ, −ρ J Q(−σv, −σω) J], [0, ρJ]]` with `J = J_r⁻¹(σω)`
+    /// of SO(3); the signs go into `Q` (see [`q_block`]) and `J`, exactly.
+    fn jr_inv_from(
+        k: &AngleCoeffs<T>,
+        v: &Vector3<T>,
+        w: &Vector3<T>,
+        sigma: T,
+        rho: T,
+    ) -> Matrix6<T> {
+        let jinv = So3::jr_inv_from(k, &(w * sigma));
+        let q = q_block(k, v, w, -rho, rho * sigma);
+        upper_block(&(jinv * rho), &mul3(&mul3(&jinv, &q), &jinv))
+    }
+
+    /// `J_r(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left Jacobians.
+    #[inline(always)]
+    fn jr_at(xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
+        let (v, w) = split(xi);
+        Self::jr_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), &v, &w, sigma)
+    }
+
+    /// `J_r⁻¹(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left inverse Jacobians.
+    #[inline(always)]
+    fn jr_inv_at(xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
+        let (v, w) = split(xi);
+        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        Self::jr_inv_from(&k, &v, &w, sigma, T::one())
     }
 
     /// `−Ad_T = [[−R, [−t]×R], [0, −R]]`, built negated (no negation pass over 36 entries);
@@ -219,13 +283,21 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     }
 
     fn right_jacobian(xi: &Vector6<T>) -> Matrix6<T> {
-        let (v, w) = split(xi);
-        Self::jr_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), &v, &w)
+        Self::jr_at(xi, T::one())
     }
 
     fn right_jacobian_inv(xi: &Vector6<T>) -> Matrix6<T> {
-        let (v, w) = split(xi);
-        Self::jr_inv_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), &v, &w)
+        Self::jr_inv_at(xi, T::one())
+    }
+
+    /// `J_r(−ξ)`, with the sign taken inside (no negated tangent).
+    fn left_jacobian(xi: &Vector6<T>) -> Matrix6<T> {
+        Self::jr_at(xi, -T::one())
+    }
+
+    /// `J_r⁻¹(−ξ)`, with the sign taken inside (no negated tangent).
+    fn left_jacobian_inv(xi: &Vector6<T>) -> Matrix6<T> {
+        Self::jr_inv_at(xi, -T::one())
     }
 
     fn matrix(&self) -> Matrix4<T> {
@@ -263,13 +335,16 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     fn exp_jac(xi: &Vector6<T>) -> (Self, Matrix6<T>) {
         let (v, w) = split(xi);
         let k = AngleCoeffs::from_theta_sq(w.norm_squared());
-        (Self::exp_from(&k, &v, &w), Self::jr_from(&k, &v, &w))
+        (
+            Self::exp_from(&k, &v, &w),
+            Self::jr_from(&k, &v, &w, T::one()),
+        )
     }
 
     fn log_jac(&self) -> (Vector6<T>, Matrix6<T>) {
         let (xi, k) = self.log_with_coeffs();
         let (v, w) = split(&xi);
-        (xi, Self::jr_inv_from(&k, &v, &w))
+        (xi, Self::jr_inv_from(&k, &v, &w, T::one(), T::one()))
     }
 
     /// `(a⁻¹, −Ad_a)`.
@@ -290,8 +365,8 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         let (v, w) = split(&tau);
         (
             tau,
-            Self::jr_inv_from(&k, &v, &w),
-            -Self::jr_inv_from(&k, &-v, &-w),
+            Self::jr_inv_from(&k, &v, &w, T::one(), T::one()),
+            Self::jr_inv_from(&k, &v, &w, -T::one(), -T::one()),
         )
     }
 

@@ -566,8 +566,55 @@ mod rewrites {
         });
     }
 
+    fn se3_adjoint_before<T: Real>(a: &Se3<T>) -> SMatrix<T, 6, 6> {
+        let r = a.rotation().rotation_matrix();
+        let tr = mul_skew(&r.transpose(), &-a.translation()).transpose();
+        upper_before(&r, &tr)
+    }
+
+    fn se3_values<T: Real>() {
+        let mut rng = Lcg(29);
+        for_each_vector::<T>(31, |v| {
+            let scale = [1e-5, 1e-3, 0.1, 1.0, 3.1, 5.0][rng.0 as usize % 6];
+            let w = Vector3::new(rng.next(), rng.next(), rng.next()).map(|x| T::lit(scale * x));
+            let xi = SVector::<T, 6>::new(v.x, v.y, v.z, w.x, w.y, w.z);
+            let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+            let a = Se3::exp(&xi);
+            let wv = w.cross(v);
+            let t = v + wv * k.b + w.cross(&wv) * k.c;
+            assert!(same(a.translation().as_slice(), t.as_slice()));
+            // log: J_l⁻¹(ω) t with the logarithm's kernel.
+            let (w, kl) = a.rotation().log_with_coeffs();
+            let t = a.translation();
+            let wt = w.cross(&t);
+            let v_log = t - wt * T::lit(0.5) + w.cross(&wt) * kl.d();
+            let xi_log = a.log();
+            assert!(same(&xi_log.as_slice()[..3], v_log.as_slice()));
+            assert!(same(&xi_log.as_slice()[3..], w.as_slice()));
+            // Adjoint, and −Ad in inverse_jac and between_jac.
+            let b = Se3::exp(&(xi * T::lit(-0.7)));
+            let m = |a: &SMatrix<T, 6, 6>, b: &SMatrix<T, 6, 6>| same(a.as_slice(), b.as_slice());
+            assert!(m(&a.adjoint(), &se3_adjoint_before(&a)));
+            assert!(m(&a.inverse_jac().1, &-se3_adjoint_before(&a)));
+            let z = a.between(&b);
+            assert!(m(&a.between_jac(&b).1, &-se3_adjoint_before(&z.inverse())));
+            // act_jac: [R | −R[p]×], R p + t.
+            let p = xi.fixed_rows::<3>(0) * T::lit(3.0);
+            let r = a.rotation().rotation_matrix();
+            let mut j = SMatrix::<T, 3, 6>::zeros();
+            j.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
+            j.fixed_view_mut::<3, 3>(0, 3).copy_from(&mul_skew(&r, &-p));
+            let (ap, ja, jp) = a.act_jac(&p.into_owned());
+            assert!(same(ap.as_slice(), (r * p + a.translation()).as_slice()));
+            assert!(same(ja.as_slice(), j.as_slice()));
+            assert!(same(jp.as_slice(), r.as_slice()));
+        });
+    }
+
     #[test]
     fn se3_rewrites_are_bit_identical() {
+        se3_values::<f32>();
+        se3_values::<f64>();
         se3_jacobians::<f32>();
         se3_jacobians::<f64>();
     }

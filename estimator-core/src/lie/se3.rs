@@ -21,7 +21,7 @@
 use super::so3::So3;
 use super::trig::AngleCoeffs;
 use super::{all_finite, mul_skew, skew, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
-use nalgebra::{Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
+use nalgebra::{ArrayStorage, Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
 
 /// A rigid motion `T = (R, t) ∈ SE(3)`; `a_from_b` maps `b` coordinates into `a`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -112,6 +112,18 @@ fn q_block<T: Real>(
     )
 }
 
+/// `x + p ω×x + q ω×(ω×x)`, entry by entry: `J_l(ω) x` of SO(3) (`p = b`, `q = c`, the
+/// exponential's translation) and `J_l⁻¹(ω) x` (`p = −½`, `q = d`, the logarithm's).
+fn cross_poly<T: Real>(p: T, q: T, w: &Vector3<T>, x: &Vector3<T>) -> Vector3<T> {
+    let wx = w.cross(x);
+    let wwx = w.cross(&wx);
+    Vector3::new(
+        x.x + wx.x * p + wwx.x * q,
+        x.y + wx.y * p + wwx.y * q,
+        x.z + wx.z * p + wwx.z * q,
+    )
+}
+
 /// `a·b` for 3×3 matrices: one out-of-line copy when built for size.
 #[cfg_attr(estimator_compact, inline(never))]
 fn mul3<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
@@ -149,10 +161,9 @@ impl<T: Real> Se3<T> {
     }
 
     fn exp_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Self {
-        let wv = w.cross(v);
         Self {
             rotation: So3::exp_from(k, w),
-            translation: v + wv * k.b + w.cross(&wv) * k.c,
+            translation: cross_poly(k.b, k.c, w, v),
         }
     }
 
@@ -194,21 +205,25 @@ impl<T: Real> Se3<T> {
         Self::jr_inv_from(&k, &v, &w, sigma, T::one())
     }
 
-    /// `−Ad_T = [[−R, [−t]×R], [0, −R]]`, built negated (no negation pass over 36 entries);
-    /// `[−t]×R = (Rᵀ[t]×)ᵀ` since `[t]×ᵀ = −[t]×`.
-    fn neg_adjoint(&self) -> Matrix6<T> {
+    /// `σ·Ad_T = [[σR, [σt]×R], [0, σR]]` for `σ = ±1`: the adjoint, and `−Ad_T` built negated
+    /// (no negation pass over 36 entries); `[σt]×R = (Rᵀ[−σt]×)ᵀ` since `[t]×ᵀ = −[t]×`.
+    #[cfg_attr(estimator_compact, inline(never))]
+    fn signed_adjoint(&self, sigma: T) -> Matrix6<T> {
         let r = self.rotation.rotation_matrix();
-        let tr = mul_skew(&r.transpose(), &self.translation).transpose();
-        upper_block(&-r, &tr)
+        let tr = mul_skew(&r.transpose(), &(self.translation * -sigma)).transpose();
+        upper_block(&(r * sigma), &tr)
+    }
+
+    /// `−Ad_T`.
+    fn neg_adjoint(&self) -> Matrix6<T> {
+        self.signed_adjoint(-T::one())
     }
 
     /// `log` and the kernel of its rotation angle.
     fn log_with_coeffs(&self) -> (Vector6<T>, AngleCoeffs<T>) {
         let (w, k) = self.rotation.log_with_coeffs();
         // J_l⁻¹(ω) t = t − ½ ω×t + d ω×(ω×t).
-        let t = &self.translation;
-        let wt = w.cross(t);
-        let v = t - wt * T::lit(0.5) + w.cross(&wt) * k.d();
+        let v = cross_poly(T::lit(-0.5), k.d(), &w, &self.translation);
         (join(&v, &w), k)
     }
 }
@@ -276,10 +291,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     /// `[[R, [t]×R], [0, R]]`.
     fn adjoint(&self) -> Matrix6<T> {
-        let r = self.rotation.rotation_matrix();
-        // [t]× R = (Rᵀ[−t]×)ᵀ, since [t]×ᵀ = −[t]×.
-        let tr = mul_skew(&r.transpose(), &-self.translation).transpose();
-        upper_block(&r, &tr)
+        self.signed_adjoint(T::one())
     }
 
     fn right_jacobian(xi: &Vector6<T>) -> Matrix6<T> {
@@ -371,11 +383,14 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     }
 
     /// `(R p + t, [R | −R[p]×], R)`: seed Theorem 5.1.
+    ///
+    /// SO(3)'s `act_jac` gives `R p`, `−R[p]×` and `R`; the 3×6 block is their columns side by side.
     fn act_jac(&self, p: &Vector3<T>) -> (Vector3<T>, Matrix3x6<T>, Matrix3<T>) {
-        let r = self.rotation.rotation_matrix();
-        let mut j = Matrix3x6::zeros();
-        j.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
-        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&mul_skew(&r, &-p));
-        (r * p + self.translation, j, r)
+        let (rp, h, r) = self.rotation.act_jac(p);
+        let [r0, r1, r2] = r.data.0;
+        let [h0, h1, h2] = h.data.0;
+        let j = Matrix3x6::from_array_storage(ArrayStorage([r0, r1, r2, h0, h1, h2]));
+        let t = &self.translation;
+        (Vector3::new(rp.x + t.x, rp.y + t.y, rp.z + t.z), j, r)
     }
 }

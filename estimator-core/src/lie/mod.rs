@@ -292,27 +292,30 @@ pub fn skew<T: Real>(w: &Vector3<T>) -> Matrix3<T> {
     Matrix3::new(z, -w.z, w.y, w.z, z, -w.x, -w.y, w.x, z)
 }
 
-/// `I + p[ω]× + q[ω]×²`, the shape of the SO(3) series (`J_r = I − b[ω]× + c[ω]×²`,
+/// `s·I + p[ω]× + q[ω]×²`, the shape of the SO(3) series (`J_r = I − b[ω]× + c[ω]×²`,
 /// `J_r⁻¹ = I + ½[ω]× + d[ω]×²`, see the SO(3) module docs), written out entry by entry with
 /// `[ω]×² = ωωᵀ − ‖ω‖² I` (diagonal `−(ω_y² + ω_z²)` etc., no cancellation): no product of skew
 /// matrices and no 3×3 temporaries.
+///
+/// The signs are exact: `[−ω]× = −[ω]×` and `[−ω]×² = [ω]×²`, so `J(−ω) = J(ω)ᵀ` is `p → −p`
+/// (the transposed and left Jacobians) and `−J` is `(s, p, q) → (−s, −p, −q)`, each bit for bit
+/// the transposed or negated matrix.
 #[must_use]
-pub(crate) fn skew_poly<T: Real>(p: T, q: T, w: &Vector3<T>) -> Matrix3<T> {
+pub(crate) fn skew_poly<T: Real>(s: T, p: T, q: T, w: &Vector3<T>) -> Matrix3<T> {
     let (x, y, z) = (w.x, w.y, w.z);
     let (xx, yy, zz) = (x * x, y * y, z * z);
     let (qxy, qxz, qyz) = (q * x * y, q * x * z, q * y * z);
     let (px, py, pz) = (p * x, p * y, p * z);
-    let one = T::one();
     Matrix3::new(
-        one - q * (yy + zz),
+        s - q * (yy + zz),
         qxy - pz,
         qxz + py,
         qxy + pz,
-        one - q * (xx + zz),
+        s - q * (xx + zz),
         qyz - px,
         qxz - py,
         qyz + px,
-        one - q * (xx + yy),
+        s - q * (xx + yy),
     )
 }
 
@@ -491,6 +494,11 @@ mod rewrites {
             let r = So3::from_unit_quaternion(*q);
             for_each_vector::<T>(17, |p| {
                 assert!(same(r.act(p).as_slice(), q.transform_vector(p).as_slice()));
+                let m = r.rotation_matrix();
+                let (rp, h, jp) = r.act_jac(p);
+                assert!(same(rp.as_slice(), (m * p).as_slice()));
+                assert!(same(h.as_slice(), mul_skew(&m, &-p).as_slice()));
+                assert!(same(jp.as_slice(), m.as_slice()));
             });
         });
     }
@@ -523,12 +531,15 @@ mod rewrites {
 
     fn se3_jr_before<T: Real>(k: &AngleCoeffs<T>, xi: &SVector<T, 6>) -> SMatrix<T, 6, 6> {
         let (v, w) = split(xi);
-        upper_before(&skew_poly(-k.b, k.c, &w), &q_block_before(k, &-v, &-w))
+        upper_before(
+            &skew_poly(T::one(), -k.b, k.c, &w),
+            &q_block_before(k, &-v, &-w),
+        )
     }
 
     fn se3_jr_inv_before<T: Real>(k: &AngleCoeffs<T>, xi: &SVector<T, 6>) -> SMatrix<T, 6, 6> {
         let (v, w) = split(xi);
-        let jinv = skew_poly(T::lit(0.5), k.d(), &w);
+        let jinv = skew_poly(T::one(), T::lit(0.5), k.d(), &w);
         let q = q_block_before(k, &-v, &-w);
         upper_before(&jinv, &-(jinv * q * jinv))
     }
@@ -619,8 +630,69 @@ mod rewrites {
         se3_jacobians::<f64>();
     }
 
+    fn so3_jacobians<T: Real>() {
+        let m = |a: &Matrix3<T>, b: &Matrix3<T>| same(a.as_slice(), b.as_slice());
+        for_each_vector::<T>(37, |w| {
+            let jr = So3::right_jacobian(w);
+            let jr_inv = So3::right_jacobian_inv(w);
+            assert!(m(&So3::left_jacobian(w), &jr.transpose()));
+            assert!(m(&So3::left_jacobian_inv(w), &jr_inv.transpose()));
+            let a = So3::exp(w);
+            let b = So3::exp(&(w * T::lit(-0.4)));
+            let (tau, jr, jl) = a.rminus_jac(&b);
+            let k = b.between(&a).log_with_coeffs().1;
+            let jr_inv_k = skew_poly(T::one(), T::lit(0.5), k.d(), &tau);
+            assert!(m(&jr, &jr_inv_k));
+            assert!(m(&jl, &-jr_inv_k.transpose()));
+        });
+    }
+
+    /// SO(3)'s logarithm as it was: the principal quaternion with `v` negated when `w < 0`.
+    fn so3_log_before<T: Real>(q: &UnitQuaternion<T>) -> (Vector3<T>, T, T, T) {
+        use super::trig::{poly, Cutoff};
+        let (w, v) = if q.w < T::zero() {
+            (-q.w, -q.imag())
+        } else {
+            (q.w, q.imag())
+        };
+        let n2 = v.norm_squared();
+        let n = n2.sqrt();
+        let scale = if n2 < T::lit(Cutoff::<T>::ATAN_RATIO) * w * w {
+            let r2 = n2 / (w * w);
+            T::lit(2.0) / w * poly(r2, [T::lit(1.0), T::lit(-1.0 / 3.0), T::lit(1.0 / 5.0)])
+        } else {
+            T::lit(2.0) * n.atan2(w) / n
+        };
+        (v * scale, scale * n, n, w)
+    }
+
+    fn so3_log_and_normalize<T: Real>() {
+        let check = |q: &UnitQuaternion<T>| {
+            for q in [*q, UnitQuaternion::new_unchecked(-q.into_inner())] {
+                let (w, k) = So3::from_unit_quaternion(q).log_with_coeffs();
+                let (w0, theta, sin_half, cos_half) = so3_log_before(&q);
+                assert!(same(w.as_slice(), w0.as_slice()));
+                assert!(same(
+                    &[k.theta, k.sin_half, k.cos_half],
+                    &[theta, sin_half, cos_half]
+                ));
+                // from_quaternion of a scaled copy: `q · (1/‖q‖)`.
+                let big = q.into_inner() * T::lit(3.5);
+                let n = So3::from_quaternion(&big).map(|r| r.quaternion().into_inner());
+                let want = big * (T::one() / big.coords.norm_squared().sqrt());
+                assert!(n.is_some_and(|n| same(n.coords.as_slice(), want.coords.as_slice())));
+            }
+        };
+        for_each_quaternion::<T>(check);
+        for_each_vector::<T>(41, |w| check(&So3::exp(w).quaternion()));
+    }
+
     #[test]
     fn so3_rewrites_are_bit_identical() {
+        so3_log_and_normalize::<f32>();
+        so3_log_and_normalize::<f64>();
+        so3_jacobians::<f32>();
+        so3_jacobians::<f64>();
         so3_matrices::<f32>();
         so3_matrices::<f64>();
         so3_act::<f32>();

@@ -20,7 +20,7 @@
 
 use super::so3::So3;
 use super::trig::AngleCoeffs;
-use super::{all_finite, mul_skew, skew, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, mul_skew, skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{ArrayStorage, Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
 
 /// A rigid motion `T = (R, t) ∈ SE(3)`; `a_from_b` maps `b` coordinates into `a`.
@@ -170,10 +170,8 @@ impl<T: Real> Se3<T> {
     /// `J_r(σξ)` for `σ = ±1` (`σ = −1`: `J_l(ξ)`), from the kernel of `ω`: the SO(3) block of
     /// `σω` and `Q(−σv, −σω)`.
     fn jr_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>, sigma: T) -> Matrix6<T> {
-        upper_block(
-            &So3::jr_from(k, &(w * sigma)),
-            &q_block(k, v, w, T::one(), -sigma),
-        )
+        let jr = skew_poly(T::one(), -k.b * sigma, k.c, w);
+        upper_block(&jr, &q_block(k, v, w, T::one(), -sigma))
     }
 
     /// `ρ·J_r⁻¹(σξ)` for `σ, ρ = ±1`: `[[ρJ, −ρ J Q(−σv, −σω) J], [0, ρJ]]` with `J = J_r⁻¹(σω)`
@@ -185,7 +183,7 @@ impl<T: Real> Se3<T> {
         sigma: T,
         rho: T,
     ) -> Matrix6<T> {
-        let jinv = So3::jr_inv_from(k, &(w * sigma));
+        let jinv = skew_poly(T::one(), T::lit(0.5) * sigma, k.d(), w);
         let q = q_block(k, v, w, -rho, rho * sigma);
         upper_block(&(jinv * rho), &mul3(&mul3(&jinv, &q), &jinv))
     }

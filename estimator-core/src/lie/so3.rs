@@ -38,9 +38,15 @@ impl<T: Real> So3<T> {
         if !(n2.is_finite() && n2 > T::zero()) {
             return None;
         }
-        Some(Self {
-            q: UnitQuaternion::new_unchecked(*q * (T::one() / n2.sqrt())),
-        })
+        Some(Self::scaled(q, T::one() / n2.sqrt()))
+    }
+
+    /// `s·q`, trusted to be unit, written per component (no 4-vector temporary at opt-level "s").
+    #[inline]
+    fn scaled(q: &Quaternion<T>, s: T) -> Self {
+        Self {
+            q: UnitQuaternion::new_unchecked(Quaternion::new(q.w * s, q.i * s, q.j * s, q.k * s)),
+        }
     }
 
     /// From the components `w, x, y, z` of a Hamilton quaternion (see [`So3::from_quaternion`]).
@@ -120,21 +126,15 @@ impl<T: Real> So3<T> {
         Self::from_wxyz(w, x, y, z)
     }
 
-    /// The quaternion with `w ≥ 0` as `(w, v)`, the principal representative for `log`.
-    #[inline]
-    fn principal(&self) -> (T, Vector3<T>) {
-        let q = self.q.quaternion();
-        if q.w < T::zero() {
-            (-q.w, -q.imag())
-        } else {
-            (q.w, q.imag())
-        }
-    }
-
     /// `log` plus the half-angle sine and cosine it found, to build the kernel without trigonometry.
+    ///
+    /// The principal representative `±q` with `w ≥ 0` is taken implicitly: `w ← |w|` by the same
+    /// test, and the sign of `v` goes into the scale of `ω` (exact), so `v` is never negated.
     fn log_parts(&self) -> (Vector3<T>, T, T, T) {
-        let (w, v) = self.principal();
-        let n2 = v.norm_squared();
+        let q = self.q.quaternion();
+        let flip = q.w < T::zero();
+        let w = if flip { -q.w } else { q.w };
+        let n2 = q.i * q.i + q.j * q.j + q.k * q.k;
         let n = n2.sqrt();
         // θ = 2·atan2(n, w); below the cutoff (n/w small) use 2·atan(r)/r's series, r = n/w.
         let scale = if n2 < T::lit(Cutoff::<T>::ATAN_RATIO) * w * w {
@@ -143,20 +143,21 @@ impl<T: Real> So3<T> {
         } else {
             T::lit(2.0) * n.atan2(w) / n
         };
-        let omega = v * scale;
+        let signed = if flip { -scale } else { scale };
+        let omega = Vector3::new(q.i * signed, q.j * signed, q.k * signed);
         (omega, scale * n, n, w)
     }
 
     /// The SO(3) right Jacobian from precomputed coefficients: `I − b[ω]× + c[ω]×²`.
     #[inline]
     pub(crate) fn jr_from(k: &AngleCoeffs<T>, w: &Vector3<T>) -> Matrix3<T> {
-        skew_poly(-k.b, k.c, w)
+        skew_poly(T::one(), -k.b, k.c, w)
     }
 
     /// `J_r⁻¹ = I + ½[ω]× + d[ω]×²`.
     #[inline]
     pub(crate) fn jr_inv_from(k: &AngleCoeffs<T>, w: &Vector3<T>) -> Matrix3<T> {
-        skew_poly(T::lit(0.5), k.d(), w)
+        skew_poly(T::one(), T::lit(0.5), k.d(), w)
     }
 
     /// The unit quaternion `exp(ω)` from precomputed coefficients.
@@ -287,12 +288,16 @@ impl<T: Real> LieGroup<T> for So3<T> {
         Self::jr_inv_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), w)
     }
 
+    /// `J_r(ω)ᵀ = I + b[ω]× + c[ω]×²`.
     fn left_jacobian(w: &Vector3<T>) -> Matrix3<T> {
-        Self::right_jacobian(w).transpose()
+        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        skew_poly(T::one(), k.b, k.c, w)
     }
 
+    /// `J_r⁻¹(ω)ᵀ = I − ½[ω]× + d[ω]×²`.
     fn left_jacobian_inv(w: &Vector3<T>) -> Matrix3<T> {
-        Self::right_jacobian_inv(w).transpose()
+        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        skew_poly(T::one(), T::lit(-0.5), k.d(), w)
     }
 
     fn matrix(&self) -> Matrix3<T> {
@@ -346,14 +351,24 @@ impl<T: Real> LieGroup<T> for So3<T> {
 
     fn rminus_jac(&self, b: &Self) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {
         let (tau, k) = b.between(self).log_with_coeffs();
-        let jr_inv = Self::jr_inv_from(&k, &tau);
-        // J_l⁻¹(τ) = J_r⁻¹(τ)ᵀ for SO(3).
-        (tau, jr_inv, -jr_inv.transpose())
+        let d = k.d();
+        // −J_l⁻¹(τ) = −J_r⁻¹(τ)ᵀ = −I + ½[τ]× − d[τ]×², built negated.
+        (
+            tau,
+            skew_poly(T::one(), T::lit(0.5), d, &tau),
+            skew_poly(-T::one(), T::lit(0.5), -d, &tau),
+        )
     }
 
     /// `(R p, −R[p]×, R)`: seed Theorem 5.1 with `H(p) = [−p]×` (Example 5.2).
     fn act_jac(&self, p: &Vector3<T>) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {
         let r = self.rotation_matrix();
-        (r * p, mul_skew(&r, &-p), r)
+        // `R p` and `−p` entry by entry (nalgebra's order of operations for `R p`).
+        let rp = Vector3::new(
+            r.m11 * p.x + r.m12 * p.y + r.m13 * p.z,
+            r.m21 * p.x + r.m22 * p.y + r.m23 * p.z,
+            r.m31 * p.x + r.m32 * p.y + r.m33 * p.z,
+        );
+        (rp, mul_skew(&r, &Vector3::new(-p.x, -p.y, -p.z)), r)
     }
 }

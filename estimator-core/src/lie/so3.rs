@@ -128,13 +128,16 @@ impl<T: Real> So3<T> {
 
     /// `log` plus the half-angle sine and cosine it found, to build the kernel without trigonometry.
     ///
-    /// The principal representative `±q` with `w ≥ 0` is taken implicitly: `w ← |w|` by the same
-    /// test, and the sign of `v` goes into the scale of `ω` (exact), so `v` is never negated.
+    /// The principal representative `±q` with `w ≥ 0`, component by component (no 3-vector
+    /// temporaries at opt-level "s").
     fn log_parts(&self) -> (Vector3<T>, T, T, T) {
         let q = self.q.quaternion();
-        let flip = q.w < T::zero();
-        let w = if flip { -q.w } else { q.w };
-        let n2 = q.i * q.i + q.j * q.j + q.k * q.k;
+        let (w, x, y, z) = if q.w < T::zero() {
+            (-q.w, -q.i, -q.j, -q.k)
+        } else {
+            (q.w, q.i, q.j, q.k)
+        };
+        let n2 = x * x + y * y + z * z;
         let n = n2.sqrt();
         // θ = 2·atan2(n, w); below the cutoff (n/w small) use 2·atan(r)/r's series, r = n/w.
         let scale = if n2 < T::lit(Cutoff::<T>::ATAN_RATIO) * w * w {
@@ -143,9 +146,12 @@ impl<T: Real> So3<T> {
         } else {
             T::lit(2.0) * n.atan2(w) / n
         };
-        let signed = if flip { -scale } else { scale };
-        let omega = Vector3::new(q.i * signed, q.j * signed, q.k * signed);
-        (omega, scale * n, n, w)
+        (
+            Vector3::new(x * scale, y * scale, z * scale),
+            scale * n,
+            n,
+            w,
+        )
     }
 
     /// The SO(3) right Jacobian from precomputed coefficients: `I − b[ω]× + c[ω]×²`.

@@ -1,0 +1,348 @@
+//! The size-driven rewrites (scalar forms, one-path Shepperd, shared helpers) against the
+//! straightforward nalgebra expressions they replace: the same bits, `f32` and `f64`.
+
+use super::trig::AngleCoeffs;
+use super::*;
+use nalgebra::{Matrix2, Quaternion, UnitQuaternion};
+
+/// Deterministic numbers in `[-1, 1)` (64-bit LCG).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((self.0 >> 11) as f64) / ((1u64 << 52) as f64) - 1.0
+    }
+}
+
+/// The same numbers: equal bits, except that `0.0` and `−0.0` count as equal (the old
+/// `−(…)` of a whole block also negated its structural zeros) and any two `NaN`s do.
+fn same<T: Real>(a: &[T], b: &[T]) -> bool {
+    a.len() == b.len()
+        && a.iter().zip(b).all(|(x, y)| {
+            let (x, y) = (x.to_f64(), y.to_f64());
+            x.to_bits() == y.to_bits() || x == y || (x.is_nan() && y.is_nan())
+        })
+}
+
+/// Rotation matrices of every Shepperd branch (angles up to and at π about each axis and
+/// random axes), perturbed ones, and arbitrary matrices.
+fn for_each_matrix<T: Real>(mut f: impl FnMut(&Matrix3<T>)) {
+    let mut rng = Lcg(7);
+    for i in 0..400 {
+        let axis = match i % 4 {
+            0 => Vector3::new(1.0, 0.0, 0.0),
+            1 => Vector3::new(0.0, 1.0, 0.0),
+            2 => Vector3::new(0.0, 0.0, 1.0),
+            _ => Vector3::new(rng.next(), rng.next(), rng.next()),
+        };
+        let angle = core::f64::consts::PI * (1.0 - (f64::from(i) / 400.0).powi(3));
+        let r = UnitQuaternion::from_scaled_axis(axis.normalize() * angle);
+        let m = *r.to_rotation_matrix().matrix();
+        let noise = if i % 3 == 0 { 1e-4 } else { 0.0 };
+        f(&m.map(|x| T::lit(x + noise * rng.next())));
+        f(&Matrix3::from_fn(|_, _| T::lit(rng.next())));
+    }
+}
+
+/// Vectors of magnitudes from `1e-6` to `100`.
+fn for_each_vector<T: Real>(seed: u64, mut f: impl FnMut(&Vector3<T>)) {
+    let mut rng = Lcg(seed);
+    for i in 0..100 {
+        let s = [1e-6, 1e-2, 1.0, 3.0, 100.0][i % 5];
+        f(&Vector3::new(rng.next(), rng.next(), rng.next()).map(|x| T::lit(s * x)));
+    }
+}
+
+fn for_each_quaternion<T: Real>(mut f: impl FnMut(&UnitQuaternion<T>)) {
+    let mut rng = Lcg(13);
+    for _ in 0..100 {
+        let q = Quaternion::new(rng.next(), rng.next(), rng.next(), rng.next());
+        let q = Quaternion::from(q.coords.map(T::lit));
+        f(&UnitQuaternion::new_unchecked(q * (T::one() / q.norm())));
+    }
+}
+
+/// The four written-out branches of Shepperd's method (before the one-path form).
+fn shepperd_branches<T: Real>(m: &Matrix3<T>) -> Option<So3<T>> {
+    let one = T::one();
+    let quarter = T::lit(0.25);
+    let trace = m.m11 + m.m22 + m.m33;
+    let (w, x, y, z);
+    if trace > T::zero() {
+        let s = (trace + one).sqrt() * T::lit(2.0);
+        w = quarter * s;
+        x = (m.m32 - m.m23) / s;
+        y = (m.m13 - m.m31) / s;
+        z = (m.m21 - m.m12) / s;
+    } else if m.m11 > m.m22 && m.m11 > m.m33 {
+        let s = (one + m.m11 - m.m22 - m.m33).sqrt() * T::lit(2.0);
+        w = (m.m32 - m.m23) / s;
+        x = quarter * s;
+        y = (m.m12 + m.m21) / s;
+        z = (m.m13 + m.m31) / s;
+    } else if m.m22 > m.m33 {
+        let s = (one + m.m22 - m.m11 - m.m33).sqrt() * T::lit(2.0);
+        w = (m.m13 - m.m31) / s;
+        x = (m.m12 + m.m21) / s;
+        y = quarter * s;
+        z = (m.m23 + m.m32) / s;
+    } else {
+        let s = (one + m.m33 - m.m11 - m.m22).sqrt() * T::lit(2.0);
+        w = (m.m21 - m.m12) / s;
+        x = (m.m13 + m.m31) / s;
+        y = (m.m23 + m.m32) / s;
+        z = quarter * s;
+    }
+    So3::from_wxyz(w, x, y, z)
+}
+
+fn so3_try_from_matrix_before<T: Real>(m: &Matrix3<T>) -> Option<So3<T>> {
+    if !all_finite(m.as_slice()) {
+        return None;
+    }
+    let err = (m.transpose() * m - Matrix3::<T>::identity()).norm_squared();
+    let tol = T::lit(ORTHOGONALITY_TOLERANCE);
+    if !(err <= tol * tol && m.determinant() > T::zero()) {
+        return None;
+    }
+    shepperd_branches(m)
+}
+
+fn so3_matrices<T: Real>() {
+    let mut accepted = 0;
+    let mut branch = [0usize; 4];
+    for_each_matrix::<T>(|m| {
+        let err = (m.transpose() * m - Matrix3::<T>::identity()).norm_squared();
+        assert!(same(&[orthogonality_error(m)], &[err]));
+        let m2 = m.fixed_view::<2, 2>(0, 0).into_owned();
+        let err2 = (m2.transpose() * m2 - Matrix2::<T>::identity()).norm_squared();
+        assert!(same(&[orthogonality_error(&m2)], &[err2]));
+        let got = So3::try_from_matrix(m).map(|r| r.quaternion().coords);
+        let want = so3_try_from_matrix_before(m).map(|r| r.quaternion().coords);
+        assert_eq!(got.is_some(), want.is_some());
+        if let (Some(g), Some(w)) = (got, want) {
+            assert!(same(g.as_slice(), w.as_slice()), "{m}");
+            accepted += 1;
+            // Which component Shepperd took by the square root: the largest here.
+            let k = g.iamax();
+            if let Some(b) = branch.get_mut((k + 1) % 4) {
+                *b += 1;
+            }
+        }
+    });
+    assert!(accepted > 300, "{accepted}");
+    assert!(branch.iter().all(|&n| n > 20), "{branch:?}");
+}
+
+fn so3_act<T: Real>() {
+    for_each_quaternion::<T>(|q| {
+        let r = So3::from_unit_quaternion(*q);
+        for_each_vector::<T>(17, |p| {
+            assert!(same(r.act(p).as_slice(), q.transform_vector(p).as_slice()));
+            let m = r.rotation_matrix();
+            let (rp, h, jp) = r.act_jac(p);
+            assert!(same(rp.as_slice(), (m * p).as_slice()));
+            assert!(same(h.as_slice(), mul_skew(&m, &-p).as_slice()));
+            assert!(same(jp.as_slice(), m.as_slice()));
+        });
+    });
+}
+
+/// SE(3)'s `Q` block as it was: nalgebra vectors and an outer product.
+fn q_block_before<T: Real>(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix3<T> {
+    let se = k.se();
+    let dot = w.dot(v);
+    let s = v * k.b - w * (dot * (k.c + se.e + se.e));
+    let alpha = v * k.c + w * (T::lit(0.5) * se.f * dot);
+    let g = dot * (k.c + k.c + se.f * k.theta_sq);
+    let aw = alpha * w.transpose();
+    aw + aw.transpose() + skew(&s) - Matrix3::from_diagonal_element(g)
+}
+
+fn upper_before<T: Real>(diag: &Matrix3<T>, upper: &Matrix3<T>) -> SMatrix<T, 6, 6> {
+    let mut m = SMatrix::<T, 6, 6>::zeros();
+    m.fixed_view_mut::<3, 3>(0, 0).copy_from(diag);
+    m.fixed_view_mut::<3, 3>(0, 3).copy_from(upper);
+    m.fixed_view_mut::<3, 3>(3, 3).copy_from(diag);
+    m
+}
+
+fn split<T: Real>(xi: &SVector<T, 6>) -> (Vector3<T>, Vector3<T>) {
+    (
+        xi.fixed_rows::<3>(0).into_owned(),
+        xi.fixed_rows::<3>(3).into_owned(),
+    )
+}
+
+fn se3_jr_before<T: Real>(k: &AngleCoeffs<T>, xi: &SVector<T, 6>) -> SMatrix<T, 6, 6> {
+    let (v, w) = split(xi);
+    upper_before(
+        &skew_poly(T::one(), -k.b, k.c, &w),
+        &q_block_before(k, &-v, &-w),
+    )
+}
+
+fn se3_jr_inv_before<T: Real>(k: &AngleCoeffs<T>, xi: &SVector<T, 6>) -> SMatrix<T, 6, 6> {
+    let (v, w) = split(xi);
+    let jinv = skew_poly(T::one(), T::lit(0.5), k.d(), &w);
+    let q = q_block_before(k, &-v, &-w);
+    upper_before(&jinv, &-(jinv * q * jinv))
+}
+
+fn se3_jacobians<T: Real>() {
+    let mut rng = Lcg(19);
+    for_each_vector::<T>(23, |v| {
+        // Rotation angles from the series range to beyond π.
+        let scale = [1e-5, 1e-3, 0.1, 0.5, 1.0, 2.0, 3.1, 3.2, 5.0][rng.0 as usize % 9];
+        let w = Vector3::new(rng.next(), rng.next(), rng.next()).map(|x| T::lit(scale * x));
+        let xi = SVector::<T, 6>::new(v.x, v.y, v.z, w.x, w.y, w.z);
+        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        let m = |a: &SMatrix<T, 6, 6>, b: &SMatrix<T, 6, 6>| same(a.as_slice(), b.as_slice());
+        assert!(m(&Se3::right_jacobian(&xi), &se3_jr_before(&k, &xi)));
+        assert!(m(&Se3::left_jacobian(&xi), &se3_jr_before(&k, &-xi)));
+        assert!(m(
+            &Se3::right_jacobian_inv(&xi),
+            &se3_jr_inv_before(&k, &xi)
+        ));
+        assert!(m(
+            &Se3::left_jacobian_inv(&xi),
+            &se3_jr_inv_before(&k, &-xi)
+        ));
+        assert!(m(&Se3::exp_jac(&xi).1, &se3_jr_before(&k, &xi)));
+        // log_jac and rminus_jac: the kernel of the logarithm's angle.
+        let a = Se3::exp(&xi);
+        let b = Se3::exp(&(xi * T::lit(0.3)));
+        let (tau, j) = a.log_jac();
+        let kl = a.rotation().log_with_coeffs().1;
+        assert!(m(&j, &se3_jr_inv_before(&kl, &tau)));
+        let (tau, jr, jl) = a.rminus_jac(&b);
+        let kl = b.between(&a).rotation().log_with_coeffs().1;
+        assert!(m(&jr, &se3_jr_inv_before(&kl, &tau)));
+        assert!(m(&jl, &-se3_jr_inv_before(&kl, &-tau)));
+    });
+}
+
+fn se3_adjoint_before<T: Real>(a: &Se3<T>) -> SMatrix<T, 6, 6> {
+    let r = a.rotation().rotation_matrix();
+    let tr = mul_skew(&r.transpose(), &-a.translation()).transpose();
+    upper_before(&r, &tr)
+}
+
+fn se3_values<T: Real>() {
+    let mut rng = Lcg(29);
+    for_each_vector::<T>(31, |v| {
+        let scale = [1e-5, 1e-3, 0.1, 1.0, 3.1, 5.0][rng.0 as usize % 6];
+        let w = Vector3::new(rng.next(), rng.next(), rng.next()).map(|x| T::lit(scale * x));
+        let xi = SVector::<T, 6>::new(v.x, v.y, v.z, w.x, w.y, w.z);
+        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        let a = Se3::exp(&xi);
+        let wv = w.cross(v);
+        let t = v + wv * k.b + w.cross(&wv) * k.c;
+        assert!(same(a.translation().as_slice(), t.as_slice()));
+        // log: J_l⁻¹(ω) t with the logarithm's kernel.
+        let (w, kl) = a.rotation().log_with_coeffs();
+        let t = a.translation();
+        let wt = w.cross(&t);
+        let v_log = t - wt * T::lit(0.5) + w.cross(&wt) * kl.d();
+        let xi_log = a.log();
+        assert!(same(&xi_log.as_slice()[..3], v_log.as_slice()));
+        assert!(same(&xi_log.as_slice()[3..], w.as_slice()));
+        // Adjoint, and −Ad in inverse_jac and between_jac.
+        let b = Se3::exp(&(xi * T::lit(-0.7)));
+        let m = |a: &SMatrix<T, 6, 6>, b: &SMatrix<T, 6, 6>| same(a.as_slice(), b.as_slice());
+        assert!(m(&a.adjoint(), &se3_adjoint_before(&a)));
+        assert!(m(&a.inverse_jac().1, &-se3_adjoint_before(&a)));
+        let z = a.between(&b);
+        assert!(m(&a.between_jac(&b).1, &-se3_adjoint_before(&z.inverse())));
+        // act_jac: [R | −R[p]×], R p + t.
+        let p = xi.fixed_rows::<3>(0) * T::lit(3.0);
+        let r = a.rotation().rotation_matrix();
+        let mut j = SMatrix::<T, 3, 6>::zeros();
+        j.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
+        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&mul_skew(&r, &-p));
+        let (ap, ja, jp) = a.act_jac(&p.into_owned());
+        assert!(same(ap.as_slice(), (r * p + a.translation()).as_slice()));
+        assert!(same(ja.as_slice(), j.as_slice()));
+        assert!(same(jp.as_slice(), r.as_slice()));
+    });
+}
+
+#[test]
+fn se3_rewrites_are_bit_identical() {
+    se3_values::<f32>();
+    se3_values::<f64>();
+    se3_jacobians::<f32>();
+    se3_jacobians::<f64>();
+}
+
+fn so3_jacobians<T: Real>() {
+    let m = |a: &Matrix3<T>, b: &Matrix3<T>| same(a.as_slice(), b.as_slice());
+    for_each_vector::<T>(37, |w| {
+        let jr = So3::right_jacobian(w);
+        let jr_inv = So3::right_jacobian_inv(w);
+        assert!(m(&So3::left_jacobian(w), &jr.transpose()));
+        assert!(m(&So3::left_jacobian_inv(w), &jr_inv.transpose()));
+        let a = So3::exp(w);
+        let b = So3::exp(&(w * T::lit(-0.4)));
+        let (tau, jr, jl) = a.rminus_jac(&b);
+        let k = b.between(&a).log_with_coeffs().1;
+        let jr_inv_k = skew_poly(T::one(), T::lit(0.5), k.d(), &tau);
+        assert!(m(&jr, &jr_inv_k));
+        assert!(m(&jl, &-jr_inv_k.transpose()));
+    });
+}
+
+/// SO(3)'s logarithm as it was: the principal quaternion with `v` negated when `w < 0`.
+fn so3_log_before<T: Real>(q: &UnitQuaternion<T>) -> (Vector3<T>, T, T, T) {
+    use super::trig::{poly, Cutoff};
+    let (w, v) = if q.w < T::zero() {
+        (-q.w, -q.imag())
+    } else {
+        (q.w, q.imag())
+    };
+    let n2 = v.norm_squared();
+    let n = n2.sqrt();
+    let scale = if n2 < T::lit(Cutoff::<T>::ATAN_RATIO) * w * w {
+        let r2 = n2 / (w * w);
+        T::lit(2.0) / w * poly(r2, [T::lit(1.0), T::lit(-1.0 / 3.0), T::lit(1.0 / 5.0)])
+    } else {
+        T::lit(2.0) * n.atan2(w) / n
+    };
+    (v * scale, scale * n, n, w)
+}
+
+fn so3_log_and_normalize<T: Real>() {
+    let check = |q: &UnitQuaternion<T>| {
+        for q in [*q, UnitQuaternion::new_unchecked(-q.into_inner())] {
+            let (w, k) = So3::from_unit_quaternion(q).log_with_coeffs();
+            let (w0, theta, sin_half, cos_half) = so3_log_before(&q);
+            assert!(same(w.as_slice(), w0.as_slice()));
+            assert!(same(
+                &[k.theta, k.sin_half, k.cos_half],
+                &[theta, sin_half, cos_half]
+            ));
+            // from_quaternion of a scaled copy: `q · (1/‖q‖)`.
+            let big = q.into_inner() * T::lit(3.5);
+            let n = So3::from_quaternion(&big).map(|r| r.quaternion().into_inner());
+            let want = big * (T::one() / big.coords.norm_squared().sqrt());
+            assert!(n.is_some_and(|n| same(n.coords.as_slice(), want.coords.as_slice())));
+        }
+    };
+    for_each_quaternion::<T>(check);
+    for_each_vector::<T>(41, |w| check(&So3::exp(w).quaternion()));
+}
+
+#[test]
+fn so3_rewrites_are_bit_identical() {
+    so3_log_and_normalize::<f32>();
+    so3_log_and_normalize::<f64>();
+    so3_jacobians::<f32>();
+    so3_jacobians::<f64>();
+    so3_matrices::<f32>();
+    so3_matrices::<f64>();
+    so3_act::<f32>();
+    so3_act::<f64>();
+}

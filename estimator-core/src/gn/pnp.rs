@@ -243,25 +243,35 @@ pub fn check_point_spread<T: Real>(points: &[Vector3<T>]) -> Result<(), SolveErr
     if n == 0 {
         return Err(SolveError::DegenerateGeometry);
     }
-    let inv_n = T::one() / T::from_usize(n).unwrap_or_else(T::one);
-    let mean = points.iter().fold(Vector3::zeros(), |acc, p| acc + p) * inv_n;
-    let s = points.iter().fold(Matrix3::zeros(), |acc: Matrix3<T>, p| {
+    let count = T::from_usize(n).unwrap_or_else(T::one);
+    let inv_n = T::one() / count;
+    let mut sum = Vector3::zeros();
+    for p in points {
+        sum += p;
+    }
+    let mean = sum * inv_n;
+    // The six distinct entries of the symmetric `S` (`d dᵀ` is exactly symmetric), summed in
+    // the order of the points.
+    let [mut s11, mut s22, mut s33, mut s12, mut s13, mut s23] = [T::zero(); 6];
+    for p in points {
         let d = p - mean;
-        acc + d * d.transpose()
-    });
-    let tr = s.m11 + s.m22 + s.m33;
-    let i2 = s.m11 * s.m22 - s.m12 * s.m21 + s.m11 * s.m33 - s.m13 * s.m31 + s.m22 * s.m33
-        - s.m23 * s.m32;
-    let scale = mean.norm_squared() + T::one();
-    let spread = tr > T::lit(COINCIDENT_REL) * T::from_usize(n).unwrap_or_else(T::one) * scale;
-    if !spread {
-        return Err(SolveError::DegenerateGeometry);
+        s11 += d.x * d.x;
+        s22 += d.y * d.y;
+        s33 += d.z * d.z;
+        s12 += d.x * d.y;
+        s13 += d.x * d.z;
+        s23 += d.y * d.z;
     }
+    let tr = s11 + s22 + s33;
+    let i2 = s11 * s22 - s12 * s12 + s11 * s33 - s13 * s13 + s22 * s33 - s23 * s23;
+    let scale = mean.x * mean.x + mean.y * mean.y + mean.z * mean.z + T::one();
+    let spread = tr > T::lit(COINCIDENT_REL) * count * scale;
     let not_collinear = i2 > T::lit(COLLINEAR_REL) * tr * tr;
-    if !not_collinear {
-        return Err(SolveError::DegenerateGeometry);
+    if spread && not_collinear {
+        Ok(())
+    } else {
+        Err(SolveError::DegenerateGeometry)
     }
-    Ok(())
 }
 
 /// The χ²(2) inlier test `‖eⱼ‖² ≤ chi2` of every observation at `pose`.

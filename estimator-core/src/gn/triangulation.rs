@@ -1,6 +1,6 @@
 //! Triangulation of one landmark `p ∈ R³` from several calibrated views:
-//! minimizes `Σᵢ ρ(‖K π(Tᵢ p) − zᵢ‖² / σ²)` over `p` with the [`solve`] core, from a linear
-//! start.
+//! minimizes `Σᵢ ρ(‖K π(Tᵢ p) − zᵢ‖² / σ²)` over `p` with the [`solve`](super::solve) core, from
+//! a linear start.
 //!
 //! * **Start** (closed form): the point closest to all rays in the least-squares sense. The ray
 //!   of view `i` leaves the centre `cᵢ = −Rᵢᵀ tᵢ` along `dᵢ = Rᵢᵀ K⁻¹[u, v, 1]ᵀ / ‖·‖`; with the
@@ -10,7 +10,7 @@
 //!   `∂eᵢ/∂p = Jπ(xᵢ) Rᵢ / σ` (seed Theorem 5.1: `∂(T p)/∂p = R`), and `p ⊕ δ = p + δ`.
 //! * **Covariance**: `(Σ wᵢ JᵢᵀJᵢ)⁻¹` at the solution (m²).
 
-use super::solver::{solve, Method, Problem, SolverOptions, Status};
+use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
 use super::{Factor, Loss, PinholeCamera, SolveError};
 use crate::lie::{LieGroup, Se3};
 use crate::Real;
@@ -172,7 +172,8 @@ pub fn triangulate<T: Real>(
         max_iterations: options.max_iterations,
         ..SolverOptions::default()
     };
-    let sol = solve(&problem, &start, &solver_options)?;
+    let mut sol = Solution::placeholder(&start);
+    solve_into(&problem, &start, &solver_options, &mut sol)?;
     // The solver evaluated every view at its last linearization; the final (converged) step is
     // re-checked here so that a returned point is in front of every camera.
     let in_front = cameras_from_world

@@ -16,6 +16,7 @@
 use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
 use super::{Loss, PinholeCamera, SolveError};
 use crate::lie::{LieGroup, Se3};
+use crate::scalar::all_finite;
 use crate::Real;
 use nalgebra::{Matrix2x6, Matrix3, Matrix6, SMatrix, SVector, Vector2, Vector3};
 
@@ -398,8 +399,8 @@ pub fn solve_pnp<T: Real>(
     {
         return Err(SolveError::InvalidOptions);
     }
-    if !world_points.iter().all(|p| p.iter().all(|x| x.is_finite()))
-        || !pixels.iter().all(|z| z.iter().all(|x| x.is_finite()))
+    if !world_points.iter().all(|p| all_finite(p.as_slice()))
+        || !pixels.iter().all(|z| all_finite(z.as_slice()))
     {
         return Err(SolveError::NonFiniteInput);
     }

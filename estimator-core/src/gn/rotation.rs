@@ -18,6 +18,7 @@
 use super::solver::{solve_into, Problem, Solution, SolverOptions, Status};
 use super::SolveError;
 use crate::lie::{skew, LieGroup, So3};
+use crate::scalar::all_finite;
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
@@ -140,7 +141,7 @@ pub fn solve_rotation_from_vectors<T: Real>(
             got: pairs.len(),
         });
     }
-    let finite = |v: &Vector3<T>| v.iter().all(|x| x.is_finite());
+    let finite = |v: &Vector3<T>| all_finite(v.as_slice());
     if !pairs
         .iter()
         .all(|p| finite(&p.body) && finite(&p.world) && p.sigma.is_finite())

@@ -13,6 +13,7 @@
 use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
 use super::{Factor, Loss, PinholeCamera, SolveError};
 use crate::lie::{LieGroup, Se3};
+use crate::scalar::all_finite;
 use crate::Real;
 use nalgebra::{Matrix2x3, Matrix3, SMatrix, SVector, Vector2, Vector3};
 
@@ -137,7 +138,7 @@ pub fn triangulate<T: Real>(
         return Err(SolveError::InvalidOptions);
     }
     if !cameras_from_world.iter().all(|t| t.is_finite())
-        || !pixels.iter().all(|z| z.iter().all(|x| x.is_finite()))
+        || !pixels.iter().all(|z| all_finite(z.as_slice()))
     {
         return Err(SolveError::NonFiniteInput);
     }

@@ -174,7 +174,7 @@ pub fn reprojection_error<T: Real>(
     inv_sigma: T,
     min_depth: T,
 ) -> Option<(Vector2<T>, Matrix2x6<T>)> {
-    let x = r * p + t;
+    let x = camera_point(r, t, p);
     let (uv, jp) = camera.project_jac(&x, min_depth)?;
     let jp = jp * inv_sigma;
     let b = jp * r; // Jπ R: the translation block.
@@ -191,6 +191,19 @@ pub fn reprojection_error<T: Real>(
     j.m25 = r1.y;
     j.m26 = r1.z;
     Some(((uv - z) * inv_sigma, j))
+}
+
+/// `R p + t`: a world point in the camera frame (one copy of the code for every caller in a
+/// build for size).
+#[cfg_attr(not(estimator_compact), inline(always))]
+#[cfg_attr(estimator_compact, inline(never))]
+fn camera_point<T: Real>(r: &Matrix3<T>, t: &Vector3<T>, p: &Vector3<T>) -> Vector3<T> {
+    // Row by row, in the order of nalgebra's `r * p + t` (column by column, then `t`).
+    Vector3::new(
+        p.x * r.m11 + p.y * r.m12 + p.z * r.m13 + t.x,
+        p.x * r.m21 + p.y * r.m22 + p.z * r.m23 + t.y,
+        p.x * r.m31 + p.y * r.m32 + p.z * r.m33 + t.z,
+    )
 }
 
 /// The PnP residuals as a [`Problem`] over `Se3` (whitened, `K = 2`).
@@ -292,7 +305,7 @@ fn inlier_mask<T: Real>(
     for (k, (p, z)) in pairs.enumerate() {
         let uv = problem
             .camera
-            .project(&(r * p + t), problem.min_depth)
+            .project(&camera_point(&r, &t, p), problem.min_depth)
             .ok_or(SolveError::PointBehindCamera)?;
         let e = (uv - z) * problem.inv_sigma;
         if e.norm_squared() <= chi2 {

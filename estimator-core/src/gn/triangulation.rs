@@ -143,7 +143,7 @@ pub fn triangulate<T: Real>(
         return Err(SolveError::NonFiniteInput);
     }
 
-    // Linear start: (Σ Pᵢ) p = Σ Pᵢ cᵢ.
+    // Linear start: (Σ Pᵢ) p = Σ Pᵢ cᵢ (the upper triangle of `m` stays zero).
     let mut m = Matrix3::zeros();
     let mut b = Vector3::zeros();
     for (pose, z) in cameras_from_world.iter().zip(pixels) {
@@ -151,9 +151,21 @@ pub fn triangulate<T: Real>(
         let c = world_from_camera.translation();
         let d = world_from_camera.rotation().act(&camera.unproject(z));
         let d = d / d.norm();
-        let proj = Matrix3::identity() - d * d.transpose();
-        m += proj;
-        b += proj * c;
+        // `Pᵢ = I − d dᵀ` is symmetric and `Factor::new` reads only the lower triangle of `m`:
+        // its six distinct entries, then `m += Pᵢ` (lower triangle), `b += Pᵢ cᵢ`, each entry
+        // with the arithmetic of nalgebra's `identity() − d * dᵀ` and `proj * c`.
+        let (x, y, z) = (d.x, d.y, d.z);
+        let (pxx, pyy, pzz) = (T::one() - x * x, T::one() - y * y, T::one() - z * z);
+        let (pxy, pxz, pyz) = (T::zero() - x * y, T::zero() - x * z, T::zero() - y * z);
+        m.m11 += pxx;
+        m.m21 += pxy;
+        m.m31 += pxz;
+        m.m22 += pyy;
+        m.m32 += pyz;
+        m.m33 += pzz;
+        b.x += c.x * pxx + c.y * pxy + c.z * pxz;
+        b.y += c.x * pxy + c.y * pyy + c.z * pyz;
+        b.z += c.x * pxz + c.y * pyz + c.z * pzz;
     }
     let start = Factor::new(&m)
         .and_then(|f| f.solve(&b))

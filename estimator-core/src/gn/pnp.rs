@@ -197,7 +197,7 @@ pub fn reprojection_error<T: Real>(
 /// build for size).
 #[cfg_attr(not(estimator_compact), inline(always))]
 #[cfg_attr(estimator_compact, inline(never))]
-fn camera_point<T: Real>(r: &Matrix3<T>, t: &Vector3<T>, p: &Vector3<T>) -> Vector3<T> {
+pub(super) fn camera_point<T: Real>(r: &Matrix3<T>, t: &Vector3<T>, p: &Vector3<T>) -> Vector3<T> {
     // Row by row, in the order of nalgebra's `r * p + t` (column by column, then `t`).
     Vector3::new(
         p.x * r.m11 + p.y * r.m12 + p.z * r.m13 + t.x,

@@ -10,6 +10,7 @@
 //!   `∂eᵢ/∂p = Jπ(xᵢ) Rᵢ / σ` (seed Theorem 5.1: `∂(T p)/∂p = R`), and `p ⊕ δ = p + δ`.
 //! * **Covariance**: `(Σ wᵢ JᵢᵀJᵢ)⁻¹` at the solution (m²).
 
+use super::pnp::camera_point;
 use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
 use super::{Factor, Loss, PinholeCamera, SolveError};
 use crate::lie::{LieGroup, Se3};
@@ -72,9 +73,11 @@ pub fn point_reprojection_error<T: Real>(
     inv_sigma: T,
     min_depth: T,
 ) -> Option<(Vector2<T>, Matrix2x3<T>)> {
-    let (x, _, jp) = camera_from_world.act_jac(p);
+    // `x = R p + t` and `∂x/∂p = R` (what `act_jac` gives, without its pose Jacobian).
+    let r = camera_from_world.rotation().rotation_matrix();
+    let x = camera_point(&r, &camera_from_world.translation(), p);
     let (uv, jpi) = camera.project_jac(&x, min_depth)?;
-    Some(((uv - z) * inv_sigma, jpi * jp * inv_sigma))
+    Some(((uv - z) * inv_sigma, jpi * r * inv_sigma))
 }
 
 struct TriProblem<'a, T: Real> {

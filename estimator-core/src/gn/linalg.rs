@@ -104,7 +104,9 @@ pub(crate) fn cholesky_in_place<T: Real>(a: &mut [T], n: usize) -> Result<(), So
         let col_j = rest.get_mut(j..n).ok_or(SolveError::NotPositiveDefinite)?;
         let a_jj = col_j.first().copied().unwrap_or_else(T::zero);
         for col_k in before.chunks_exact(n) {
-            let Some(col_k) = col_k.get(j..) else { continue };
+            let Some(col_k) = col_k.get(j..) else {
+                continue;
+            };
             let factor = -col_k.first().copied().unwrap_or_else(T::zero);
             for (y, &x) in col_j.iter_mut().zip(col_k) {
                 *y = x * factor + *y;
@@ -124,7 +126,7 @@ pub(crate) fn cholesky_in_place<T: Real>(a: &mut [T], n: usize) -> Result<(), So
         if let Some((diagonal, below)) = col_j.split_first_mut() {
             *diagonal = l_jj;
             for y in below {
-                *y = *y / l_jj;
+                *y /= l_jj;
             }
         }
     }

@@ -716,3 +716,49 @@ fn damp<T: Real>(a: &mut [T], n: usize, lambda: T) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bits of every entry of `ne` (information, gradient, cost).
+    fn entries<T: Real, const N: usize>(
+        ne: &NormalEquations<T, N>,
+    ) -> impl Iterator<Item = u64> + '_ {
+        let all = ne.information.iter().chain(ne.gradient.iter()).copied();
+        all.chain(core::iter::once(ne.cost))
+            .map(|v| Real::to_f64(v).to_bits())
+    }
+
+    /// `NormalEquations::add` (in a build for size: the shared kernel over run-time dimensions)
+    /// gives the same bits as the `(N, K)`-specialised accumulation.
+    fn add_matches_fixed<T: Real, const N: usize, const K: usize>() {
+        let x = |k: usize| T::lit(((k * 37 % 23) as f64 - 11.0) / 7.0);
+        let e = SVector::<T, K>::from_fn(|r, _| x(r + 1));
+        let j = SMatrix::<T, K, N>::from_fn(|r, c| x(3 * r + 5 * c + 2));
+        for loss in [
+            Loss::LeastSquares,
+            Loss::Huber(T::lit(0.5)),
+            Loss::Cauchy(T::lit(0.8)),
+        ] {
+            let mut shared = NormalEquations::<T, N>::zeros();
+            let mut fixed = NormalEquations::<T, N>::zeros();
+            for scale in [T::one(), T::lit(-2.5), T::lit(1e-3)] {
+                shared.add(&loss, &(e * scale), &j);
+                fixed.add_fixed(&loss, &(e * scale), &j);
+            }
+            assert!(entries(&shared).eq(entries(&fixed)), "{loss:?}");
+            assert_eq!(shared.blocks, fixed.blocks);
+        }
+    }
+
+    #[test]
+    fn add_is_the_specialised_accumulation() {
+        add_matches_fixed::<f64, 6, 2>();
+        add_matches_fixed::<f64, 3, 2>();
+        add_matches_fixed::<f64, 3, 3>();
+        add_matches_fixed::<f32, 6, 2>();
+        add_matches_fixed::<f32, 3, 3>();
+        add_matches_fixed::<f64, 6, 4>();
+    }
+}

@@ -100,15 +100,19 @@ pub(crate) fn cholesky_in_place<T: Real>(a: &mut [T], n: usize) -> Result<(), So
         let (before, rest) = a
             .split_at_mut_checked(j * n)
             .ok_or(SolveError::NotPositiveDefinite)?;
-        let col_j = rest.get_mut(..n).ok_or(SolveError::NotPositiveDefinite)?;
-        let a_jj = col_j.get(j).copied().unwrap_or_else(T::zero);
+        // Rows `j..` of column j: `col_j[0]` is the diagonal entry.
+        let col_j = rest.get_mut(j..n).ok_or(SolveError::NotPositiveDefinite)?;
+        let a_jj = col_j.first().copied().unwrap_or_else(T::zero);
         for col_k in before.chunks_exact(n) {
-            let factor = -col_k.get(j).copied().unwrap_or_else(T::zero);
-            for (y, &x) in col_j.iter_mut().zip(col_k).skip(j) {
+            let Some(col_k) = col_k.get(j..) else {
+                continue;
+            };
+            let factor = -col_k.first().copied().unwrap_or_else(T::zero);
+            for (y, &x) in col_j.iter_mut().zip(col_k) {
                 *y = x * factor + *y;
             }
         }
-        let d = col_j.get(j).copied().unwrap_or_else(T::zero);
+        let d = col_j.first().copied().unwrap_or_else(T::zero);
         // Written so that a NaN pivot (which compares false) is refused too.
         let positive = d > T::zero();
         if !positive {
@@ -119,8 +123,11 @@ pub(crate) fn cholesky_in_place<T: Real>(a: &mut [T], n: usize) -> Result<(), So
         if !own_information {
             return Err(SolveError::NotPositiveDefinite);
         }
-        for (k, y) in col_j.iter_mut().enumerate().skip(j) {
-            *y = if k == j { l_jj } else { *y / l_jj };
+        if let Some((diagonal, below)) = col_j.split_first_mut() {
+            *diagonal = l_jj;
+            for y in below {
+                *y /= l_jj;
+            }
         }
     }
     Ok(())

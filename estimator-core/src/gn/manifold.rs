@@ -46,7 +46,7 @@ impl<T: Real, const N: usize> Manifold<T, N> for SVector<T, N> {
     }
     #[inline]
     fn all_finite(&self) -> bool {
-        self.iter().all(|x| x.is_finite())
+        crate::scalar::all_finite(self.as_slice())
     }
 }
 

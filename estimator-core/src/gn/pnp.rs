@@ -16,6 +16,7 @@
 use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
 use super::{Loss, PinholeCamera, SolveError};
 use crate::lie::{LieGroup, Se3};
+use crate::scalar::all_finite;
 use crate::Real;
 use nalgebra::{Matrix2x6, Matrix3, Matrix6, SMatrix, SVector, Vector2, Vector3};
 
@@ -173,7 +174,7 @@ pub fn reprojection_error<T: Real>(
     inv_sigma: T,
     min_depth: T,
 ) -> Option<(Vector2<T>, Matrix2x6<T>)> {
-    let x = r * p + t;
+    let x = camera_point(r, t, p);
     let (uv, jp) = camera.project_jac(&x, min_depth)?;
     let jp = jp * inv_sigma;
     let b = jp * r; // Jπ R: the translation block.
@@ -190,6 +191,19 @@ pub fn reprojection_error<T: Real>(
     j.m25 = r1.y;
     j.m26 = r1.z;
     Some(((uv - z) * inv_sigma, j))
+}
+
+/// `R p + t`: a world point in the camera frame (one copy of the code for every caller in a
+/// build for size).
+#[cfg_attr(not(estimator_compact), inline(always))]
+#[cfg_attr(estimator_compact, inline(never))]
+pub(super) fn camera_point<T: Real>(r: &Matrix3<T>, t: &Vector3<T>, p: &Vector3<T>) -> Vector3<T> {
+    // Row by row, in the order of nalgebra's `r * p + t` (column by column, then `t`).
+    Vector3::new(
+        p.x * r.m11 + p.y * r.m12 + p.z * r.m13 + t.x,
+        p.x * r.m21 + p.y * r.m22 + p.z * r.m23 + t.y,
+        p.x * r.m31 + p.y * r.m32 + p.z * r.m33 + t.z,
+    )
 }
 
 /// The PnP residuals as a [`Problem`] over `Se3` (whitened, `K = 2`).
@@ -243,25 +257,35 @@ pub fn check_point_spread<T: Real>(points: &[Vector3<T>]) -> Result<(), SolveErr
     if n == 0 {
         return Err(SolveError::DegenerateGeometry);
     }
-    let inv_n = T::one() / T::from_usize(n).unwrap_or_else(T::one);
-    let mean = points.iter().fold(Vector3::zeros(), |acc, p| acc + p) * inv_n;
-    let s = points.iter().fold(Matrix3::zeros(), |acc: Matrix3<T>, p| {
+    let count = T::from_usize(n).unwrap_or_else(T::one);
+    let inv_n = T::one() / count;
+    let mut sum = Vector3::zeros();
+    for p in points {
+        sum += p;
+    }
+    let mean = sum * inv_n;
+    // The six distinct entries of the symmetric `S` (`d dᵀ` is exactly symmetric), summed in
+    // the order of the points.
+    let [mut s11, mut s22, mut s33, mut s12, mut s13, mut s23] = [T::zero(); 6];
+    for p in points {
         let d = p - mean;
-        acc + d * d.transpose()
-    });
-    let tr = s.m11 + s.m22 + s.m33;
-    let i2 = s.m11 * s.m22 - s.m12 * s.m21 + s.m11 * s.m33 - s.m13 * s.m31 + s.m22 * s.m33
-        - s.m23 * s.m32;
-    let scale = mean.norm_squared() + T::one();
-    let spread = tr > T::lit(COINCIDENT_REL) * T::from_usize(n).unwrap_or_else(T::one) * scale;
-    if !spread {
-        return Err(SolveError::DegenerateGeometry);
+        s11 += d.x * d.x;
+        s22 += d.y * d.y;
+        s33 += d.z * d.z;
+        s12 += d.x * d.y;
+        s13 += d.x * d.z;
+        s23 += d.y * d.z;
     }
+    let tr = s11 + s22 + s33;
+    let i2 = s11 * s22 - s12 * s12 + s11 * s33 - s13 * s13 + s22 * s33 - s23 * s23;
+    let scale = mean.x * mean.x + mean.y * mean.y + mean.z * mean.z + T::one();
+    let spread = tr > T::lit(COINCIDENT_REL) * count * scale;
     let not_collinear = i2 > T::lit(COLLINEAR_REL) * tr * tr;
-    if !not_collinear {
-        return Err(SolveError::DegenerateGeometry);
+    if spread && not_collinear {
+        Ok(())
+    } else {
+        Err(SolveError::DegenerateGeometry)
     }
-    Ok(())
 }
 
 /// The χ²(2) inlier test `‖eⱼ‖² ≤ chi2` of every observation at `pose`.
@@ -281,7 +305,7 @@ fn inlier_mask<T: Real>(
     for (k, (p, z)) in pairs.enumerate() {
         let uv = problem
             .camera
-            .project(&(r * p + t), problem.min_depth)
+            .project(&camera_point(&r, &t, p), problem.min_depth)
             .ok_or(SolveError::PointBehindCamera)?;
         let e = (uv - z) * problem.inv_sigma;
         if e.norm_squared() <= chi2 {
@@ -388,8 +412,8 @@ pub fn solve_pnp<T: Real>(
     {
         return Err(SolveError::InvalidOptions);
     }
-    if !world_points.iter().all(|p| p.iter().all(|x| x.is_finite()))
-        || !pixels.iter().all(|z| z.iter().all(|x| x.is_finite()))
+    if !world_points.iter().all(|p| all_finite(p.as_slice()))
+        || !pixels.iter().all(|z| all_finite(z.as_slice()))
     {
         return Err(SolveError::NonFiniteInput);
     }

@@ -1,6 +1,6 @@
 //! Rotation from paired direction observations (for example gravity and the magnetic field in
 //! the body frame against their world references): the start-up attitude of a filter, solved
-//! by the same [`solve`] core over `SO(3)`.
+//! by the same [`solve`](super::solve) core over `SO(3)`.
 //!
 //! Each pair gives a body-frame direction `bᵢ` and its world-frame reference `wᵢ` (both are
 //! normalized; only directions matter). The model is `bᵢ = R⁻¹ wᵢ` with
@@ -15,9 +15,10 @@
 //! from the first pair `u` and the pair most perpendicular to it `v`, in both frames, give
 //! `R₀ = W Bᵀ`.
 
-use super::solver::{solve, Problem, SolverOptions, Status};
+use super::solver::{solve_into, Problem, Solution, SolverOptions, Status};
 use super::SolveError;
 use crate::lie::{skew, LieGroup, So3};
+use crate::scalar::all_finite;
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
@@ -140,7 +141,7 @@ pub fn solve_rotation_from_vectors<T: Real>(
             got: pairs.len(),
         });
     }
-    let finite = |v: &Vector3<T>| v.iter().all(|x| x.is_finite());
+    let finite = |v: &Vector3<T>| all_finite(v.as_slice());
     if !pairs
         .iter()
         .all(|p| finite(&p.body) && finite(&p.world) && p.sigma.is_finite())
@@ -173,7 +174,8 @@ pub fn solve_rotation_from_vectors<T: Real>(
         Some(_) => return Err(SolveError::NonFiniteGuess),
         None => start,
     };
-    let sol = solve(&RotProblem { pairs }, &start, options)?;
+    let mut sol = Solution::placeholder(&start);
+    solve_into(&RotProblem { pairs }, &start, options, &mut sol)?;
     let r = sol.state.normalize();
     if !r.is_finite() {
         return Err(SolveError::NonFiniteResidual);

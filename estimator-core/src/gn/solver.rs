@@ -82,6 +82,32 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
     /// Folds one block in: `A += w JᵀJ`, `g += w Jᵀe`, `F += ρ(‖e‖²)`.
     #[inline]
     pub fn add<const K: usize>(&mut self, loss: &Loss<T>, e: &SVector<T, K>, j: &SMatrix<T, K, N>) {
+        // Built for size: one copy of the code for every `(N, K)`, with the same arithmetic
+        // (nalgebra's `dot` sums left to right up to `K = 3`, pairwise from `K = 4`).
+        #[cfg(estimator_compact)]
+        if K <= 3 {
+            add_shared(
+                self.information.as_mut_slice(),
+                self.gradient.as_mut_slice(),
+                &mut self.cost,
+                loss,
+                e.as_slice(),
+                j.as_slice(),
+            );
+            self.blocks += 1;
+            return;
+        }
+        self.add_fixed(loss, e, j);
+    }
+
+    /// [`Self::add`] specialised for `(N, K)`.
+    #[inline]
+    fn add_fixed<const K: usize>(
+        &mut self,
+        loss: &Loss<T>,
+        e: &SVector<T, K>,
+        j: &SMatrix<T, K, N>,
+    ) {
         let (rho, w) = loss.evaluate(e.norm_squared());
         let wj = j * w;
         // `A += (w J)ᵀ J` entry by entry (the same dot products as `tr_mul`, without its
@@ -142,6 +168,44 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
             Err(SolveError::NonFiniteResidual)
         }
     }
+}
+
+/// `x₀y₀ + x₁y₁ + …` summed left to right from the first product, as nalgebra's `dot` for the
+/// short vectors of a block (so the shared code gives the same numbers as the specialised one).
+#[cfg(estimator_compact)]
+fn dot_exact<T: Real>(x: &[T], y: &[T], scale: T) -> T {
+    let mut terms = x.iter().zip(y).map(|(&a, &b)| a * scale * b);
+    let first = terms.next().unwrap_or_else(T::zero);
+    terms.fold(first, |acc, t| acc + t)
+}
+
+/// [`NormalEquations::add`] on the column-major storage: `info` (`n × n`), `grad` (`n`), the
+/// error `e` (`k`) and the Jacobian `j` (`k × n`, column `c` is entries `c·k .. c·k + k`); `n`
+/// and `k` are the lengths of `grad` and `e`. One copy of the code for every `(N, K)`.
+#[cfg(estimator_compact)]
+#[inline(never)]
+fn add_shared<T: Real>(
+    info: &mut [T],
+    grad: &mut [T],
+    cost: &mut T,
+    loss: &Loss<T>,
+    e: &[T],
+    j: &[T],
+) {
+    let (rho, w) = loss.evaluate(dot_exact(e, e, T::one()));
+    let (n, k) = (grad.len(), e.len());
+    if k > 0 {
+        // `A += (w J)ᵀ J` and `g += (w J)ᵀ e`: `(w Jᵣ)·J꜀` entry by entry, `w J` not stored.
+        for (r, (g, jr)) in grad.iter_mut().zip(j.chunks_exact(k)).enumerate() {
+            for (c, jc) in j.chunks_exact(k).enumerate() {
+                if let Some(x) = info.get_mut(c * n + r) {
+                    *x += dot_exact(jr, jc, w);
+                }
+            }
+            *g += dot_exact(jr, e, w);
+        }
+    }
+    *cost += rho;
 }
 
 /// The iteration.
@@ -570,22 +634,44 @@ fn damped_step<T: Real, const N: usize>(
     step: &mut SVector<T, N>,
 ) -> Result<StepStats<T>, StepError> {
     let mut damped = ne.information;
+    damped_step_shared(
+        damped.as_mut_slice(),
+        ne.information.as_slice(),
+        ne.gradient.as_slice(),
+        lambda,
+        lm,
+        step.as_mut_slice(),
+    )
+}
+
+/// [`damped_step`] on the column-major storage: `damped` holds a copy of the `n × n`
+/// information `a` and is overwritten by the factor, `g` is the gradient and `step` receives
+/// `ξ` (`n` their length). One copy of the code for every dimension.
+#[cfg_attr(estimator_compact, inline(never))]
+#[cfg_attr(not(estimator_compact), inline(always))]
+fn damped_step_shared<T: Real>(
+    damped: &mut [T],
+    a: &[T],
+    g: &[T],
+    lambda: T,
+    lm: bool,
+    step: &mut [T],
+) -> Result<StepStats<T>, StepError> {
+    let n = step.len();
     if lm {
-        damp(damped.as_mut_slice(), N, lambda);
+        damp(damped, n, lambda);
     }
     // Factorized in place (what `Factor::new` and `Factor::solve` do, without a second
     // `N × N` copy in this frame).
-    linalg::cholesky_in_place(damped.as_mut_slice(), N).map_err(StepError::Factor)?;
-    *step = -ne.gradient;
-    linalg::substitute(damped.as_slice(), N, step.as_mut_slice());
-    if !linalg::all_finite(step.as_slice()) {
+    linalg::cholesky_in_place(damped, n).map_err(StepError::Factor)?;
+    for (x, &gk) in step.iter_mut().zip(g) {
+        *x = -gk;
+    }
+    linalg::substitute(damped, n, step);
+    if !linalg::all_finite(step) {
         return Err(StepError::Solve(SolveError::NonFiniteResidual));
     }
-    Ok(step_stats(
-        ne.information.as_slice(),
-        ne.gradient.as_slice(),
-        step.as_slice(),
-    ))
+    Ok(step_stats(a, g, step))
 }
 
 /// `‖ξ‖`, `ξᵀAξ` and `ξᵀg` for the column-major `n × n` matrix `a` (`n` the length of `step`):
@@ -628,5 +714,51 @@ fn damp<T: Real>(a: &mut [T], n: usize, lambda: T) {
         if let Some(x) = a.get_mut(k * n + k) {
             *x += lambda * (*x).max(floor);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bits of every entry of `ne` (information, gradient, cost).
+    fn entries<T: Real, const N: usize>(
+        ne: &NormalEquations<T, N>,
+    ) -> impl Iterator<Item = u64> + '_ {
+        let all = ne.information.iter().chain(ne.gradient.iter()).copied();
+        all.chain(core::iter::once(ne.cost))
+            .map(|v| Real::to_f64(v).to_bits())
+    }
+
+    /// `NormalEquations::add` (in a build for size: the shared kernel over run-time dimensions)
+    /// gives the same bits as the `(N, K)`-specialised accumulation.
+    fn add_matches_fixed<T: Real, const N: usize, const K: usize>() {
+        let x = |k: usize| T::lit(((k * 37 % 23) as f64 - 11.0) / 7.0);
+        let e = SVector::<T, K>::from_fn(|r, _| x(r + 1));
+        let j = SMatrix::<T, K, N>::from_fn(|r, c| x(3 * r + 5 * c + 2));
+        for loss in [
+            Loss::LeastSquares,
+            Loss::Huber(T::lit(0.5)),
+            Loss::Cauchy(T::lit(0.8)),
+        ] {
+            let mut shared = NormalEquations::<T, N>::zeros();
+            let mut fixed = NormalEquations::<T, N>::zeros();
+            for scale in [T::one(), T::lit(-2.5), T::lit(1e-3)] {
+                shared.add(&loss, &(e * scale), &j);
+                fixed.add_fixed(&loss, &(e * scale), &j);
+            }
+            assert!(entries(&shared).eq(entries(&fixed)), "{loss:?}");
+            assert_eq!(shared.blocks, fixed.blocks);
+        }
+    }
+
+    #[test]
+    fn add_is_the_specialised_accumulation() {
+        add_matches_fixed::<f64, 6, 2>();
+        add_matches_fixed::<f64, 3, 2>();
+        add_matches_fixed::<f64, 3, 3>();
+        add_matches_fixed::<f32, 6, 2>();
+        add_matches_fixed::<f32, 3, 3>();
+        add_matches_fixed::<f64, 6, 4>();
     }
 }

@@ -1,6 +1,6 @@
 //! Triangulation of one landmark `p ∈ R³` from several calibrated views:
-//! minimizes `Σᵢ ρ(‖K π(Tᵢ p) − zᵢ‖² / σ²)` over `p` with the [`solve`] core, from a linear
-//! start.
+//! minimizes `Σᵢ ρ(‖K π(Tᵢ p) − zᵢ‖² / σ²)` over `p` with the [`solve`](super::solve) core, from
+//! a linear start.
 //!
 //! * **Start** (closed form): the point closest to all rays in the least-squares sense. The ray
 //!   of view `i` leaves the centre `cᵢ = −Rᵢᵀ tᵢ` along `dᵢ = Rᵢᵀ K⁻¹[u, v, 1]ᵀ / ‖·‖`; with the
@@ -10,9 +10,11 @@
 //!   `∂eᵢ/∂p = Jπ(xᵢ) Rᵢ / σ` (seed Theorem 5.1: `∂(T p)/∂p = R`), and `p ⊕ δ = p + δ`.
 //! * **Covariance**: `(Σ wᵢ JᵢᵀJᵢ)⁻¹` at the solution (m²).
 
-use super::solver::{solve, Method, Problem, SolverOptions, Status};
+use super::pnp::camera_point;
+use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
 use super::{Factor, Loss, PinholeCamera, SolveError};
 use crate::lie::{LieGroup, Se3};
+use crate::scalar::all_finite;
 use crate::Real;
 use nalgebra::{Matrix2x3, Matrix3, SMatrix, SVector, Vector2, Vector3};
 
@@ -71,9 +73,11 @@ pub fn point_reprojection_error<T: Real>(
     inv_sigma: T,
     min_depth: T,
 ) -> Option<(Vector2<T>, Matrix2x3<T>)> {
-    let (x, _, jp) = camera_from_world.act_jac(p);
+    // `x = R p + t` and `∂x/∂p = R` (what `act_jac` gives, without its pose Jacobian).
+    let r = camera_from_world.rotation().rotation_matrix();
+    let x = camera_point(&r, &camera_from_world.translation(), p);
     let (uv, jpi) = camera.project_jac(&x, min_depth)?;
-    Some(((uv - z) * inv_sigma, jpi * jp * inv_sigma))
+    Some(((uv - z) * inv_sigma, jpi * r * inv_sigma))
 }
 
 struct TriProblem<'a, T: Real> {
@@ -137,12 +141,12 @@ pub fn triangulate<T: Real>(
         return Err(SolveError::InvalidOptions);
     }
     if !cameras_from_world.iter().all(|t| t.is_finite())
-        || !pixels.iter().all(|z| z.iter().all(|x| x.is_finite()))
+        || !pixels.iter().all(|z| all_finite(z.as_slice()))
     {
         return Err(SolveError::NonFiniteInput);
     }
 
-    // Linear start: (Σ Pᵢ) p = Σ Pᵢ cᵢ.
+    // Linear start: (Σ Pᵢ) p = Σ Pᵢ cᵢ (the upper triangle of `m` stays zero).
     let mut m = Matrix3::zeros();
     let mut b = Vector3::zeros();
     for (pose, z) in cameras_from_world.iter().zip(pixels) {
@@ -150,9 +154,21 @@ pub fn triangulate<T: Real>(
         let c = world_from_camera.translation();
         let d = world_from_camera.rotation().act(&camera.unproject(z));
         let d = d / d.norm();
-        let proj = Matrix3::identity() - d * d.transpose();
-        m += proj;
-        b += proj * c;
+        // `Pᵢ = I − d dᵀ` is symmetric and `Factor::new` reads only the lower triangle of `m`:
+        // its six distinct entries, then `m += Pᵢ` (lower triangle), `b += Pᵢ cᵢ`, each entry
+        // with the arithmetic of nalgebra's `identity() − d * dᵀ` and `proj * c`.
+        let (x, y, z) = (d.x, d.y, d.z);
+        let (pxx, pyy, pzz) = (T::one() - x * x, T::one() - y * y, T::one() - z * z);
+        let (pxy, pxz, pyz) = (T::zero() - x * y, T::zero() - x * z, T::zero() - y * z);
+        m.m11 += pxx;
+        m.m21 += pxy;
+        m.m31 += pxz;
+        m.m22 += pyy;
+        m.m32 += pyz;
+        m.m33 += pzz;
+        b.x += c.x * pxx + c.y * pxy + c.z * pxz;
+        b.y += c.x * pxy + c.y * pyy + c.z * pyz;
+        b.z += c.x * pxz + c.y * pyz + c.z * pzz;
     }
     let start = Factor::new(&m)
         .and_then(|f| f.solve(&b))
@@ -172,7 +188,8 @@ pub fn triangulate<T: Real>(
         max_iterations: options.max_iterations,
         ..SolverOptions::default()
     };
-    let sol = solve(&problem, &start, &solver_options)?;
+    let mut sol = Solution::placeholder(&start);
+    solve_into(&problem, &start, &solver_options, &mut sol)?;
     // The solver evaluated every view at its last linearization; the final (converged) step is
     // re-checked here so that a returned point is in front of every camera.
     let in_front = cameras_from_world

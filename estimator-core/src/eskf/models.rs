@@ -415,9 +415,9 @@ impl<T: Real> Heading<T> {
             z,
             z,
         );
-        let psi = cy.atan2(cx);
+        let psi = cy.arctan2(cx);
         let (s, c) = (self.yaw - psi).sincos();
-        Ok((s.atan2(c), row))
+        Ok((s.arctan2(c), row))
     }
 }
 

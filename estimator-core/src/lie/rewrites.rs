@@ -309,7 +309,7 @@ fn so3_log_before<T: Real>(q: &UnitQuaternion<T>) -> (Vector3<T>, T, T, T) {
         let r2 = n2 / (w * w);
         T::lit(2.0) / w * poly(r2, [T::lit(1.0), T::lit(-1.0 / 3.0), T::lit(1.0 / 5.0)])
     } else {
-        T::lit(2.0) * n.atan2(w) / n
+        T::lit(2.0) * n.arctan2(w) / n
     };
     (v * scale, scale * n, n, w)
 }

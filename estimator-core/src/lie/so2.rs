@@ -56,7 +56,7 @@ impl<T: Real> So2<T> {
     /// The angle in `(−π, π]`.
     #[must_use]
     pub fn angle(&self) -> T {
-        self.im.atan2(self.re)
+        self.im.arctan2(self.re)
     }
 
     /// `cos θ`.

@@ -166,7 +166,7 @@ pub fn atan2_f32(y: f32, x: f32) -> f32 {
     use core::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
     // The parts of π/4, π/2, π that their `f32` values miss (`c − f32(c)`, rounded).
     const FRAC_PI_4_LO: f32 = -2.185_569_4e-8;
-    const FRAC_PI_2_LO: f32 = -4.371_138_8e-8;
+    const FRAC_PI_2_LO: f32 = -4.371_139e-8;
     const PI_LO: f32 = -8.742_278e-8;
     const TAN_PI_8: f32 = 0.414_213_57;
     if y.is_nan() || x.is_nan() {
@@ -193,7 +193,7 @@ pub fn atan2_f32(y: f32, x: f32) -> f32 {
     };
     let z = u * u;
     let p = (((-6.451_928e-2 * z + 1.074_373_1e-1) * z - 1.426_395_6e-1) * z + 1.999_954e-1) * z
-        - 3.333_333_1e-1;
+        - 3.333_333e-1;
     // The constant's missing part joins the small terms before the one rounding against it.
     let a = hi + (u + (p * z * u + lo));
     let a = match (steep, x.is_sign_negative()) {

@@ -51,14 +51,14 @@ impl<T: Real> ImuNoise<T> {
     }
 
     pub(crate) fn is_valid(&self) -> bool {
-        [
+        let all = [
             self.gyroscope_noise_density,
             self.gyroscope_random_walk,
             self.accelerometer_noise_density,
             self.accelerometer_random_walk,
-        ]
-        .iter()
-        .all(|x| x.is_finite() && *x >= T::zero())
+        ];
+        // Finite (the shared out-of-line check) and not below zero (false for NaN).
+        all_finite(&all) && all.iter().all(|x| *x >= T::zero())
     }
 }
 
@@ -86,7 +86,7 @@ impl<T: Real> Default for FilterConfig<T> {
 impl<T: Real> FilterConfig<T> {
     /// `Ok` when every number is finite, the noise densities are `≥ 0` and `max_dt > 0`.
     pub fn validate(&self) -> Result<(), EskfError> {
-        if !(self.gravity.iter().all(|x| x.is_finite()) && self.max_dt.is_finite()) {
+        if !(finite(&self.gravity) && self.max_dt.is_finite()) {
             return Err(EskfError::NonFinite);
         }
         if !self.imu_noise.is_valid() {

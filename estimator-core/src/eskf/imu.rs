@@ -461,7 +461,7 @@ fn scaled<T: Real>(mut m: Matrix3<T>, s: T) -> Matrix3<T> {
 
 /// `y + x·a`, entry by entry (one small function for the nominal integration).
 #[cfg_attr(estimator_compact, inline(never))]
-fn axpy<T: Real>(y: &Vector3<T>, x: &Vector3<T>, a: T) -> Vector3<T> {
+pub(crate) fn axpy<T: Real>(y: &Vector3<T>, x: &Vector3<T>, a: T) -> Vector3<T> {
     Vector3::new(y.x + x.x * a, y.y + x.y * a, y.z + x.z * a)
 }
 

@@ -2,10 +2,13 @@
 //! against the straightforward nalgebra expressions they replace: the same bits (or the same
 //! answer, for the checks), `f32` and `f64`.
 
-use super::imu::ImuNoise;
+use super::align::InitialSigmas;
+use super::imu::{axpy, ImuNoise};
+use super::models::{add3, div3, neg3, sub3};
 use super::state::{plus_seg, seg};
+use crate::lie::So3;
 use crate::Real;
-use nalgebra::{SVector, Vector3};
+use nalgebra::{Matrix3, SVector, UnitQuaternion, Vector3};
 
 /// Deterministic numbers in `[-1, 1)` (64-bit LCG).
 struct Lcg(u64);
@@ -104,4 +107,58 @@ fn noise_validity_is_unchanged() {
 fn finite_is_the_iterator_check() {
     finite_check::<f32>();
     finite_check::<f64>();
+}
+
+fn vector_helpers<T: Real>() {
+    let mut rng = Lcg(11);
+    for i in 0..600 {
+        let a = Vector3::<T>::from_fn(|r, _| number(&mut rng, i + r));
+        let b = Vector3::<T>::from_fn(|r, _| number(&mut rng, i / 2 + 5 * r));
+        let s = number::<T>(&mut rng, i / 3);
+        assert!(same(sub3(&a, &b).as_slice(), (a - b).as_slice()));
+        assert!(same(add3(&a, &b).as_slice(), (a + b).as_slice()));
+        assert!(same(div3(&a, s).as_slice(), (a / s).as_slice()));
+        assert!(same(neg3(&a).as_slice(), (-a).as_slice()));
+        assert!(same(div3(&neg3(&a), s).as_slice(), (-a / s).as_slice()));
+        let old = a - b * b.dot(&a);
+        assert!(same(axpy(&a, &b, -b.dot(&a)).as_slice(), old.as_slice()));
+    }
+}
+
+fn attitude_covariance<T: Real>() {
+    let mut rng = Lcg(17);
+    for i in 0..400 {
+        let axis = Vector3::new(rng.next(), rng.next(), rng.next());
+        let q = UnitQuaternion::from_scaled_axis(axis * 3.0)
+            .coords
+            .map(T::lit);
+        let attitude = So3::from_unit_quaternion(UnitQuaternion::new_unchecked(q.into()));
+        let up = Vector3::<T>::from_fn(|r, _| number(&mut rng, i / 4 + 2 * r));
+        let sigmas = InitialSigmas {
+            tilt: number(&mut rng, i / 7),
+            yaw: number(&mut rng, i / 5),
+            ..InitialSigmas::default()
+        };
+        let (r, t2, y2) = (
+            attitude.rotation_matrix(),
+            sigmas.tilt * sigmas.tilt,
+            sigmas.yaw * sigmas.yaw,
+        );
+        let sw = Matrix3::identity() * t2 + up * up.transpose() * (y2 - t2);
+        let old = super::imu::mm(&super::imu::mm(&r.transpose(), &sw), &r);
+        let new = sigmas.attitude_covariance(&attitude, &up);
+        assert!(same(new.as_slice(), old.as_slice()));
+    }
+}
+
+#[test]
+fn vector_helpers_are_the_nalgebra_expressions() {
+    vector_helpers::<f32>();
+    vector_helpers::<f64>();
+}
+
+#[test]
+fn attitude_covariance_is_the_matrix_expression() {
+    attitude_covariance::<f32>();
+    attitude_covariance::<f64>();
 }

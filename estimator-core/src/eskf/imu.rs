@@ -224,7 +224,8 @@ fn add_cross<T: Real, const N: usize>(m: &mut SMatrix<T, N, N>, i: usize, j: usi
 }
 
 /// `(a + aᵀ)/2`: the symmetric part of a diagonal block (removes the rounding asymmetry).
-fn sym<T: Real>(a: &Matrix3<T>) -> Matrix3<T> {
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn sym<T: Real>(a: &Matrix3<T>) -> Matrix3<T> {
     (a + a.transpose()) * T::lit(0.5)
 }
 
@@ -309,7 +310,7 @@ pub(crate) fn predict_ins<T: Real>(
     let f = axpy(&imu.accel, &x.accel_bias, -T::one());
     let (dr, jr) = So3::exp_jac(&(omega * dt));
     let r = x.attitude.rotation_matrix();
-    let a = r * f + cfg.gravity;
+    let a = super::models::add3(&mv(&r, &f), &cfg.gravity);
     let new_x = InsState {
         attitude: x.attitude.compose(&dr).renormalize(),
         velocity: axpy(&x.velocity, &a, dt),
@@ -457,6 +458,16 @@ fn scaled<T: Real>(mut m: Matrix3<T>, s: T) -> Matrix3<T> {
         *x *= s;
     }
     m
+}
+
+/// `r f`, entry by entry (the sums of nalgebra's `r * f`, without its generic product loop).
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn mv<T: Real>(r: &Matrix3<T>, f: &Vector3<T>) -> Vector3<T> {
+    Vector3::new(
+        r.m11 * f.x + r.m12 * f.y + r.m13 * f.z,
+        r.m21 * f.x + r.m22 * f.y + r.m23 * f.z,
+        r.m31 * f.x + r.m32 * f.y + r.m33 * f.z,
+    )
 }
 
 /// `y + x·a`, entry by entry (one small function for the nominal integration).

@@ -3,7 +3,7 @@
 //! answer, for the checks), `f32` and `f64`.
 
 use super::align::InitialSigmas;
-use super::imu::{axpy, ImuNoise};
+use super::imu::{axpy, mm, mv, ImuNoise};
 use super::models::{add3, div3, neg3, sub3};
 use super::state::{plus_seg, seg};
 use crate::lie::So3;
@@ -161,4 +161,28 @@ fn vector_helpers_are_the_nalgebra_expressions() {
 fn attitude_covariance_is_the_matrix_expression() {
     attitude_covariance::<f32>();
     attitude_covariance::<f64>();
+}
+
+fn products<T: Real>() {
+    let mut rng = Lcg(23);
+    for i in 0..600 {
+        let a = Matrix3::<T>::from_fn(|r, c| number(&mut rng, i / 3 + r + 3 * c));
+        let b = Matrix3::<T>::from_fn(|r, c| number(&mut rng, i / 5 + 2 * r + c));
+        let f = Vector3::<T>::from_fn(|r, _| number(&mut rng, i / 2 + r));
+        let g = Vector3::<T>::from_fn(|r, _| number(&mut rng, i / 7 + 4 * r));
+        assert!(same(mv(&a, &f).as_slice(), (a * f).as_slice()));
+        assert!(same(
+            add3(&mv(&a, &f), &g).as_slice(),
+            (a * f + g).as_slice()
+        ));
+        assert!(same(mm(&a, &b).as_slice(), (a * b).as_slice()));
+        let old = a * b.transpose();
+        assert!(same(mm(&a, &b.transpose()).as_slice(), old.as_slice()));
+    }
+}
+
+#[test]
+fn products_are_nalgebras() {
+    products::<f32>();
+    products::<f64>();
 }

@@ -3,7 +3,7 @@
 //! answer, for the checks), `f32` and `f64`.
 
 use super::align::InitialSigmas;
-use super::imu::{axpy, mm, mv, ImuNoise};
+use super::imu::{add33, axpy, mm, mv, ImuNoise};
 use super::models::{add3, div3, neg3, sub3};
 use super::state::{plus_seg, seg};
 use crate::lie::So3;
@@ -176,6 +176,7 @@ fn products<T: Real>() {
             (a * f + g).as_slice()
         ));
         assert!(same(mm(&a, &b).as_slice(), (a * b).as_slice()));
+        assert!(same(add33(&a, &b).as_slice(), (a + b).as_slice()));
         let old = a * b.transpose();
         assert!(same(mm(&a, &b.transpose()).as_slice(), old.as_slice()));
     }

@@ -10,7 +10,8 @@
 //! * Initial gyro bias: the mean angular rate `ω̄` (the body does not rotate).
 
 use super::error::EskfError;
-use super::imu::{finite, mm};
+use super::imu::{axpy, finite, mm};
+use super::models::{add3, div3, neg3};
 use crate::lie::So3;
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
@@ -45,18 +46,19 @@ fn mean<T: Real>(xs: &[Vector3<T>]) -> Result<Vector3<T>, EskfError> {
         if !finite(x) {
             return Err(EskfError::NonFinite);
         }
-        sum += x;
+        sum = add3(&sum, x);
         n += T::one();
     }
-    Ok(sum / n)
+    Ok(div3(&sum, n))
 }
 
 /// The unit vector along the part of `v` orthogonal to the unit `u`, if any.
 fn horizontal<T: Real>(v: &Vector3<T>, u: &Vector3<T>) -> Option<Vector3<T>> {
-    let h = v - u * u.dot(v);
+    // `v − u (u·v)` as `v + u·(−u·v)`: the same bits (negation is exact).
+    let h = axpy(v, u, -u.dot(v));
     let n = h.norm();
     if n > T::lit(1e-6) * v.norm() && n > T::zero() {
-        Some(h / n)
+        Some(div3(&h, n))
     } else {
         None
     }
@@ -94,8 +96,8 @@ pub fn align_at_rest<T: Real>(
     if (nf - ng).abs() > rest_tolerance {
         return Err(EskfError::NotAtRest);
     }
-    let ub = f / nf;
-    let uw = -gravity / ng;
+    let ub = div3(&f, nf);
+    let uw = div3(&neg3(gravity), ng);
     let (hb, hw) = match mag {
         Some(m) => {
             let mb = mean(m.samples)?;
@@ -161,7 +163,20 @@ impl<T: Real> InitialSigmas<T> {
         let t2 = self.tilt * self.tilt;
         let y2 = self.yaw * self.yaw;
         // Σ_w = σ_t² I + (σ_ψ² − σ_t²) u uᵀ.
-        let sw = Matrix3::identity() * t2 + up * up.transpose() * (y2 - t2);
+        // Written out entry by entry: `I t2 + (u uᵀ) d`, the same products and sums.
+        let (d, o) = (y2 - t2, T::zero() * t2);
+        let e = |a: T, b: T, i: T| i + a * b * d;
+        let sw = Matrix3::new(
+            e(up.x, up.x, t2),
+            e(up.x, up.y, o),
+            e(up.x, up.z, o),
+            e(up.y, up.x, o),
+            e(up.y, up.y, t2),
+            e(up.y, up.z, o),
+            e(up.z, up.x, o),
+            e(up.z, up.y, o),
+            e(up.z, up.z, t2),
+        );
         mm(&mm(&r.transpose(), &sw), &r)
     }
 }
@@ -177,6 +192,6 @@ pub(crate) fn prior_attitude_covariance<T: Real>(
     if !super::imu::greater(gn, T::zero()) {
         return Err(EskfError::ZeroNorm);
     }
-    let up = -config.gravity / gn;
+    let up = div3(&neg3(&config.gravity), gn);
     Ok(sigmas.attitude_covariance(&alignment.attitude, &up))
 }

@@ -51,14 +51,14 @@ impl<T: Real> ImuNoise<T> {
     }
 
     pub(crate) fn is_valid(&self) -> bool {
-        [
+        let all = [
             self.gyroscope_noise_density,
             self.gyroscope_random_walk,
             self.accelerometer_noise_density,
             self.accelerometer_random_walk,
-        ]
-        .iter()
-        .all(|x| x.is_finite() && *x >= T::zero())
+        ];
+        // Finite (the shared out-of-line check) and not below zero (false for NaN).
+        all_finite(&all) && all.iter().all(|x| *x >= T::zero())
     }
 }
 
@@ -86,7 +86,7 @@ impl<T: Real> Default for FilterConfig<T> {
 impl<T: Real> FilterConfig<T> {
     /// `Ok` when every number is finite, the noise densities are `≥ 0` and `max_dt > 0`.
     pub fn validate(&self) -> Result<(), EskfError> {
-        if !(self.gravity.iter().all(|x| x.is_finite()) && self.max_dt.is_finite()) {
+        if !(finite(&self.gravity) && self.max_dt.is_finite()) {
             return Err(EskfError::NonFinite);
         }
         if !self.imu_noise.is_valid() {
@@ -224,7 +224,8 @@ fn add_cross<T: Real, const N: usize>(m: &mut SMatrix<T, N, N>, i: usize, j: usi
 }
 
 /// `(a + aᵀ)/2`: the symmetric part of a diagonal block (removes the rounding asymmetry).
-fn sym<T: Real>(a: &Matrix3<T>) -> Matrix3<T> {
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn sym<T: Real>(a: &Matrix3<T>) -> Matrix3<T> {
     (a + a.transpose()) * T::lit(0.5)
 }
 
@@ -272,15 +273,15 @@ impl<T: Real> FRows<T> {
     /// `(F Q)₂ = Q₂ + dt (Q₁ + ½ C)`, with `C = A Q₀ + B Q₄ = B([f]× Q₀ + Q₄)`.
     fn apply(&self, q: &[T; 45], rot: bool) -> [Matrix3<T>; 3] {
         let (q0, q1) = (col_blk(q, 0), col_blk(q, 1));
-        let c = mm(&self.b, &(mm(&self.fx, &q0) + col_blk(q, 4)));
+        let c = mm(&self.b, &add33(&mm(&self.fx, &q0), &col_blk(q, 4)));
         let top = if rot {
-            mm(&self.f00, &q0) + mm(&self.f03, &col_blk(q, 3))
+            add33(&mm(&self.f00, &q0), &mm(&self.f03, &col_blk(q, 3)))
         } else {
             Matrix3::zeros()
         };
         [
             top,
-            q1 + c,
+            add33(&q1, &c),
             col_blk(q, 2) + (q1 + c * T::lit(0.5)) * self.dt,
         ]
     }
@@ -309,7 +310,7 @@ pub(crate) fn predict_ins<T: Real>(
     let f = axpy(&imu.accel, &x.accel_bias, -T::one());
     let (dr, jr) = So3::exp_jac(&(omega * dt));
     let r = x.attitude.rotation_matrix();
-    let a = r * f + cfg.gravity;
+    let a = super::models::add3(&mv(&r, &f), &cfg.gravity);
     let new_x = InsState {
         attitude: x.attitude.compose(&dr).renormalize(),
         velocity: axpy(&x.velocity, &a, dt),
@@ -419,17 +420,19 @@ pub(crate) fn predict_ahrs<T: Real>(
     }
     check_dt(dt, cfg.max_dt)?;
     let (dr, jr) = So3::exp_jac(&(axpy(gyro, &x.gyro_bias, -T::one()) * dt));
-    let f00 = dr.rotation_matrix().transpose();
+    // F00 = ΔRᵀ, so F00ᵀ = ΔR (no transpose pass).
+    let f00t = dr.rotation_matrix();
+    let f00 = f00t.transpose();
     let f01 = scaled(jr, -dt);
     let p00 = blk(p, 0, 0);
     let p01 = blk(p, 0, 1);
     let p11 = blk(p, 1, 1);
     // M0j = F00 P0j + F01 P1j; P⁺00 = M00 F00ᵀ + M01 F01ᵀ; P⁺01 = M01; P⁺11 = P11.
-    let m00 = mm(&f00, &p00) + mm(&f01, &p01.transpose());
-    let m01 = mm(&f00, &p01) + mm(&f01, &p11);
+    let m00 = add33(&mm(&f00, &p00), &mm(&f01, &p01.transpose()));
+    let m01 = add33(&mm(&f00, &p01), &mm(&f01, &p11));
     // N00 = M00 F00ᵀ + M01 F01ᵀ is symmetric: its upper triangle, mirrored (exactly symmetric
     // without a separate symmetrization; at opt-level 3 the unused lower products are dead).
-    let n = mm(&m00, &f00.transpose()) + mm(&m01, &f01.transpose());
+    let n = add33(&mm(&m00, &f00t), &mm(&m01, &f01.transpose()));
     let n00 = Matrix3::new(
         n.m11, n.m12, n.m13, n.m12, n.m22, n.m23, n.m13, n.m23, n.m33,
     );
@@ -459,9 +462,30 @@ fn scaled<T: Real>(mut m: Matrix3<T>, s: T) -> Matrix3<T> {
     m
 }
 
+/// `r f`, entry by entry (the sums of nalgebra's `r * f`, without its generic product loop).
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn mv<T: Real>(r: &Matrix3<T>, f: &Vector3<T>) -> Vector3<T> {
+    Vector3::new(
+        r.m11 * f.x + r.m12 * f.y + r.m13 * f.z,
+        r.m21 * f.x + r.m22 * f.y + r.m23 * f.z,
+        r.m31 * f.x + r.m32 * f.y + r.m33 * f.z,
+    )
+}
+
+/// `a + b` for 3×3 matrices, entry by entry over the storage (nalgebra's sum is a generic
+/// loop at opt-level "s").
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn add33<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    let mut out = *a;
+    for (o, x) in out.as_mut_slice().iter_mut().zip(b.as_slice()) {
+        *o += *x;
+    }
+    out
+}
+
 /// `y + x·a`, entry by entry (one small function for the nominal integration).
 #[cfg_attr(estimator_compact, inline(never))]
-fn axpy<T: Real>(y: &Vector3<T>, x: &Vector3<T>, a: T) -> Vector3<T> {
+pub(crate) fn axpy<T: Real>(y: &Vector3<T>, x: &Vector3<T>, a: T) -> Vector3<T> {
     Vector3::new(y.x + x.x * a, y.y + x.y * a, y.z + x.z * a)
 }
 

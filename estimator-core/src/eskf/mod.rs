@@ -120,6 +120,8 @@ mod gate;
 mod imu;
 mod ins;
 mod models;
+#[cfg(test)]
+mod rewrites;
 mod state;
 mod update;
 

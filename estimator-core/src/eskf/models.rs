@@ -54,6 +54,31 @@ fn in_body<T: Real>(attitude: &So3<T>, v: &Vector3<T>) -> (Vector3<T>, Matrix3<T
     (b, skew(&b))
 }
 
+/// `a − b`, entry by entry (the same differences as nalgebra's `a - b`, without its generic
+/// loop).
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn sub3<T: Real>(a: &Vector3<T>, b: &Vector3<T>) -> Vector3<T> {
+    Vector3::new(a.x - b.x, a.y - b.y, a.z - b.z)
+}
+
+/// `a + b`, entry by entry.
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn add3<T: Real>(a: &Vector3<T>, b: &Vector3<T>) -> Vector3<T> {
+    Vector3::new(a.x + b.x, a.y + b.y, a.z + b.z)
+}
+
+/// `v / s`, entry by entry.
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn div3<T: Real>(v: &Vector3<T>, s: T) -> Vector3<T> {
+    Vector3::new(v.x / s, v.y / s, v.z / s)
+}
+
+/// `−v`, entry by entry.
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn neg3<T: Real>(v: &Vector3<T>) -> Vector3<T> {
+    Vector3::new(-v.x, -v.y, -v.z)
+}
+
 /// GNSS antenna position in the world frame, with the antenna at `lever_arm` in the body frame.
 ///
 /// `h(x) = p + R ℓ`; `H = [−R[ℓ]×, 0, I, 0, 0]` (blocks δθ, δv, δp, δb_g, δb_a).
@@ -87,7 +112,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssPosition<T> {
         }
         let (rl, d_att, _) = x.attitude.act_jac(&self.lever_arm);
         let mut lin = Linearization {
-            residual: self.position - (x.position + rl),
+            residual: sub3(&self.position, &add3(&x.position, &rl)),
             jacobian: jacobian(&[(0, d_att)]),
         };
         set_identity(&mut lin.jacobian, 6);
@@ -125,7 +150,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssVelocity<T> {
             return Err(EskfError::NonFinite);
         }
         let mut lin = Linearization {
-            residual: self.velocity - x.velocity,
+            residual: sub3(&self.velocity, &x.velocity),
             jacobian: SMatrix::zeros(),
         };
         set_identity(&mut lin.jacobian, 3);
@@ -155,7 +180,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for ZeroVelocity<T> {
     #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
         let mut lin = Linearization {
-            residual: -x.velocity,
+            residual: neg3(&x.velocity),
             jacobian: SMatrix::zeros(),
         };
         set_identity(&mut lin.jacobian, 3);
@@ -242,7 +267,7 @@ impl<T: Real> Magnetometer<T> {
             return Err(EskfError::ZeroNorm);
         }
         let (hx, h_att) = in_body(attitude, &self.reference);
-        Ok((self.field - hx, h_att))
+        Ok((sub3(&self.field, &hx), h_att))
     }
 }
 
@@ -299,8 +324,8 @@ impl<T: Real> GravityDirection<T> {
         if !(na > T::zero() && nu > T::zero()) {
             return Err(EskfError::ZeroNorm);
         }
-        let (hx, h_att) = in_body(attitude, &(self.up / nu));
-        Ok((self.accel / na - hx, h_att))
+        let (hx, h_att) = in_body(attitude, &div3(&self.up, nu));
+        Ok((sub3(&div3(&self.accel, na), &hx), h_att))
     }
 }
 
@@ -353,9 +378,9 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
         if self.accel.norm_squared() <= T::zero() {
             return Err(EskfError::ZeroNorm);
         }
-        let (f, h_att) = in_body(&x.attitude, &(-self.gravity));
+        let (f, h_att) = in_body(&x.attitude, &neg3(&self.gravity));
         let mut lin = Linearization {
-            residual: self.accel - (f + x.accel_bias),
+            residual: sub3(&self.accel, &add3(&f, &x.accel_bias)),
             jacobian: jacobian(&[(0, h_att)]),
         };
         set_identity(&mut lin.jacobian, 12);
@@ -492,11 +517,11 @@ impl<T: Real> CameraLandmark<T> {
 
     /// [`Self::project`], and the landmark in the body `q` (the linearization needs it too).
     fn project_parts(&self, x: &InsState<T>) -> Result<Projection<T>, EskfError> {
-        let q = x.attitude.inverse().act(&(self.landmark - x.position));
+        let q = x.attitude.inverse().act(&sub3(&self.landmark, &x.position));
         let rbc = self.body_from_camera.rotation();
         let c = rbc
             .inverse()
-            .act(&(q - self.body_from_camera.translation()));
+            .act(&sub3(&q, &self.body_from_camera.translation()));
         if !greater(c.z, self.min_depth) {
             return Err(EskfError::BehindCamera);
         }
@@ -541,7 +566,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
         );
         let jc = mm(&jpi, &rcb);
         Ok(Linearization {
-            residual: self.pixel - uv,
+            residual: Vector2::new(self.pixel.x - uv.x, self.pixel.y - uv.y),
             jacobian: jacobian(&[(0, mm(&jc, &skew(&q))), (6, -mm(&jc, &rt))]),
         })
     }

@@ -63,14 +63,11 @@ impl<T: Real> InsState<T> {
 impl<T: Real> ErrorState<T, 15> for InsState<T> {
     fn oplus(&self, dx: &SVector<T, 15>) -> Self {
         Self {
-            attitude: self
-                .attitude
-                .rplus(&dx.fixed_rows::<3>(0).into_owned())
-                .normalize(),
-            velocity: self.velocity + dx.fixed_rows::<3>(3),
-            position: self.position + dx.fixed_rows::<3>(6),
-            gyro_bias: self.gyro_bias + dx.fixed_rows::<3>(9),
-            accel_bias: self.accel_bias + dx.fixed_rows::<3>(12),
+            attitude: self.attitude.rplus(&seg(dx, 0)).normalize(),
+            velocity: plus_seg(&self.velocity, dx, 3),
+            position: plus_seg(&self.position, dx, 6),
+            gyro_bias: plus_seg(&self.gyro_bias, dx, 9),
+            accel_bias: plus_seg(&self.accel_bias, dx, 12),
         }
     }
 
@@ -88,6 +85,26 @@ impl<T: Real> ErrorState<T, 15> for InsState<T> {
     fn attitude(&self) -> &So3<T> {
         &self.attitude
     }
+}
+
+/// Entries `k..k + 3` of `dx` (zero past the end, which no caller reaches): read from the
+/// storage, without nalgebra's generic row view.
+pub(crate) fn seg<T: Real, const N: usize>(dx: &SVector<T, N>, k: usize) -> Vector3<T> {
+    match dx.as_slice().get(k..k + 3) {
+        Some(&[a, b, c]) => Vector3::new(a, b, c),
+        _ => Vector3::zeros(),
+    }
+}
+
+/// `v + dx[k..k + 3]`, entry by entry (the same sums as `v + dx.fixed_rows::<3>(k)`).
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn plus_seg<T: Real, const N: usize>(
+    v: &Vector3<T>,
+    dx: &SVector<T, N>,
+    k: usize,
+) -> Vector3<T> {
+    let d = seg(dx, k);
+    Vector3::new(v.x + d.x, v.y + d.y, v.z + d.z)
 }
 
 /// The attitude-only nominal state `x = (R, b_g)`, error `δx = (δθ, δb_g) ∈ R⁶`.
@@ -113,11 +130,8 @@ impl<T: Real> AhrsState<T> {
 impl<T: Real> ErrorState<T, 6> for AhrsState<T> {
     fn oplus(&self, dx: &SVector<T, 6>) -> Self {
         Self {
-            attitude: self
-                .attitude
-                .rplus(&dx.fixed_rows::<3>(0).into_owned())
-                .normalize(),
-            gyro_bias: self.gyro_bias + dx.fixed_rows::<3>(3),
+            attitude: self.attitude.rplus(&seg(dx, 0)).normalize(),
+            gyro_bias: plus_seg(&self.gyro_bias, dx, 3),
         }
     }
 

@@ -642,11 +642,11 @@ fn commit_shared<T: Real, const C: usize>(
                 *e += *a * kj + *b * vj;
             }
         }
-        *t = gr * c0;
+        *t = super::imu::mv(&gr, &c0);
     }
     let [t0, t1, t2, ..] = top;
-    let c00 = Matrix3::from_columns(&[t0, t1, t2]) * gr.transpose();
-    let c00 = (c00 + c00.transpose()) * T::lit(0.5);
+    let c00 = super::imu::mm(&Matrix3::from_columns(&[t0, t1, t2]), &gr.transpose());
+    let c00 = super::imu::sym(&c00);
     // K, U, S and P are finite, so P⁺ can only fail by overflow; for a positive semi-definite
     // P⁺, |P⁺_ij| ≤ √(P⁺_ii P⁺_jj), so a finite positive diagonal bounds every entry.
     let ok = |d: T| d.is_finite() && d > T::zero();

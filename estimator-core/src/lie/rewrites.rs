@@ -431,6 +431,26 @@ fn se2_values<T: Real>() {
         assert!(same(t2.as_slice(), tau2.as_slice()));
         assert!(m(&jr, &Se2::right_jacobian_inv(&tau2)));
         assert!(m(&jl, &-Se2::right_jacobian_inv(&-tau2)));
+        // J_r⁻¹ with J_r's last column written out, as it was.
+        let k = AngleCoeffs::from_theta_sq(tau.z * tau.z);
+        let h = super::trig::half_cot(k.theta_sq, k.theta, k.sin_half, k.cos_half);
+        let hw = T::lit(0.5) * tau.z;
+        let wc = tau.z * k.c;
+        let m13 = wc * tau.x - k.b * tau.y;
+        let m23 = k.b * tau.x + wc * tau.y;
+        let z0 = T::zero();
+        let jr_inv = Matrix3::new(
+            h,
+            -hw,
+            -(h * m13 - hw * m23),
+            hw,
+            h,
+            -(hw * m13 + h * m23),
+            z0,
+            z0,
+            T::one(),
+        );
+        assert!(m(&Se2::right_jacobian_inv(&tau), &jr_inv));
         assert!(m(&Se2::left_jacobian(&tau), &Se2::right_jacobian(&-tau)));
         assert!(m(
             &Se2::left_jacobian_inv(&tau),

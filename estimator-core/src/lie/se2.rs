@@ -96,12 +96,12 @@ impl<T: Real> Se2<T> {
     }
 
     fn jr_inv_from(k: &AngleCoeffs<T>, tau: &Vector3<T>) -> Matrix3<T> {
-        let (vx, vy, w) = (tau.x, tau.y, tau.z);
+        let w = tau.z;
         let h = half_cot(k.theta_sq, k.theta, k.sin_half, k.cos_half);
         let hw = T::lit(0.5) * w;
-        let wc = w * k.c;
-        let m13 = wc * vx - k.b * vy;
-        let m23 = k.b * vx + wc * vy;
+        // J_r's last column `m` (the same expressions), read from jr_from.
+        let jr = Self::jr_from(k, tau);
+        let (m13, m23) = (jr.m13, jr.m23);
         Matrix3::new(
             h,
             -hw,

@@ -3,7 +3,7 @@
 
 use super::trig::AngleCoeffs;
 use super::*;
-use nalgebra::{Matrix2, Quaternion, UnitQuaternion};
+use nalgebra::{Matrix2, Quaternion, UnitQuaternion, Vector2};
 
 /// Deterministic numbers in `[-1, 1)` (64-bit LCG).
 struct Lcg(u64);
@@ -345,4 +345,151 @@ fn so3_rewrites_are_bit_identical() {
     so3_matrices::<f64>();
     so3_act::<f32>();
     so3_act::<f64>();
+}
+
+/// SO(2)'s `try_from_matrix` as it was: a finiteness check before the orthogonality test.
+fn so2_try_from_matrix_before<T: Real>(m: &Matrix2<T>) -> Option<So2<T>> {
+    if !all_finite(m.as_slice()) {
+        return None;
+    }
+    let err = (m.transpose() * m - Matrix2::<T>::identity()).norm_squared();
+    let tol = T::lit(ORTHOGONALITY_TOLERANCE);
+    if !(err <= tol * tol && m.determinant() > T::zero()) {
+        return None;
+    }
+    So2::from_cos_sin(m.m11 + m.m22, m.m21 - m.m12)
+}
+
+fn so2_values<T: Real>() {
+    let special = [
+        T::zero(),
+        T::one(),
+        T::lit(f64::NAN),
+        T::lit(f64::INFINITY),
+        T::lit(f64::NEG_INFINITY),
+        T::lit(1e30),
+    ];
+    let mut rng = Lcg(43);
+    let mut accepted = 0;
+    for i in 0..600 {
+        let r = So2::from_angle(T::lit(4.0 * rng.next()));
+        let noise = [0.0, 1e-5, 1e-2][i % 3];
+        let mut m = r.rotation_matrix().map(|x| x + T::lit(noise * rng.next()));
+        if i % 5 == 4 {
+            // A special value in one entry (or all four).
+            let x = special[i / 5 % special.len()];
+            match m.as_mut_slice().get_mut(i / 30 % 5) {
+                Some(e) => *e = x,
+                None => m = Matrix2::from_element(x),
+            }
+        }
+        let got = So2::try_from_matrix(&m).map(|r| [r.cos(), r.sin()]);
+        let want = so2_try_from_matrix_before(&m).map(|r| [r.cos(), r.sin()]);
+        assert_eq!(got.is_some(), want.is_some(), "{m}");
+        if let (Some(g), Some(w)) = (got, want) {
+            assert!(same(&g, &w));
+            accepted += 1;
+        }
+        // is_finite as it was, on finite and non-finite parts.
+        for (c, s) in [(m.m11, m.m21), (m.m12, m.m22)] {
+            let r = So2::from_unit(c, s);
+            assert_eq!(r.is_finite(), c.is_finite() && s.is_finite());
+            let t = Vector2::new(m.m22, m.m11);
+            let e = Se2::from_parts(r, t);
+            assert_eq!(e.is_finite(), r.is_finite() && all_finite(t.as_slice()));
+        }
+    }
+    assert!(accepted > 200, "{accepted}");
+}
+
+fn se2_values<T: Real>() {
+    let m = |a: &Matrix3<T>, b: &Matrix3<T>| same(a.as_slice(), b.as_slice());
+    let mut rng = Lcg(47);
+    for_each_vector::<T>(53, |tau| {
+        let scale = [1e-5, 1e-3, 0.1, 1.0, 3.1, 5.0][rng.0 as usize % 6];
+        let tau = Vector3::new(tau.x, tau.y, T::lit(scale * rng.next()));
+        let a = Se2::exp(&tau);
+        let b = Se2::exp(&(tau * T::lit(-0.6)));
+        // inverse: (R⁻¹, −(R⁻¹ t)) with So2's act and nalgebra's negation.
+        let r_inv = a.rotation().inverse();
+        let inv = a.inverse();
+        assert!(same(
+            &[inv.rotation().cos(), inv.rotation().sin()],
+            &[r_inv.cos(), r_inv.sin()]
+        ));
+        let t_inv = -r_inv.act(&a.translation());
+        assert!(same(inv.translation().as_slice(), t_inv.as_slice()));
+        // The Jacobians the trait's default methods gave.
+        assert!(m(&a.inverse_jac().1, &-a.adjoint()));
+        let z = a.between(&b);
+        let (z2, j, i) = a.between_jac(&b);
+        assert_eq!(z2, z);
+        assert!(m(&j, &-z.inverse().adjoint()));
+        assert!(m(&i, &Matrix3::identity()));
+        let (t2, jr, jl) = a.rminus_jac(&b);
+        let tau2 = a.rminus(&b);
+        assert!(same(t2.as_slice(), tau2.as_slice()));
+        assert!(m(&jr, &Se2::right_jacobian_inv(&tau2)));
+        assert!(m(&jl, &-Se2::right_jacobian_inv(&-tau2)));
+        // J_r⁻¹ with J_r's last column written out, as it was.
+        let k = AngleCoeffs::from_theta_sq(tau.z * tau.z);
+        let h = super::trig::half_cot(k.theta_sq, k.theta, k.sin_half, k.cos_half);
+        let hw = T::lit(0.5) * tau.z;
+        let wc = tau.z * k.c;
+        let m13 = wc * tau.x - k.b * tau.y;
+        let m23 = k.b * tau.x + wc * tau.y;
+        let z0 = T::zero();
+        let jr_inv = Matrix3::new(
+            h,
+            -hw,
+            -(h * m13 - hw * m23),
+            hw,
+            h,
+            -(hw * m13 + h * m23),
+            z0,
+            z0,
+            T::one(),
+        );
+        assert!(m(&Se2::right_jacobian_inv(&tau), &jr_inv));
+        assert!(m(&Se2::left_jacobian(&tau), &Se2::right_jacobian(&-tau)));
+        assert!(m(
+            &Se2::left_jacobian_inv(&tau),
+            &Se2::right_jacobian_inv(&-tau)
+        ));
+    });
+}
+
+/// `negate` against nalgebra's `Neg`, and SO(3)'s `−Ad` in `inverse_jac` and `between_jac`.
+fn negate_and_so3_adjoints<T: Real>() {
+    let m = |a: &Matrix3<T>, b: &Matrix3<T>| same(a.as_slice(), b.as_slice());
+    for_each_matrix::<T>(|x| {
+        let mut y = *x;
+        negate(&mut y);
+        assert!(y
+            .iter()
+            .zip(x.iter())
+            .all(|(a, b)| a.to_f64().to_bits() == (-*b).to_f64().to_bits()));
+    });
+    for_each_vector::<T>(59, |w| {
+        let a = So3::exp(w);
+        let b = So3::exp(&(w * T::lit(0.7) + Vector3::new(T::lit(0.3), T::zero(), T::zero())));
+        let (ai, j) = a.inverse_jac();
+        assert_eq!(ai, a.inverse());
+        assert!(m(&j, &-a.adjoint()));
+        let z = a.between(&b);
+        let (z2, j, i) = a.between_jac(&b);
+        assert_eq!(z2, z);
+        assert!(m(&j, &-z.inverse().adjoint()));
+        assert!(m(&i, &Matrix3::identity()));
+    });
+}
+
+#[test]
+fn so2_se2_rewrites_are_bit_identical() {
+    so2_values::<f32>();
+    so2_values::<f64>();
+    se2_values::<f32>();
+    se2_values::<f64>();
+    negate_and_so3_adjoints::<f32>();
+    negate_and_so3_adjoints::<f64>();
 }

@@ -17,7 +17,7 @@
 
 use super::so2::So2;
 use super::trig::{half_cot, poly, AngleCoeffs, Cutoff};
-use super::{all_finite, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, negate, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
 
 /// A planar rigid motion `T = (R, t) ∈ SE(2)`.
@@ -65,6 +65,7 @@ impl<T: Real> Se2<T> {
         self.translation
     }
 
+    #[cfg_attr(estimator_compact, inline(never))]
     fn exp_from(k: &AngleCoeffs<T>, tau: &Vector3<T>) -> Self {
         let w = tau.z;
         let wb = w * k.b;
@@ -95,12 +96,12 @@ impl<T: Real> Se2<T> {
     }
 
     fn jr_inv_from(k: &AngleCoeffs<T>, tau: &Vector3<T>) -> Matrix3<T> {
-        let (vx, vy, w) = (tau.x, tau.y, tau.z);
+        let w = tau.z;
         let h = half_cot(k.theta_sq, k.theta, k.sin_half, k.cos_half);
         let hw = T::lit(0.5) * w;
-        let wc = w * k.c;
-        let m13 = wc * vx - k.b * vy;
-        let m23 = k.b * vx + wc * vy;
+        // J_r's last column `m` (the same expressions), read from jr_from.
+        let jr = Self::jr_from(k, tau);
+        let (m13, m23) = (jr.m13, jr.m23);
         Matrix3::new(
             h,
             -hw,
@@ -175,11 +176,16 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         }
     }
 
+    #[cfg_attr(estimator_compact, inline(never))]
     fn inverse(&self) -> Self {
+        // `−(R⁻¹ t)` entry by entry: So2::act of `(cos, −sin)`, each entry negated (no vector
+        // temporary and no `Neg` pass).
         let r_inv = self.rotation.inverse();
+        let (c, ns) = (r_inv.cos(), r_inv.sin());
+        let t = &self.translation;
         Self {
             rotation: r_inv,
-            translation: -r_inv.act(&self.translation),
+            translation: Vector2::new(-(c * t.x - ns * t.y), -(ns * t.x + c * t.y)),
         }
     }
 
@@ -200,6 +206,16 @@ impl<T: Real> LieGroup<T> for Se2<T> {
 
     fn right_jacobian_inv(tau: &Vector3<T>) -> Matrix3<T> {
         Self::jr_inv_from(&AngleCoeffs::from_theta_sq(tau.z * tau.z), tau)
+    }
+
+    /// `J_r(−τ)`, `−τ` entry by entry.
+    fn left_jacobian(tau: &Vector3<T>) -> Matrix3<T> {
+        Self::right_jacobian(&Vector3::new(-tau.x, -tau.y, -tau.z))
+    }
+
+    /// `J_r⁻¹(−τ)`, `−τ` entry by entry.
+    fn left_jacobian_inv(tau: &Vector3<T>) -> Matrix3<T> {
+        Self::right_jacobian_inv(&Vector3::new(-tau.x, -tau.y, -tau.z))
     }
 
     fn matrix(&self) -> Matrix3<T> {
@@ -229,12 +245,36 @@ impl<T: Real> LieGroup<T> for Se2<T> {
     }
 
     fn is_finite(&self) -> bool {
-        self.rotation.is_finite() && all_finite(self.translation.as_slice())
+        let t = &self.translation;
+        all_finite(&[self.rotation.cos(), self.rotation.sin(), t.x, t.y])
     }
 
     fn exp_jac(tau: &Vector3<T>) -> (Self, Matrix3<T>) {
         let k = AngleCoeffs::from_theta_sq(tau.z * tau.z);
         (Self::exp_from(&k, tau), Self::jr_from(&k, tau))
+    }
+
+    /// `(a⁻¹, −Ad_a)`, negated in place ([`negate`]).
+    fn inverse_jac(&self) -> (Self, Matrix3<T>) {
+        let mut j = self.adjoint();
+        negate(&mut j);
+        (self.inverse(), j)
+    }
+
+    /// `(z = a⁻¹·b, −Ad_{z⁻¹}, I)`, negated in place ([`negate`]).
+    fn between_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
+        let z = self.between(b);
+        let mut j = z.inverse().adjoint();
+        negate(&mut j);
+        (z, j, Matrix3::identity())
+    }
+
+    /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))`, the last negated in place ([`negate`]).
+    fn rminus_jac(&self, b: &Self) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {
+        let tau = self.rminus(b);
+        let mut jl = Self::left_jacobian_inv(&tau);
+        negate(&mut jl);
+        (tau, Self::right_jacobian_inv(&tau), jl)
     }
 
     /// `(R p + t, [R | R G p], R)`, `G = [0 −1; 1 0]`.

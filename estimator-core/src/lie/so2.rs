@@ -152,15 +152,16 @@ impl<T: Real> LieGroup<T> for So2<T> {
         self.rotation_matrix()
     }
 
+    #[cfg_attr(estimator_compact, inline(never))]
     fn normalize(&self) -> Self {
         Self::from_cos_sin(self.re, self.im).unwrap_or(*self)
     }
 
     /// The nearest rotation of a 2×2 matrix is `((m₁₁ + m₂₂)/2, (m₂₁ − m₁₂)/2)` normalized.
+    ///
+    /// A non-finite entry makes the orthogonality error infinite or NaN (a sum of squares with
+    /// that entry's square in it), which the tolerance test rejects: no separate finiteness check.
     fn try_from_matrix(m: &Matrix2<T>) -> Option<Self> {
-        if !all_finite(m.as_slice()) {
-            return None;
-        }
         let err = orthogonality_error(m);
         let tol = T::lit(ORTHOGONALITY_TOLERANCE);
         // Written so that NaN (which compares false) is rejected too.
@@ -173,7 +174,7 @@ impl<T: Real> LieGroup<T> for So2<T> {
     }
 
     fn is_finite(&self) -> bool {
-        self.re.is_finite() && self.im.is_finite()
+        all_finite(&[self.re, self.im])
     }
 
     /// `(R p, R G¹ p = R [−p_y; p_x], R)`.

@@ -18,7 +18,7 @@
 
 use super::trig::{half_sinc, poly, AngleCoeffs, Cutoff};
 use super::{
-    all_finite, mul_skew, orthogonality_error, skew, skew_poly, LieGroup, Real,
+    all_finite, mul_skew, negate, orthogonality_error, skew, skew_poly, LieGroup, Real,
     ORTHOGONALITY_TOLERANCE,
 };
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
@@ -353,6 +353,21 @@ impl<T: Real> LieGroup<T> for So3<T> {
             b.rotation_matrix().transpose(),
             Matrix3::identity(),
         )
+    }
+
+    /// `(a⁻¹, −R)`, negated in place ([`negate`]).
+    fn inverse_jac(&self) -> (Self, Matrix3<T>) {
+        let mut j = self.adjoint();
+        negate(&mut j);
+        (self.inverse(), j)
+    }
+
+    /// `(z = a⁻¹·b, −R_{z⁻¹}, I)`, negated in place ([`negate`]).
+    fn between_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
+        let z = self.between(b);
+        let mut j = z.inverse().adjoint();
+        negate(&mut j);
+        (z, j, Matrix3::identity())
     }
 
     fn rminus_jac(&self, b: &Self) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {

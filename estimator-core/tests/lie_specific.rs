@@ -163,6 +163,11 @@ fn try_from_matrix_accepts_and_rejects() {
     let mut nan = r;
     nan[(1, 2)] = f64::NAN;
     assert!(So3::try_from_matrix(&nan).is_none());
+    for bad in [f64::INFINITY, f64::NEG_INFINITY, f64::MAX] {
+        let mut m = r;
+        m[(0, 0)] = bad;
+        assert!(So3::try_from_matrix(&m).is_none(), "{bad}");
+    }
     assert!(So3::try_from_matrix(&Matrix3::<f64>::zeros()).is_none());
 
     let r2 = So2::from_angle(0.7).matrix();

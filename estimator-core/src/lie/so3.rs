@@ -319,12 +319,10 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn try_from_matrix(m: &Matrix3<T>) -> Option<Self> {
-        if !all_finite(m.as_slice()) {
-            return None;
-        }
+        // No separate finiteness check: a NaN or infinite entry makes the error NaN or infinite,
+        // and the comparison below (false for NaN) rejects it.
         let err = orthogonality_error(m);
         let tol = T::lit(ORTHOGONALITY_TOLERANCE);
-        // Written so that NaN (which compares false) is rejected too.
         let orthogonal = err <= tol * tol;
         let proper = m.determinant() > T::zero();
         if !(orthogonal && proper) {

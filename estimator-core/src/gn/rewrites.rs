@@ -2,9 +2,9 @@
 //! nalgebra code they replace: the same bits (and the same errors), `f32` and `f64`.
 
 use super::*;
-use crate::lie::{LieGroup, So3};
+use super::rotation::{triad, triad_start, unit};
 use crate::Real;
-use nalgebra::{Vector2, Vector3};
+use nalgebra::Vector3;
 
 /// Deterministic numbers in `[-1, 1)` (64-bit LCG).
 struct Lcg(u64);
@@ -103,4 +103,83 @@ fn point_spread<T: Real>() {
 fn check_point_spread_is_the_nalgebra_form() {
     point_spread::<f32>();
     point_spread::<f64>();
+}
+
+/// The TRIAD start of [`solve_rotation_from_vectors`] before [`triad_start`]: the unit vectors of
+/// the first pair and of the best pair carried through the loop.
+fn triad_start_before<T: Real>(pairs: &[VectorPair<T>]) -> Result<crate::lie::So3<T>, SolveError> {
+    let mut first: Option<(Vector3<T>, Vector3<T>)> = None;
+    let mut best: Option<(T, Vector3<T>, Vector3<T>)> = None;
+    for p in pairs {
+        let b = unit(&p.body).ok_or(SolveError::DegenerateGeometry)?;
+        let w = unit(&p.world).ok_or(SolveError::DegenerateGeometry)?;
+        match first {
+            None => first = Some((b, w)),
+            Some((b1, _)) => {
+                let s = b1.cross(&b).norm();
+                if best.as_ref().is_none_or(|(sb, _, _)| s > *sb) {
+                    best = Some((s, b, w));
+                }
+            }
+        }
+    }
+    let ((b1, w1), (_, b2, w2)) = first.zip(best).ok_or(SolveError::DegenerateGeometry)?;
+    triad(&b1, &b2, &w1, &w2).ok_or(SolveError::DegenerateGeometry)
+}
+
+/// Pair sets of 0 to 6 pairs: random, with repeated (tied) and parallel directions, zero
+/// vectors on either side, tiny and huge magnitudes.
+fn rotation_start<T: Real>() {
+    let mut rng = Lcg(11);
+    let (mut ok, mut degenerate) = (0, 0);
+    for i in 0..1500 {
+        let n = i % 7;
+        let mut pairs = [VectorPair {
+            body: Vector3::<T>::zeros(),
+            world: Vector3::zeros(),
+            sigma: T::one(),
+        }; 6];
+        let scale = [1.0, 1e-20, 1e20, 3.0][i % 4];
+        for p in pairs.iter_mut().take(n) {
+            p.body = rng.vector(scale);
+            p.world = rng.vector(1.0);
+        }
+        match i % 11 {
+            // A tie: two pairs with the same body direction.
+            1 if n >= 3 => pairs[2].body = pairs[1].body * T::lit(2.0),
+            // All body directions parallel.
+            2 => {
+                for k in 1..n {
+                    pairs[k].body = pairs[0].body * T::lit(k as f64 + 0.5);
+                }
+            }
+            // World directions parallel.
+            3 if n >= 2 => pairs[1].world = -pairs[0].world,
+            // Zero vectors, first pair or later ones.
+            4 if n >= 1 => pairs[0].world = Vector3::zeros(),
+            5 if n >= 1 => pairs[n - 1].body = Vector3::zeros(),
+            6 if n >= 2 => pairs[1].world = Vector3::zeros(),
+            _ => {}
+        }
+        let pairs = &pairs[..n];
+        let got = triad_start(pairs);
+        let want = triad_start_before(pairs);
+        match (got, want) {
+            (Ok(g), Ok(w)) => {
+                assert!(same(g.quaternion().coords.as_slice(), w.quaternion().coords.as_slice()));
+                ok += 1;
+            }
+            (g, w) => {
+                assert_eq!(g.err(), w.err(), "{i}");
+                degenerate += 1;
+            }
+        }
+    }
+    assert!(ok > 300 && degenerate > 300, "{ok} {degenerate}");
+}
+
+#[test]
+fn triad_start_is_the_carried_form() {
+    rotation_start::<f32>();
+    rotation_start::<f64>();
 }

@@ -1,8 +1,8 @@
 //! The size-driven rewrites of `gn` (scalar forms, shared helpers) against the straightforward
 //! nalgebra code they replace: the same bits (and the same errors), `f32` and `f64`.
 
-use super::*;
 use super::rotation::{triad, triad_start, unit};
+use super::*;
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -166,7 +166,10 @@ fn rotation_start<T: Real>() {
         let want = triad_start_before(pairs);
         match (got, want) {
             (Ok(g), Ok(w)) => {
-                assert!(same(g.quaternion().coords.as_slice(), w.quaternion().coords.as_slice()));
+                assert!(same(
+                    g.quaternion().coords.as_slice(),
+                    w.quaternion().coords.as_slice()
+                ));
                 ok += 1;
             }
             (g, w) => {

@@ -61,6 +61,8 @@ pub mod linalg;
 pub mod loss;
 pub mod manifold;
 pub mod pnp;
+#[cfg(test)]
+mod rewrites;
 pub mod rotation;
 pub mod solver;
 pub mod triangulation;

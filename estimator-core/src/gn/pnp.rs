@@ -259,16 +259,20 @@ pub fn check_point_spread<T: Real>(points: &[Vector3<T>]) -> Result<(), SolveErr
     }
     let count = T::from_usize(n).unwrap_or_else(T::one);
     let inv_n = T::one() / count;
-    let mut sum = Vector3::zeros();
+    // `Σ p / n` and `p − p̄` component by component (nalgebra's `+=`, `* inv_n` and `-` do the
+    // same operations, entry by entry), with no vector temporaries on the stack.
+    let [mut mx, mut my, mut mz] = [T::zero(); 3];
     for p in points {
-        sum += p;
+        mx += p.x;
+        my += p.y;
+        mz += p.z;
     }
-    let mean = sum * inv_n;
+    let (mx, my, mz) = (mx * inv_n, my * inv_n, mz * inv_n);
     // The six distinct entries of the symmetric `S` (`d dᵀ` is exactly symmetric), summed in
     // the order of the points.
     let [mut s11, mut s22, mut s33, mut s12, mut s13, mut s23] = [T::zero(); 6];
     for p in points {
-        let d = p - mean;
+        let d = Vector3::new(p.x - mx, p.y - my, p.z - mz);
         s11 += d.x * d.x;
         s22 += d.y * d.y;
         s33 += d.z * d.z;
@@ -278,7 +282,7 @@ pub fn check_point_spread<T: Real>(points: &[Vector3<T>]) -> Result<(), SolveErr
     }
     let tr = s11 + s22 + s33;
     let i2 = s11 * s22 - s12 * s12 + s11 * s33 - s13 * s13 + s22 * s33 - s23 * s23;
-    let scale = mean.x * mean.x + mean.y * mean.y + mean.z * mean.z + T::one();
+    let scale = mx * mx + my * my + mz * mz + T::one();
     let spread = tr > T::lit(COINCIDENT_REL) * count * scale;
     let not_collinear = i2 > T::lit(COLLINEAR_REL) * tr * tr;
     if spread && not_collinear {

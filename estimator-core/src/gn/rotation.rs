@@ -65,7 +65,7 @@ pub fn vector_pair_error<T: Real>(
     ((pred - body_unit) * inv_sigma, skew(&pred) * inv_sigma)
 }
 
-fn unit<T: Real>(v: &Vector3<T>) -> Option<Vector3<T>> {
+pub(super) fn unit<T: Real>(v: &Vector3<T>) -> Option<Vector3<T>> {
     let n = v.norm();
     if n.is_finite() && n > T::zero() {
         Some(v / n)
@@ -90,7 +90,7 @@ fn triad_frame<T: Real>(u: &Vector3<T>, v: &Vector3<T>) -> Option<Matrix3<T>> {
 }
 
 /// The TRIAD rotation `W Bᵀ` from two body/world pairs of unit vectors.
-fn triad<T: Real>(
+pub(super) fn triad<T: Real>(
     b1: &Vector3<T>,
     b2: &Vector3<T>,
     w1: &Vector3<T>,
@@ -99,6 +99,37 @@ fn triad<T: Real>(
     let b = triad_frame(b1, b2)?;
     let w = triad_frame(w1, w2)?;
     So3::from_rotation_matrix(&(w * b.transpose()))
+}
+
+/// [`triad`] of the unit vectors of two pairs; `None` for a zero vector or parallel directions.
+fn triad_pairs<T: Real>(first: &VectorPair<T>, second: &VectorPair<T>) -> Option<So3<T>> {
+    let (b1, w1) = (unit(&first.body)?, unit(&first.world)?);
+    let (b2, w2) = (unit(&second.body)?, unit(&second.world)?);
+    triad(&b1, &b2, &w1, &w2)
+}
+
+/// The TRIAD start of [`solve_rotation_from_vectors`]: from the first pair and the pair whose body
+/// direction is most perpendicular to the first one's (the first such pair on a tie).
+///
+/// # Errors
+/// [`SolveError::DegenerateGeometry`]: fewer than 2 pairs, a zero vector, or parallel directions.
+pub(super) fn triad_start<T: Real>(pairs: &[VectorPair<T>]) -> Result<So3<T>, SolveError> {
+    // Unit vectors of the first pair and of the pair most perpendicular to it (body side). Every
+    // pair's vectors are checked here; the best pair is kept by reference and its unit vectors
+    // formed again (the same bits) instead of carried through the loop.
+    let (first, rest) = pairs.split_first().ok_or(SolveError::DegenerateGeometry)?;
+    let b1 = unit(&first.body).ok_or(SolveError::DegenerateGeometry)?;
+    let mut best: Option<(T, &VectorPair<T>)> = None;
+    for p in rest {
+        let b = unit(&p.body).ok_or(SolveError::DegenerateGeometry)?;
+        unit(&p.world).ok_or(SolveError::DegenerateGeometry)?;
+        let s = b1.cross(&b).norm();
+        if best.is_none_or(|(sb, _)| s > sb) {
+            best = Some((s, p));
+        }
+    }
+    let (_, second) = best.ok_or(SolveError::DegenerateGeometry)?;
+    triad_pairs(first, second).ok_or(SolveError::DegenerateGeometry)
 }
 
 struct RotProblem<'a, T: Real> {
@@ -151,24 +182,7 @@ pub fn solve_rotation_from_vectors<T: Real>(
     if !pairs.iter().all(|p| p.sigma > T::zero()) || !options.is_valid() {
         return Err(SolveError::InvalidOptions);
     }
-    // Unit vectors of the first pair and of the pair most perpendicular to it (body side).
-    let mut first: Option<(Vector3<T>, Vector3<T>)> = None;
-    let mut best: Option<(T, Vector3<T>, Vector3<T>)> = None;
-    for p in pairs {
-        let b = unit(&p.body).ok_or(SolveError::DegenerateGeometry)?;
-        let w = unit(&p.world).ok_or(SolveError::DegenerateGeometry)?;
-        match first {
-            None => first = Some((b, w)),
-            Some((b1, _)) => {
-                let s = b1.cross(&b).norm();
-                if best.as_ref().is_none_or(|(sb, _, _)| s > *sb) {
-                    best = Some((s, b, w));
-                }
-            }
-        }
-    }
-    let ((b1, w1), (_, b2, w2)) = first.zip(best).ok_or(SolveError::DegenerateGeometry)?;
-    let start = triad(&b1, &b2, &w1, &w2).ok_or(SolveError::DegenerateGeometry)?;
+    let start = triad_start(pairs)?;
     let start = match guess {
         Some(g) if g.is_finite() => *g,
         Some(_) => return Err(SolveError::NonFiniteGuess),

@@ -1,0 +1,188 @@
+//! The size-driven rewrites of `gn` (scalar forms, shared helpers) against the straightforward
+//! nalgebra code they replace: the same bits (and the same errors), `f32` and `f64`.
+
+use super::rotation::{triad, triad_start, unit};
+use super::*;
+use crate::Real;
+use nalgebra::Vector3;
+
+/// Deterministic numbers in `[-1, 1)` (64-bit LCG).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((self.0 >> 11) as f64) / ((1u64 << 52) as f64) - 1.0
+    }
+
+    fn vector<T: Real>(&mut self, scale: f64) -> Vector3<T> {
+        Vector3::new(self.next(), self.next(), self.next()).map(|x| T::lit(scale * x))
+    }
+}
+
+/// Equal bits, entry by entry (any two `NaN`s count as equal).
+fn same<T: Real>(a: &[T], b: &[T]) -> bool {
+    a.len() == b.len()
+        && a.iter().zip(b).all(|(x, y)| {
+            let (x, y) = (x.to_f64(), y.to_f64());
+            x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan())
+        })
+}
+
+/// [`check_point_spread`] before the scalar sums: nalgebra's `sum += p`, `sum * inv_n`, `p − mean`.
+fn check_point_spread_before<T: Real>(points: &[Vector3<T>]) -> Result<(), SolveError> {
+    let n = points.len();
+    if n == 0 {
+        return Err(SolveError::DegenerateGeometry);
+    }
+    let count = T::from_usize(n).unwrap_or_else(T::one);
+    let inv_n = T::one() / count;
+    let mut sum = Vector3::zeros();
+    for p in points {
+        sum += p;
+    }
+    let mean = sum * inv_n;
+    let [mut s11, mut s22, mut s33, mut s12, mut s13, mut s23] = [T::zero(); 6];
+    for p in points {
+        let d = p - mean;
+        s11 += d.x * d.x;
+        s22 += d.y * d.y;
+        s33 += d.z * d.z;
+        s12 += d.x * d.y;
+        s13 += d.x * d.z;
+        s23 += d.y * d.z;
+    }
+    let tr = s11 + s22 + s33;
+    let i2 = s11 * s22 - s12 * s12 + s11 * s33 - s13 * s13 + s22 * s33 - s23 * s23;
+    let scale = mean.x * mean.x + mean.y * mean.y + mean.z * mean.z + T::one();
+    let spread = tr > T::lit(1e-12) * count * scale;
+    let not_collinear = i2 > T::lit(1e-10) * tr * tr;
+    if spread && not_collinear {
+        Ok(())
+    } else {
+        Err(SolveError::DegenerateGeometry)
+    }
+}
+
+/// Point sets of every kind: spread, nearly collinear, nearly coincident, far from the origin,
+/// with non-finite entries, and the empty set.
+fn point_spread<T: Real>() {
+    let mut rng = Lcg(3);
+    let (mut ok, mut degenerate) = (0, 0);
+    for i in 0..600 {
+        let n = i % 9;
+        let offset = rng.vector::<T>([0.0, 1.0, 1e3, 1e6][i % 4]);
+        let dir = rng.vector::<T>(1.0);
+        let mut pts = [Vector3::<T>::zeros(); 8];
+        for (k, p) in pts.iter_mut().enumerate().take(n) {
+            let along = dir * T::lit(k as f64);
+            let across = rng.vector::<T>([1.0, 1e-4, 1e-6, 1e-9, 0.0][i % 5]);
+            *p = offset + along + across;
+        }
+        if i % 97 == 5 {
+            pts[0].y = T::lit(f64::NAN);
+        }
+        if i % 89 == 7 {
+            pts[1].x = T::lit(f64::INFINITY);
+        }
+        let pts = &pts[..n];
+        let got = check_point_spread(pts);
+        assert_eq!(got, check_point_spread_before(pts), "{i}");
+        if got.is_ok() {
+            ok += 1;
+        } else {
+            degenerate += 1;
+        }
+    }
+    assert!(ok > 100 && degenerate > 100, "{ok} {degenerate}");
+}
+
+#[test]
+fn check_point_spread_is_the_nalgebra_form() {
+    point_spread::<f32>();
+    point_spread::<f64>();
+}
+
+/// The TRIAD start of [`solve_rotation_from_vectors`] before [`triad_start`]: the unit vectors of
+/// the first pair and of the best pair carried through the loop.
+fn triad_start_before<T: Real>(pairs: &[VectorPair<T>]) -> Result<crate::lie::So3<T>, SolveError> {
+    let mut first: Option<(Vector3<T>, Vector3<T>)> = None;
+    let mut best: Option<(T, Vector3<T>, Vector3<T>)> = None;
+    for p in pairs {
+        let b = unit(&p.body).ok_or(SolveError::DegenerateGeometry)?;
+        let w = unit(&p.world).ok_or(SolveError::DegenerateGeometry)?;
+        match first {
+            None => first = Some((b, w)),
+            Some((b1, _)) => {
+                let s = b1.cross(&b).norm();
+                if best.as_ref().is_none_or(|(sb, _, _)| s > *sb) {
+                    best = Some((s, b, w));
+                }
+            }
+        }
+    }
+    let ((b1, w1), (_, b2, w2)) = first.zip(best).ok_or(SolveError::DegenerateGeometry)?;
+    triad(&b1, &b2, &w1, &w2).ok_or(SolveError::DegenerateGeometry)
+}
+
+/// Pair sets of 0 to 6 pairs: random, with repeated (tied) and parallel directions, zero
+/// vectors on either side, tiny and huge magnitudes.
+fn rotation_start<T: Real>() {
+    let mut rng = Lcg(11);
+    let (mut ok, mut degenerate) = (0, 0);
+    for i in 0..1500 {
+        let n = i % 7;
+        let mut pairs = [VectorPair {
+            body: Vector3::<T>::zeros(),
+            world: Vector3::zeros(),
+            sigma: T::one(),
+        }; 6];
+        let scale = [1.0, 1e-20, 1e20, 3.0][i % 4];
+        for p in pairs.iter_mut().take(n) {
+            p.body = rng.vector(scale);
+            p.world = rng.vector(1.0);
+        }
+        match i % 11 {
+            // A tie: two pairs with the same body direction.
+            1 if n >= 3 => pairs[2].body = pairs[1].body * T::lit(2.0),
+            // All body directions parallel.
+            2 => {
+                for k in 1..n {
+                    pairs[k].body = pairs[0].body * T::lit(k as f64 + 0.5);
+                }
+            }
+            // World directions parallel.
+            3 if n >= 2 => pairs[1].world = -pairs[0].world,
+            // Zero vectors, first pair or later ones.
+            4 if n >= 1 => pairs[0].world = Vector3::zeros(),
+            5 if n >= 1 => pairs[n - 1].body = Vector3::zeros(),
+            6 if n >= 2 => pairs[1].world = Vector3::zeros(),
+            _ => {}
+        }
+        let pairs = &pairs[..n];
+        let got = triad_start(pairs);
+        let want = triad_start_before(pairs);
+        match (got, want) {
+            (Ok(g), Ok(w)) => {
+                assert!(same(
+                    g.quaternion().coords.as_slice(),
+                    w.quaternion().coords.as_slice()
+                ));
+                ok += 1;
+            }
+            (g, w) => {
+                assert_eq!(g.err(), w.err(), "{i}");
+                degenerate += 1;
+            }
+        }
+    }
+    assert!(ok > 300 && degenerate > 300, "{ok} {degenerate}");
+}
+
+#[test]
+fn triad_start_is_the_carried_form() {
+    rotation_start::<f32>();
+    rotation_start::<f64>();
+}

@@ -6,7 +6,7 @@ use super::align::InitialSigmas;
 use super::imu::{add33, axpy, mm, mv, ImuNoise};
 use super::models::{add3, div3, neg3, sub3};
 use super::state::{plus_seg, seg};
-use crate::lie::So3;
+use crate::lie::{LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, SVector, UnitQuaternion, Vector3};
 
@@ -186,4 +186,142 @@ fn products<T: Real>() {
 fn products_are_nalgebras() {
     products::<f32>();
     products::<f64>();
+}
+
+/// `cholesky_inverse` against `Cholesky::new(a).map(|c| c.inverse())` on `C × C` matrices:
+/// symmetric positive definite ones over a wide range of scales and conditioning, symmetric
+/// indefinite and singular ones, and ones with special numbers (zeros, infinities, NaN).
+fn cholesky_inverse_case<T: Real, const C: usize>(seed: u64) {
+    use super::update::cholesky_inverse;
+    use nalgebra::{Cholesky, SMatrix};
+    let mut rng = Lcg(seed);
+    for i in 0..600 {
+        let b = SMatrix::<T, C, C>::from_fn(|r, c| number(&mut rng, i / 2 + 3 * r + c));
+        let g = SMatrix::<T, C, C>::from_fn(|_, _| T::lit(rng.next()));
+        let d = T::lit([1e-6, 1e-3, 1.0, 1e3][i % 4] * (rng.next() + 1.0));
+        let cases = [
+            g * g.transpose() + SMatrix::identity() * d,
+            g * g.transpose(),
+            (b + b.transpose()) * T::lit(0.5),
+            b,
+            (g + g.transpose()) * T::lit(0.5),
+        ];
+        for a in cases {
+            let old = Cholesky::new(a).map(|c| c.inverse());
+            let new = cholesky_inverse(&a);
+            assert_eq!(old.is_some(), new.is_some(), "{a:?}");
+            if let (Some(old), Some(new)) = (old, new) {
+                assert!(same(old.as_slice(), new.as_slice()), "{a:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn cholesky_inverse_is_nalgebras() {
+    cholesky_inverse_case::<f32, 1>(29);
+    cholesky_inverse_case::<f32, 2>(31);
+    cholesky_inverse_case::<f32, 3>(37);
+    cholesky_inverse_case::<f32, 4>(41);
+    cholesky_inverse_case::<f64, 1>(43);
+    cholesky_inverse_case::<f64, 2>(47);
+    cholesky_inverse_case::<f64, 3>(53);
+    cholesky_inverse_case::<f64, 6>(59);
+}
+
+/// The update's shared helpers against the per-size code they replace: the chart Jacobian
+/// (`J_rᵀ · Hᵀ[0..3, ..]` through nalgebra), the Gauss-Newton step (the former per-size loops)
+/// and the step length (`‖next − prev‖` through a vector difference).
+fn update_helpers<T: Real, const N: usize>(seed: u64) {
+    use super::update::{chart_jacobian, distance, gauss_newton_step};
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    for i in 0..400 {
+        let dx = SVector::<T, N>::from_fn(|r, _| {
+            if i % 3 == 0 {
+                T::lit(rng.next())
+            } else {
+                number(&mut rng, i / 2 + r)
+            }
+        });
+        let prev = SVector::<T, N>::from_fn(|r, _| number(&mut rng, i / 3 + 2 * r));
+        let mut ht = SMatrix::<T, N, 3>::from_fn(|r, c| number(&mut rng, i / 5 + r + 7 * c));
+        let k = SMatrix::<T, N, 3>::from_fn(|r, c| number(&mut rng, i / 7 + 3 * r + c));
+        let r = SVector::<T, 3>::from_fn(|r, _| number(&mut rng, i + r));
+        let m = 1 + i % 3;
+        for c in m..3 {
+            ht.column_mut(c).fill(T::zero());
+        }
+
+        let mut old = ht;
+        let dth: SVector<T, 3> = dx.fixed_rows::<3>(0).into_owned();
+        let jrt: Matrix3<T> = <So3<T> as LieGroup<T>>::right_jacobian(&dth).transpose();
+        let top = jrt * old.fixed_rows::<3>(0);
+        old.fixed_rows_mut::<3>(0).copy_from(&top);
+        let mut new = ht;
+        chart_jacobian(dx.as_slice(), new.as_mut_slice());
+        assert!(same(new.as_slice(), old.as_slice()));
+
+        let dot = |a: &[T], b: &[T]| a.iter().zip(b).fold(T::zero(), |acc, (x, y)| acc + *x * *y);
+        let mut y = r;
+        for (yc, hc) in y.iter_mut().zip(ht.as_slice().chunks_exact(N)).take(m) {
+            *yc += dot(hc, prev.as_slice());
+        }
+        let mut old = SVector::<T, N>::zeros();
+        for (kc, yc) in k.as_slice().chunks_exact(N).zip(y.iter()).take(m) {
+            for (o, x) in old.iter_mut().zip(kc) {
+                *o += *yc * *x;
+            }
+        }
+        let mut new = SVector::<T, N>::from_element(T::lit(f64::NAN));
+        gauss_newton_step(
+            ht.as_slice(),
+            k.as_slice(),
+            &r,
+            m,
+            prev.as_slice(),
+            new.as_mut_slice(),
+        );
+        assert!(same(new.as_slice(), old.as_slice()));
+
+        let step = dx - prev;
+        let old = dot(step.as_slice(), step.as_slice()).sqrt();
+        let new = distance(dx.as_slice(), prev.as_slice());
+        assert!(same(&[new], &[old]));
+    }
+}
+
+#[test]
+fn update_helpers_are_the_per_size_code() {
+    update_helpers::<f32, 15>(61);
+    update_helpers::<f32, 6>(67);
+    update_helpers::<f64, 15>(71);
+    update_helpers::<f64, 6>(73);
+}
+
+/// `mat_vec` against nalgebra's matrix-vector product (signed zeros included: no leading
+/// zero term), for `K r` (`N × 3`) and `S⁻¹ r` (`3 × 3`, and other capacities).
+fn mat_vec_case<T: Real, const R: usize, const C: usize>(seed: u64) {
+    use super::update::mat_vec;
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    for i in 0..600 {
+        let a = SMatrix::<T, R, C>::from_fn(|r, c| number(&mut rng, i / 3 + 2 * r + c));
+        let x = SVector::<T, C>::from_fn(|r, _| number(&mut rng, i / 2 + r));
+        let old = a * x;
+        let mut new = SVector::<T, R>::from_element(T::lit(f64::NAN));
+        mat_vec(a.as_slice(), x.as_slice(), new.as_mut_slice());
+        assert!(same(new.as_slice(), old.as_slice()));
+    }
+}
+
+#[test]
+fn mat_vec_is_nalgebras_product() {
+    mat_vec_case::<f32, 15, 3>(79);
+    mat_vec_case::<f32, 6, 3>(83);
+    mat_vec_case::<f32, 3, 3>(89);
+    mat_vec_case::<f32, 6, 6>(97);
+    mat_vec_case::<f64, 15, 3>(101);
+    mat_vec_case::<f64, 1, 1>(103);
+    mat_vec_case::<f64, 4, 2>(107);
 }

@@ -345,13 +345,7 @@ where
     };
     linearize_into(model, x, &mut w, true)?;
     let s_inv = gain_into(p, r_noise, &mut w)?;
-    // NIS = rᵀ S⁻¹ r with the S⁻¹ already formed for K, and an explicit sum: `Cholesky::solve`
-    // (dynamic-range `dot`s) and `dot` keep shape asserts, panic paths at opt-level "s".
-    let y = s_inv * w.r;
-    let nis =
-        w.r.iter()
-            .zip(y.iter())
-            .fold(T::zero(), |acc, (a, b)| acc + *a * *b);
+    let nis = nis(&s_inv, &w.r);
     if !nis.is_finite() {
         return Err(EskfError::SingularInnovation);
     }
@@ -359,10 +353,35 @@ where
     if nis > threshold {
         return Ok(UpdateOutcome::Rejected { nis, threshold });
     }
-    w.dx = w.k * w.r;
+    mat_vec(w.k.as_slice(), w.r.as_slice(), w.dx.as_mut_slice());
     let iterations = iterate(x, p, model, opts, r_noise, &mut w);
     commit(x, p, &mut w)?;
     Ok(UpdateOutcome::Accepted { nis, iterations })
+}
+
+/// `NIS = rᵀ S⁻¹ r` with the `S⁻¹` already formed for `K`, and an explicit sum:
+/// `Cholesky::solve` (dynamic-range `dot`s) and `dot` keep shape asserts, panic paths at
+/// opt-level "s". Generic over the row capacity only: one copy for both filters.
+#[cfg_attr(estimator_compact, inline(never))]
+fn nis<T: Real, const C: usize>(s_inv: &SMatrix<T, C, C>, r: &SVector<T, C>) -> T {
+    let mut y = SVector::<T, C>::zeros();
+    mat_vec(s_inv.as_slice(), r.as_slice(), y.as_mut_slice());
+    r.iter()
+        .zip(y.iter())
+        .fold(T::zero(), |acc, (a, b)| acc + *a * *b)
+}
+
+/// `out = A x` for the column-major `out.len() × x.len()` matrix `a`, in the order of
+/// nalgebra's product (`gemv`): `out_i = a_i0 x_0`, then `out_i = a_ij x_j + out_i` for
+/// `j = 1, 2, …` (no leading zero term). Not generic over the sizes: one copy for `K r` in
+/// both filters and for the NIS.
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn mat_vec<T: Real>(a: &[T], x: &[T], out: &mut [T]) {
+    for (j, (col, xj)) in a.chunks_exact(out.len().max(1)).zip(x).enumerate() {
+        for (o, e) in out.iter_mut().zip(col) {
+            *o = if j == 0 { *e * *xj } else { *e * *xj + *o };
+        }
+    }
 }
 
 /// Linearizes at `x̂ ⊕ δx` (`δx` = `w.dx`) into `w.ht`, `w.r`, with the chart Jacobian
@@ -388,13 +407,29 @@ where
         return Err(EskfError::NonFinite);
     }
     if !first {
-        // H̃ᵀ = blockdiag(J_rᵀ, I) Hᵀ: only the first three rows of Hᵀ change.
-        let dth: SVector<T, 3> = w.dx.fixed_rows::<3>(0).into_owned();
-        let jrt = So3::right_jacobian(&dth).transpose();
-        let top = jrt * w.ht.fixed_rows::<3>(0);
-        w.ht.fixed_rows_mut::<3>(0).copy_from(&top);
+        chart_jacobian(w.dx.as_slice(), w.ht.as_mut_slice());
     }
     Ok(())
+}
+
+/// `H̃ᵀ = blockdiag(J_r(δθ)ᵀ, I) Hᵀ` in place on the column-major storage `ht` of the `n × C`
+/// matrix `Hᵀ`, `n = dx.len()`: only the first three rows change, column by column
+/// `J_rᵀ h` ([`mv`](super::imu::mv), the sums of nalgebra's `J_rᵀ · Hᵀ[0..3, ..]`), over every
+/// column (the zero padding too, as that product did). Not generic over the sizes: one copy
+/// for both filters.
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn chart_jacobian<T: Real>(dx: &[T], ht: &mut [T]) {
+    let dth = Vector3::new(at(dx, 0), at(dx, 1), at(dx, 2));
+    let jrt = So3::right_jacobian(&dth).transpose();
+    for col in ht.chunks_exact_mut(dx.len().max(1)) {
+        if let Some(top) = col.get_mut(0..3) {
+            let h = Vector3::new(at(top, 0), at(top, 1), at(top, 2));
+            let v = super::imu::mv(&jrt, &h);
+            for (e, x) in top.iter_mut().zip(v.iter()) {
+                *e = *x;
+            }
+        }
+    }
 }
 
 /// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`; returns `S⁻¹`. The per-size entry of
@@ -460,9 +495,15 @@ fn gain_shared<T: Real, const C: usize>(
     let st = s.transpose();
     *s += st;
     *s *= T::lit(0.5);
-    let chol = Cholesky::new(*s).ok_or(EskfError::SingularInnovation)?;
     // K = U S⁻¹ with S⁻¹ from the Cholesky factor (C × C, small); the columns past m stay zero.
-    let s_inv = chol.inverse();
+    // Built for size, nalgebra's factorization and solves in plain loops (the same bits, see
+    // `cholesky_inverse`); at opt-level 2 or 3, nalgebra's own, which it unrolls faster.
+    #[cfg(estimator_compact)]
+    let s_inv = cholesky_inverse(s).ok_or(EskfError::SingularInnovation)?;
+    #[cfg(not(estimator_compact))]
+    let s_inv = Cholesky::new(*s)
+        .ok_or(EskfError::SingularInnovation)?
+        .inverse();
     k.fill(T::zero());
     for (kc, sc) in k
         .chunks_exact_mut(n.max(1))
@@ -479,22 +520,91 @@ fn gain_shared<T: Real, const C: usize>(
     Ok(s_inv)
 }
 
-/// The columns of a column-major matrix with `N` rows, as contiguous slices.
-#[inline]
-fn columns<T: Real, const N: usize>(m: &[T]) -> core::slice::ChunksExact<'_, T> {
-    m.chunks_exact(N.max(1))
+/// `A⁻¹` by `nalgebra::Cholesky::new(A)?.inverse()`, operation for operation (the same bits;
+/// `None` exactly when nalgebra's factorization fails), in plain loops over the column arrays
+/// instead of nalgebra's run-time-sized views: nalgebra's order of operations is the factor
+/// column by column, `a_ij ← (−l_jk) l_ik + a_ij` for `k < j ≤ i`, then `l_jj = √a_jj` (failing
+/// for a zero, negative or NaN `a_jj`) and `l_ij = a_ij / l_jj` (`i > j`; the strict upper
+/// triangle keeps `A`); then, per column `b` of the identity, the forward solve
+/// `b_i ← b_i / l_ii`, `b_k ← (−b_i) l_ki + b_k` (`k > i`) and the backward solve
+/// `b_i ← (b_i − (0 + Σ_{k>i} l_ki b_k)) / l_ii` (`i` descending).
+#[cfg_attr(estimator_compact, inline(never))]
+#[cfg_attr(not(estimator_compact), allow(dead_code))] // tests only, unless built for size
+pub(crate) fn cholesky_inverse<T: Real, const C: usize>(
+    a: &SMatrix<T, C, C>,
+) -> Option<SMatrix<T, C, C>> {
+    let mut l = *a;
+    let l = l.as_mut_slice();
+    for j in 0..C {
+        for k in 0..j {
+            let f = -at(l, k * C + j);
+            for i in j..C {
+                let x = at(l, k * C + i);
+                if let Some(e) = l.get_mut(j * C + i) {
+                    *e = f * x + *e;
+                }
+            }
+        }
+        let d = at(l, j * C + j);
+        if d == T::zero() {
+            return None;
+        }
+        let d = d.try_sqrt()?;
+        for i in j..C {
+            if let Some(e) = l.get_mut(j * C + i) {
+                *e = if i == j { d } else { *e / d };
+            }
+        }
+    }
+    let l: &[T] = l;
+    let mut inv = SMatrix::<T, C, C>::identity();
+    for b in inv.as_mut_slice().chunks_exact_mut(C.max(1)) {
+        for i in 0..C {
+            let coeff = at(b, i) / at(l, i * C + i);
+            if let Some(e) = b.get_mut(i) {
+                *e = coeff;
+            }
+            for k in i + 1..C {
+                let x = at(l, i * C + k);
+                if let Some(e) = b.get_mut(k) {
+                    *e = -coeff * x + *e;
+                }
+            }
+        }
+        for i in (0..C).rev() {
+            let mut dot = T::zero();
+            for k in i + 1..C {
+                dot += at(l, i * C + k) * at(b, k);
+            }
+            if let Some(e) = b.get_mut(i) {
+                *e = (*e - dot) / at(l, i * C + i);
+            }
+        }
+    }
+    Some(inv)
 }
 
-/// `out = K y` over the `m` active columns of `K` (`N × C`).
-fn gain_times<T: Real, const N: usize, const C: usize>(
-    k: &SMatrix<T, N, C>,
-    y: &SVector<T, C>,
+/// The Gauss-Newton step `next = K (r + H̃ prev)` over the `m` active rows, on the column-major
+/// storage of the `n × C` matrices `ht` (`H̃ᵀ`) and `k` (`K`), `n = prev.len()`: `y = r`,
+/// `y_c += (row c of H̃)·prev`, then `next = Σ_c y_c k_c` from zero. Generic over the row
+/// capacity only: one copy for both filters.
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn gauss_newton_step<T: Real, const C: usize>(
+    ht: &[T],
+    k: &[T],
+    r: &SVector<T, C>,
     m: usize,
-    out: &mut SVector<T, N>,
+    prev: &[T],
+    next: &mut [T],
 ) {
-    out.fill(T::zero());
-    for (kc, yc) in columns::<T, N>(k.as_slice()).zip(y.iter()).take(m) {
-        axpy(out.as_mut_slice(), *yc, kc);
+    let n = prev.len().max(1);
+    let mut y = *r;
+    for (yc, hc) in y.iter_mut().zip(ht.chunks_exact(n)).take(m) {
+        *yc += dot(hc, prev);
+    }
+    next.fill(T::zero());
+    for (kc, yc) in k.chunks_exact(n).zip(y.iter()).take(m) {
+        axpy(next, *yc, kc);
     }
 }
 
@@ -505,6 +615,19 @@ fn axpy<T: Real>(y: &mut [T], a: T, x: &[T]) {
     for (y, x) in y.iter_mut().zip(x) {
         *y += a * *x;
     }
+}
+
+/// `‖a − b‖` over two equally long slices: `√(a − b)·(a − b)`, the differences then [`dot`]'s
+/// sum. Not generic over the length: one copy for both filters.
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn distance<T: Real>(a: &[T], b: &[T]) -> T {
+    a.iter()
+        .zip(b)
+        .fold(T::zero(), |acc, (x, y)| {
+            let d = *x - *y;
+            acc + d * d
+        })
+        .sqrt()
 }
 
 /// `a · b` over two equally long slices.
@@ -535,12 +658,15 @@ where
         let (u, s, k, prev) = (w.u, w.s, w.k, w.dx);
         let ok = linearize_into(model, x, w, false).is_ok() && gain_into(p, r_noise, w).is_ok();
         // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
-        let mut y = w.r;
-        for (yc, hc) in y.iter_mut().zip(columns::<T, N>(w.ht.as_slice())).take(w.m) {
-            *yc += dot(hc, prev.as_slice());
-        }
         let mut next = SVector::<T, N>::zeros();
-        gain_times(&w.k, &y, w.m, &mut next);
+        gauss_newton_step(
+            w.ht.as_slice(),
+            w.k.as_slice(),
+            &w.r,
+            w.m,
+            prev.as_slice(),
+            next.as_mut_slice(),
+        );
         if !(ok && finite_vec(&next)) {
             w.u = u;
             w.s = s;
@@ -550,8 +676,7 @@ where
         }
         w.dx = next;
         iterations += 1;
-        let step = next - prev;
-        if dot(step.as_slice(), step.as_slice()).sqrt() < opts.step_tolerance {
+        if distance(next.as_slice(), prev.as_slice()) < opts.step_tolerance {
             break;
         }
     }
@@ -654,7 +779,7 @@ fn commit_shared<T: Real, const C: usize>(
     let diag_ok = (3..n).all(|i| {
         let d = pairs().fold(T::zero(), |acc, (vc, kc)| acc + at(vc, i) * at(kc, i));
         ok(at(p, i * n + i) + d * two)
-    }) && c00.diagonal().iter().all(|d| ok(*d));
+    }) && (0..3).all(|i| ok(at(c00.as_slice(), 4 * i)));
     if !(state_ok && diag_ok) {
         return Err(EskfError::NumericalFailure);
     }

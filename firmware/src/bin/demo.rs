@@ -231,8 +231,8 @@ fn run_benchmarks(w: &scenario::Workload<f32>) {
     bench(&mut i, "libm_sqrtf", || {
         black_box(libm::sqrtf(black_box(x)));
     });
-    bench(&mut i, "libm_atan2f", || {
-        black_box(libm::atan2f(black_box(x), black_box(0.3f32)));
+    bench(&mut i, "atan2_f32", || {
+        black_box(estimator_core::scalar::atan2_f32(black_box(x), black_box(0.3f32)));
     });
 
     let tau = Vector3::new(0.3f32, -0.2, 0.9);

@@ -233,6 +233,15 @@ impl<T: Real> LieGroup<T> for So3<T> {
         }
     }
 
+    /// Under `estimator_compact`, through the shared kernel ([`AngleCoeffs::from_theta_sq`] and
+    /// [`So3::exp_from`]): the same `θ`, `sincos(θ/2)` and `sin(θ/2)/θ`, so the same bits, without
+    /// a second inlined copy of them (the kernel's `a`, `b`, `c` are computed and unused).
+    #[cfg(estimator_compact)]
+    fn exp(w: &Vector3<T>) -> Self {
+        Self::exp_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), w)
+    }
+
+    #[cfg(not(estimator_compact))]
     fn exp(w: &Vector3<T>) -> Self {
         let theta_sq = w.norm_squared();
         let theta = theta_sq.sqrt();

@@ -297,7 +297,7 @@ fn so3_jacobians<T: Real>() {
 
 /// SO(3)'s logarithm as it was: the principal quaternion with `v` negated when `w < 0`.
 fn so3_log_before<T: Real>(q: &UnitQuaternion<T>) -> (Vector3<T>, T, T, T) {
-    use super::trig::{poly, Cutoff};
+    use super::trig::Cutoff;
     let (w, v) = if q.w < T::zero() {
         (-q.w, -q.imag())
     } else {
@@ -307,7 +307,7 @@ fn so3_log_before<T: Real>(q: &UnitQuaternion<T>) -> (Vector3<T>, T, T, T) {
     let n = n2.sqrt();
     let scale = if n2 < T::lit(Cutoff::<T>::ATAN_RATIO) * w * w {
         let r2 = n2 / (w * w);
-        T::lit(2.0) / w * poly(r2, [T::lit(1.0), T::lit(-1.0 / 3.0), T::lit(1.0 / 5.0)])
+        T::lit(2.0) / w * poly_loop(r2, [T::lit(1.0), T::lit(-1.0 / 3.0), T::lit(1.0 / 5.0)])
     } else {
         T::lit(2.0) * n.arctan2(w) / n
     };
@@ -511,4 +511,57 @@ fn so2_se2_rewrites_are_bit_identical() {
     se2_values::<f64>();
     negate_and_so3_adjoints::<f32>();
     negate_and_so3_adjoints::<f64>();
+}
+
+/// Horner's loop as `poly` had it: from `acc = 0`, `acc = acc·x + pₖ` for the last coefficient
+/// first.
+fn poly_loop<T: Real, const N: usize>(x: T, coeffs: [T; N]) -> T {
+    let mut acc = T::zero();
+    for k in coeffs.iter().rev() {
+        acc = acc * x + *k;
+    }
+    acc
+}
+
+/// `poly` written out (three to six coefficients) against the loop, for finite `x ≥ 0` (every
+/// caller's argument is a square below a cutoff), the kernel's own coefficients among them.
+fn poly_unrolled<T: Real>() {
+    use super::trig::poly;
+    let mut rng = Lcg(47);
+    let mut xs = [
+        0.0, 1e-300, 1e-40, 1e-12, 1e-6, 0.01, 0.3, 1.0, 2.5, 30.0, 1e10,
+    ]
+    .to_vec();
+    xs.extend((0..200).map(|i| (rng.next() + 1.0) * [1e-4, 0.1, 1.0, 5.0][i % 4]));
+    let c: [T; 6] = [
+        1.0 / 6.0,
+        -1.0 / 120.0,
+        1.0 / 5040.0,
+        -1.0 / 362_880.0,
+        0.3,
+        -7.0,
+    ]
+    .map(T::lit);
+    let [c0, c1, c2, c3, c4, c5] = c;
+    for x in xs.into_iter().map(T::lit) {
+        let got = [
+            poly(x, [c0, c1, c2]),
+            poly(x, [c0, c1, c2, c3]),
+            poly(x, [c0, c1, c2, c3, c4]),
+            poly(x, c),
+        ];
+        let want = [
+            poly_loop(x, [c0, c1, c2]),
+            poly_loop(x, [c0, c1, c2, c3]),
+            poly_loop(x, [c0, c1, c2, c3, c4]),
+            poly_loop(x, c),
+        ];
+        assert!(same(&got, &want));
+    }
+}
+
+#[test]
+fn poly_is_bit_identical_to_the_loop() {
+    poly_unrolled::<f32>();
+    poly_unrolled::<f64>();
 }

@@ -50,17 +50,32 @@ impl<T: Real> Cutoff<T> {
     pub(crate) const ATAN_RATIO: f64 = taylor_cutoff(T::EPSILON_F64, 1.0, 1.0 / 7.0, 3);
 }
 
-/// Evaluates `p₀ + p₁x + p₂x² + …` (Horner).
+/// Evaluates `p₀ + p₁x + p₂x² + …` (Horner), for `x` finite (every caller is below a cutoff).
+///
+/// Written out for the lengths in use (up to six coefficients), starting from the last
+/// coefficient: the same bits as the loop `acc = acc·x + pₖ` from `acc = 0` (whose first step
+/// `0·x + p_last` is exactly `p_last` for finite `x`), one multiply and add fewer. At opt-level "s"
+/// the loop stays rolled and stores its coefficients to the stack first (a `movw`/`movt`/`str`
+/// each); written out, each is one literal load, which is smaller for up to five coefficients
+/// and no larger for six.
 #[inline(always)]
 pub(crate) fn poly<T: Real, const N: usize>(x: T, coeffs: [T; N]) -> T {
     // Coefficients arrive as `T` (each `T::lit(literal)` folds at compile time): an `[f64; N]`
     // indexed in a loop that is not unrolled (opt-level "s") would convert at run time, which
     // is a soft-float `__aeabi_d2f` call on a Cortex-M4F.
-    let mut acc = T::zero();
-    for k in coeffs.iter().rev() {
-        acc = acc * x + *k;
+    match coeffs.as_slice() {
+        [p0, p1, p2] => (*p2 * x + *p1) * x + *p0,
+        [p0, p1, p2, p3] => ((*p3 * x + *p2) * x + *p1) * x + *p0,
+        [p0, p1, p2, p3, p4] => (((*p4 * x + *p3) * x + *p2) * x + *p1) * x + *p0,
+        [p0, p1, p2, p3, p4, p5] => ((((*p5 * x + *p4) * x + *p3) * x + *p2) * x + *p1) * x + *p0,
+        _ => {
+            let mut acc = T::zero();
+            for k in coeffs.iter().rev() {
+                acc = acc * x + *k;
+            }
+            acc
+        }
     }
-    acc
 }
 
 /// Coefficients of one rotation angle, shared by exp, the Jacobians and their inverses.
@@ -132,7 +147,9 @@ impl<T: Real> AngleCoeffs<T> {
     }
 
     /// `d = 1/θ² − (1 + cos θ)/(2θ sin θ)`, the coefficient of `[θ]×²` in `J_r⁻¹`; computed on
-    /// demand, since only the inverse Jacobians need it.
+    /// demand, since only the inverse Jacobians need it. Out of line under `estimator_compact`
+    /// (small enough that LLVM would otherwise inline it at each of its callers).
+    #[cfg_attr(estimator_compact, inline(never))]
     pub fn d(&self) -> T {
         let (theta_sq, theta) = (self.theta_sq, self.theta);
         if theta_sq < T::lit(Cutoff::<T>::D) {

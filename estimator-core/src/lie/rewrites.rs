@@ -565,3 +565,36 @@ fn poly_is_bit_identical_to_the_loop() {
     poly_unrolled::<f32>();
     poly_unrolled::<f64>();
 }
+
+/// `positive_finite` against `is_finite() && > 0` on every class of number.
+fn positive_finite_cases<T: Real>() {
+    let mut xs = [
+        0.0,
+        -0.0,
+        1e-310,
+        -1e-310,
+        1e-45,
+        1.0,
+        -1.0,
+        3.4e38,
+        1e300,
+        f64::MAX,
+        -f64::MAX,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+        -f64::NAN,
+    ]
+    .to_vec();
+    let mut rng = Lcg(53);
+    xs.extend((0..100).map(|_| rng.next() * 10f64.powf(40.0 * rng.next())));
+    for x in xs.into_iter().map(T::lit) {
+        assert_eq!(positive_finite(x), x.is_finite() && x > T::zero(), "{x:?}");
+    }
+}
+
+#[test]
+fn positive_finite_is_is_finite_and_positive() {
+    positive_finite_cases::<f32>();
+    positive_finite_cases::<f64>();
+}

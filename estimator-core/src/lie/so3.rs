@@ -18,8 +18,8 @@
 
 use super::trig::{half_sinc, poly, AngleCoeffs, Cutoff};
 use super::{
-    all_finite, mul_skew, negate, orthogonality_error, skew, skew_poly, LieGroup, Real,
-    ORTHOGONALITY_TOLERANCE,
+    all_finite, mul_skew, negate, orthogonality_error, positive_finite, skew, skew_poly, LieGroup,
+    Real, ORTHOGONALITY_TOLERANCE,
 };
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
@@ -35,7 +35,7 @@ impl<T: Real> So3<T> {
     #[must_use]
     pub fn from_quaternion(q: &Quaternion<T>) -> Option<Self> {
         let n2 = q.coords.norm_squared();
-        if !(n2.is_finite() && n2 > T::zero()) {
+        if !positive_finite(n2) {
             return None;
         }
         Some(Self::scaled(q, T::one() / n2.sqrt()))

@@ -21,7 +21,7 @@ use super::{
     all_finite, mul_skew, negate, orthogonality_error, positive_finite, skew, skew_poly, LieGroup,
     Real, ORTHOGONALITY_TOLERANCE,
 };
-use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3, Vector4};
 
 /// A 3-D rotation `R ∈ SO(3)`, stored as a unit Hamilton quaternion.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -105,14 +105,15 @@ impl<T: Real> So3<T> {
             m.m13 + m.m31,
             m.m23 + m.m32,
         ];
+        // `from` lists the components in nalgebra's storage order `[x, y, z, w]`.
         let (radicand, from): (T, [u8; 4]) = if trace > T::zero() {
-            (trace + one, [SELF, 0, 1, 2])
+            (trace + one, [0, 1, 2, SELF])
         } else if m.m11 > m.m22 && m.m11 > m.m33 {
-            (one + m.m11 - m.m22 - m.m33, [0, SELF, 3, 4])
+            (one + m.m11 - m.m22 - m.m33, [SELF, 3, 4, 0])
         } else if m.m22 > m.m33 {
-            (one + m.m22 - m.m11 - m.m33, [1, 3, SELF, 5])
+            (one + m.m22 - m.m11 - m.m33, [3, SELF, 5, 1])
         } else {
-            (one + m.m33 - m.m11 - m.m22, [2, 4, 5, SELF])
+            (one + m.m33 - m.m11 - m.m22, [4, 5, SELF, 2])
         };
         let s = radicand.sqrt() * T::lit(2.0);
         let mut q = [T::zero(); 4];
@@ -122,8 +123,7 @@ impl<T: Real> So3<T> {
                 None => T::lit(0.25) * s,
             };
         }
-        let [w, x, y, z] = q;
-        Self::from_wxyz(w, x, y, z)
+        Self::from_quaternion(&Quaternion::from(Vector4::from(q)))
     }
 
     /// `log` plus the half-angle sine and cosine it found, to build the kernel without trigonometry.

@@ -341,6 +341,14 @@ pub(crate) fn negate<T: Real, const R: usize, const C: usize>(m: &mut SMatrix<T,
     }
 }
 
+/// The `N × N` identity. Out of line under `estimator_compact`: one copy per size instead of a
+/// store per entry at each Jacobian that is `I` (the same matrix either way).
+#[cfg_attr(estimator_compact, inline(never))]
+#[must_use]
+pub(crate) fn eye<T: Real, const N: usize>() -> SMatrix<T, N, N> {
+    SMatrix::identity()
+}
+
 /// `‖MᵀM − I‖²_F`, the orthogonality error of [`LieGroup::try_from_matrix`]: entry `(i, j)` of
 /// `MᵀM` is the dot product of columns `i` and `j`. The same operations in the same order as
 /// `(m.transpose() * m - I).norm_squared()`, without the two `N × N` temporaries.

@@ -598,3 +598,44 @@ fn positive_finite_is_is_finite_and_positive() {
     positive_finite_cases::<f32>();
     positive_finite_cases::<f64>();
 }
+
+/// `eye` is nalgebra's identity, and the Jacobians that are `I` come from it.
+fn eye_cases<T: Real>() {
+    let (a3, b3) = (
+        So3::<T>::exp(&Vector3::new(T::lit(0.3), T::lit(-0.2), T::lit(1.1))),
+        So3::identity(),
+    );
+    assert!(same(
+        eye::<T, 3>().as_slice(),
+        Matrix3::<T>::identity().as_slice()
+    ));
+    assert!(same(
+        eye::<T, 6>().as_slice(),
+        SMatrix::<T, 6, 6>::identity().as_slice()
+    ));
+    assert!(same(
+        a3.compose_jac(&b3).2.as_slice(),
+        Matrix3::<T>::identity().as_slice()
+    ));
+    assert!(same(
+        a3.between_jac(&b3).2.as_slice(),
+        Matrix3::<T>::identity().as_slice()
+    ));
+    let a2 = Se2::<T>::new(T::lit(0.5), T::lit(-2.0), T::lit(2.0));
+    assert!(same(
+        a2.between_jac(&Se2::identity()).2.as_slice(),
+        Matrix3::<T>::identity().as_slice()
+    ));
+    let a6 = Se3::<T>::from_parts(a3, Vector3::new(T::lit(1.0), T::lit(2.0), T::lit(-3.0)));
+    let j = a6.between_jac(&Se3::identity()).2;
+    assert!(same(
+        j.as_slice(),
+        SMatrix::<T, 6, 6>::identity().as_slice()
+    ));
+}
+
+#[test]
+fn identity_jacobians_are_the_identity() {
+    eye_cases::<f32>();
+    eye_cases::<f64>();
+}

@@ -20,7 +20,7 @@
 
 use super::so3::So3;
 use super::trig::AngleCoeffs;
-use super::{all_finite, mul_skew, skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, eye, mul_skew, skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{ArrayStorage, Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
 
 /// A rigid motion `T = (R, t) ∈ SE(3)`; `a_from_b` maps `b` coordinates into `a`.
@@ -365,7 +365,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     /// `(z = a⁻¹·b, −Ad_{z⁻¹}, I)`.
     fn between_jac(&self, b: &Self) -> (Self, Matrix6<T>, Matrix6<T>) {
         let z = self.between(b);
-        (z, z.inverse().neg_adjoint(), Matrix6::identity())
+        (z, z.inverse().neg_adjoint(), eye())
     }
 
     /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))` with one trigonometric kernel for the log and both

@@ -18,8 +18,8 @@
 
 use super::trig::{half_sinc, poly, AngleCoeffs, Cutoff};
 use super::{
-    all_finite, mul_skew, negate, orthogonality_error, positive_finite, skew, skew_poly, LieGroup,
-    Real, ORTHOGONALITY_TOLERANCE,
+    all_finite, eye, mul_skew, negate, orthogonality_error, positive_finite, skew, skew_poly,
+    LieGroup, Real, ORTHOGONALITY_TOLERANCE,
 };
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3, Vector4};
 
@@ -355,11 +355,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn compose_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
-        (
-            self.compose(b),
-            b.rotation_matrix().transpose(),
-            Matrix3::identity(),
-        )
+        (self.compose(b), b.rotation_matrix().transpose(), eye())
     }
 
     /// `(a⁻¹, −R)`, negated in place ([`negate`]).
@@ -374,7 +370,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
         let z = self.between(b);
         let mut j = z.inverse().adjoint();
         negate(&mut j);
-        (z, j, Matrix3::identity())
+        (z, j, eye())
     }
 
     fn rminus_jac(&self, b: &Self) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {

@@ -175,8 +175,10 @@ impl<T: Real> So3<T> {
         }
     }
 
-    /// `log` and its kernel (for SE(3)'s log, which needs `J_l⁻¹` of the same angle).
-    #[inline]
+    /// `log` and its kernel (for SE(3)'s log, which needs `J_l⁻¹` of the same angle). Out of
+    /// line under `estimator_compact` (one copy for `log_jac`, `rminus_jac` and SE(3)'s log).
+    #[cfg_attr(not(estimator_compact), inline)]
+    #[cfg_attr(estimator_compact, inline(never))]
     pub(crate) fn log_with_coeffs(&self) -> (Vector3<T>, AngleCoeffs<T>) {
         let (omega, theta, sin_half, cos_half) = self.log_parts();
         let k = AngleCoeffs::from_half_angle(theta * theta, theta, sin_half, cos_half);

@@ -639,3 +639,30 @@ fn identity_jacobians_are_the_identity() {
     eye_cases::<f32>();
     eye_cases::<f64>();
 }
+
+/// `AngleCoeffs::of_vector(ω)` is `from_theta_sq(‖ω‖²)`, every field.
+fn of_vector_cases<T: Real>() {
+    let fields = |k: &AngleCoeffs<T>| {
+        [
+            k.theta_sq,
+            k.theta,
+            k.sin_half,
+            k.cos_half,
+            k.half_sinc,
+            k.a,
+            k.b,
+            k.c,
+        ]
+    };
+    for_each_vector::<T>(59, |w| {
+        let got = AngleCoeffs::of_vector(w);
+        let want = AngleCoeffs::from_theta_sq(w.norm_squared());
+        assert!(same(&fields(&got), &fields(&want)));
+    });
+}
+
+#[test]
+fn of_vector_is_from_theta_sq_of_the_norm() {
+    of_vector_cases::<f32>();
+    of_vector_cases::<f64>();
+}

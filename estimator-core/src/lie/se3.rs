@@ -192,14 +192,14 @@ impl<T: Real> Se3<T> {
     #[inline(always)]
     fn jr_at(xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
         let (v, w) = split(xi);
-        Self::jr_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), &v, &w, sigma)
+        Self::jr_from(&AngleCoeffs::of_vector(&w), &v, &w, sigma)
     }
 
     /// `J_r⁻¹(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left inverse Jacobians.
     #[inline(always)]
     fn jr_inv_at(xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
         let (v, w) = split(xi);
-        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        let k = AngleCoeffs::of_vector(&w);
         Self::jr_inv_from(&k, &v, &w, sigma, T::one())
     }
 
@@ -249,6 +249,8 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     fn exp(xi: &Vector6<T>) -> Self {
         let (v, w) = split(xi);
+        // Not `of_vector`: where SE(3)'s exponential is the only user of the kernel (the PnP
+        // firmware) the squared norm inlines with it, and a call to a shared copy costs 80 bytes.
         Self::exp_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), &v, &w)
     }
 
@@ -344,7 +346,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     fn exp_jac(xi: &Vector6<T>) -> (Self, Matrix6<T>) {
         let (v, w) = split(xi);
-        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        let k = AngleCoeffs::of_vector(&w);
         (
             Self::exp_from(&k, &v, &w),
             Self::jr_from(&k, &v, &w, T::one()),

@@ -240,7 +240,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
     /// a second inlined copy of them (the kernel's `a`, `b`, `c` are computed and unused).
     #[cfg(estimator_compact)]
     fn exp(w: &Vector3<T>) -> Self {
-        Self::exp_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), w)
+        Self::exp_from(&AngleCoeffs::of_vector(w), w)
     }
 
     #[cfg(not(estimator_compact))]
@@ -298,22 +298,22 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn right_jacobian(w: &Vector3<T>) -> Matrix3<T> {
-        Self::jr_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), w)
+        Self::jr_from(&AngleCoeffs::of_vector(w), w)
     }
 
     fn right_jacobian_inv(w: &Vector3<T>) -> Matrix3<T> {
-        Self::jr_inv_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), w)
+        Self::jr_inv_from(&AngleCoeffs::of_vector(w), w)
     }
 
     /// `J_r(ω)ᵀ = I + b[ω]× + c[ω]×²`.
     fn left_jacobian(w: &Vector3<T>) -> Matrix3<T> {
-        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        let k = AngleCoeffs::of_vector(w);
         skew_poly(T::one(), k.b, k.c, w)
     }
 
     /// `J_r⁻¹(ω)ᵀ = I − ½[ω]× + d[ω]×²`.
     fn left_jacobian_inv(w: &Vector3<T>) -> Matrix3<T> {
-        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        let k = AngleCoeffs::of_vector(w);
         skew_poly(T::one(), T::lit(-0.5), k.d(), w)
     }
 
@@ -347,7 +347,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn exp_jac(w: &Vector3<T>) -> (Self, Matrix3<T>) {
-        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        let k = AngleCoeffs::of_vector(w);
         (Self::exp_from(&k, w), Self::jr_from(&k, w))
     }
 

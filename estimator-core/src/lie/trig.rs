@@ -32,6 +32,7 @@
 
 use crate::scalar::{taylor_cutoff, Real};
 use core::marker::PhantomData;
+use nalgebra::Vector3;
 
 /// Small-angle cutoffs (in `θ²`), one per series, derived from `T::EPSILON`.
 pub(crate) struct Cutoff<T>(PhantomData<T>);
@@ -106,6 +107,21 @@ impl<T: Real> AngleCoeffs<T> {
         let theta = theta_sq.sqrt();
         let (sin_half, cos_half) = (theta * T::lit(0.5)).sincos();
         Self::from_half_angle(theta_sq, theta, sin_half, cos_half)
+    }
+
+    /// From a rotation vector `ω`: [`Self::from_theta_sq`] of `‖ω‖²`.
+    #[inline(always)]
+    pub fn of_vector(w: &Vector3<T>) -> Self {
+        Self::of_components(w.x, w.y, w.z)
+    }
+
+    /// [`Self::of_vector`] with the components passed by value (in registers, so a caller's `ω`
+    /// need not be stored to memory for the call). Out of line under `estimator_compact`: one copy
+    /// of the squared norm for every SO(3) and SE(3) kernel.
+    #[cfg_attr(not(estimator_compact), inline)]
+    #[cfg_attr(estimator_compact, inline(never))]
+    fn of_components(x: T, y: T, z: T) -> Self {
+        Self::from_theta_sq(Vector3::new(x, y, z).norm_squared())
     }
 
     /// From `θ` and the sine and cosine of `θ/2`, already known (for example the vector norm and

@@ -542,7 +542,7 @@ fn poly_unrolled<T: Real>() {
         -7.0,
     ]
     .map(T::lit);
-    let [c0, c1, c2, c3, c4, c5] = c;
+    let [c0, c1, c2, c3, c4, _] = c;
     for x in xs.into_iter().map(T::lit) {
         let got = [
             poly(x, [c0, c1, c2]),
@@ -665,4 +665,27 @@ fn of_vector_cases<T: Real>() {
 fn of_vector_is_from_theta_sq_of_the_norm() {
     of_vector_cases::<f32>();
     of_vector_cases::<f64>();
+}
+
+/// SE(3)'s `hat` entry by entry against `[ω]×` and `v` copied into a zero matrix.
+fn se3_hat_cases<T: Real>() {
+    for_each_vector::<T>(61, |v| {
+        let w = Vector3::new(v.z, -v.x * T::lit(0.5), v.y);
+        let xi = SVector::<T, 6>::new(v.x, v.y, v.z, w.x, w.y, w.z);
+        let mut want = SMatrix::<T, 4, 4>::zeros();
+        want.fixed_view_mut::<3, 3>(0, 0).copy_from(&skew(&w));
+        want.fixed_view_mut::<3, 1>(0, 3).copy_from(v);
+        let got = Se3::hat(&xi);
+        assert!(got
+            .iter()
+            .zip(want.iter())
+            .all(|(a, b)| a.to_f64().to_bits() == b.to_f64().to_bits()));
+        assert!(same(Se3::vee(&got).as_slice(), xi.as_slice()));
+    });
+}
+
+#[test]
+fn se3_hat_is_bit_identical() {
+    se3_hat_cases::<f32>();
+    se3_hat_cases::<f64>();
 }

@@ -20,7 +20,7 @@
 
 use super::so3::So3;
 use super::trig::AngleCoeffs;
-use super::{all_finite, eye, mul_skew, skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, eye, mul_skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{ArrayStorage, Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
 
 /// A rigid motion `T = (R, t) ∈ SE(3)`; `a_from_b` maps `b` coordinates into `a`.
@@ -258,12 +258,16 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         self.log_with_coeffs().0
     }
 
+    /// `[[ω]×, v], [0, 0]]` entry by entry (no `[ω]×` temporary copied into a zeroed matrix).
     fn hat(xi: &Vector6<T>) -> Matrix4<T> {
         let (v, w) = split(xi);
-        let mut m = Matrix4::zeros();
-        m.fixed_view_mut::<3, 3>(0, 0).copy_from(&skew(&w));
-        m.fixed_view_mut::<3, 1>(0, 3).copy_from(&v);
-        m
+        let z = T::zero();
+        Matrix4::new(
+            z, -w.z, w.y, v.x, //
+            w.z, z, -w.x, v.y, //
+            -w.y, w.x, z, v.z, //
+            z, z, z, z,
+        )
     }
 
     fn vee(m: &Matrix4<T>) -> Vector6<T> {

@@ -16,7 +16,7 @@
 //! with `a, b, c, d` the coefficients of the crate's trigonometric kernel (`sin θ/θ`,
 //! `(1 − cos θ)/θ²`, `(θ − sin θ)/θ³`, `1/θ² − (1 + cos θ)/(2θ sin θ)`).
 
-use super::trig::{half_sinc, poly, AngleCoeffs, Cutoff};
+use super::trig::{poly, AngleCoeffs, Cutoff};
 use super::{
     all_finite, eye, mul_skew, negate, orthogonality_error, positive_finite, skew, skew_poly,
     LieGroup, Real, ORTHOGONALITY_TOLERANCE,
@@ -248,7 +248,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
         let theta_sq = w.norm_squared();
         let theta = theta_sq.sqrt();
         let (s, c) = (theta * T::lit(0.5)).sincos();
-        let v = w * half_sinc(theta_sq, theta, s);
+        let v = w * super::trig::half_sinc(theta_sq, theta, s);
         Self {
             q: UnitQuaternion::new_unchecked(Quaternion::new(c, v.x, v.y, v.z)),
         }

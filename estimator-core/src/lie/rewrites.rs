@@ -667,7 +667,7 @@ fn of_vector_is_from_theta_sq_of_the_norm() {
     of_vector_cases::<f64>();
 }
 
-/// SE(3)'s `hat` entry by entry against `[ω]×` and `v` copied into a zero matrix.
+/// SE(3)'s `hat` and `matrix` entry by entry against the block copies they replace.
 fn se3_hat_cases<T: Real>() {
     for_each_vector::<T>(61, |v| {
         let w = Vector3::new(v.z, -v.x * T::lit(0.5), v.y);
@@ -681,6 +681,18 @@ fn se3_hat_cases<T: Real>() {
             .zip(want.iter())
             .all(|(a, b)| a.to_f64().to_bits() == b.to_f64().to_bits()));
         assert!(same(Se3::vee(&got).as_slice(), xi.as_slice()));
+        // `matrix` entry by entry against the identity overwritten block by block.
+        let a = Se3::exp(&xi);
+        let mut want = SMatrix::<T, 4, 4>::identity();
+        want.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&a.rotation().rotation_matrix());
+        want.fixed_view_mut::<3, 1>(0, 3)
+            .copy_from(&a.translation());
+        assert!(a
+            .matrix()
+            .iter()
+            .zip(want.iter())
+            .all(|(x, y)| x.to_f64().to_bits() == y.to_f64().to_bits()));
     });
 }
 

@@ -316,12 +316,17 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         Self::jr_inv_at(xi, -T::one())
     }
 
+    /// `[[R, t], [0, 1]]` entry by entry (no identity matrix overwritten block by block).
     fn matrix(&self) -> Matrix4<T> {
-        let mut m = Matrix4::identity();
-        m.fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&self.rotation.rotation_matrix());
-        m.fixed_view_mut::<3, 1>(0, 3).copy_from(&self.translation);
-        m
+        let r = self.rotation.rotation_matrix();
+        let t = &self.translation;
+        let (z, o) = (T::zero(), T::one());
+        Matrix4::new(
+            r.m11, r.m12, r.m13, t.x, //
+            r.m21, r.m22, r.m23, t.y, //
+            r.m31, r.m32, r.m33, t.z, //
+            z, z, z, o,
+        )
     }
 
     fn normalize(&self) -> Self {

@@ -701,3 +701,44 @@ fn se3_hat_is_bit_identical() {
     se3_hat_cases::<f32>();
     se3_hat_cases::<f64>();
 }
+
+/// `R(q*)` is `R(q)ᵀ` to the bit, signed zeros included (So3's `compose_jac`), for random,
+/// axis-aligned and sign-flipped quaternions.
+fn so3_conjugate_matrix<T: Real>() {
+    let bits_eq = |a: &Matrix3<T>, b: &Matrix3<T>| {
+        a.iter()
+            .zip(b.iter())
+            .all(|(x, y)| x.to_f64().to_bits() == y.to_f64().to_bits())
+    };
+    let (o, z, h) = (
+        T::one(),
+        T::zero(),
+        T::lit(core::f64::consts::FRAC_1_SQRT_2),
+    );
+    let mut qs = [
+        [o, z, z, z],
+        [z, o, z, z],
+        [z, z, o, z],
+        [z, z, z, o],
+        [h, h, z, z],
+        [h, z, -h, z],
+        [z, h, z, h],
+    ]
+    .map(|c| UnitQuaternion::new_unchecked(Quaternion::new(c[0], c[1], c[2], c[3])))
+    .to_vec();
+    for_each_quaternion::<T>(|q| qs.push(*q));
+    let a = So3::exp(&Vector3::new(T::lit(0.1), T::lit(0.2), T::lit(-0.3)));
+    for q in qs {
+        for q in [q, UnitQuaternion::new_unchecked(-q.into_inner())] {
+            let b = So3::from_unit_quaternion(q);
+            let want = b.rotation_matrix().transpose();
+            assert!(bits_eq(&a.compose_jac(&b).1, &want));
+        }
+    }
+}
+
+#[test]
+fn so3_conjugate_matrix_is_the_transpose() {
+    so3_conjugate_matrix::<f32>();
+    so3_conjugate_matrix::<f64>();
+}

@@ -357,7 +357,9 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn compose_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
-        (self.compose(b), b.rotation_matrix().transpose(), eye())
+        // R_bᵀ as the rotation matrix of the conjugate: nalgebra's formula gives R(q*) = R(q)ᵀ bit
+        // for bit (each off-diagonal pair is x − (−y) against y + x), without a transposing copy.
+        (self.compose(b), b.inverse().rotation_matrix(), eye())
     }
 
     /// `(a⁻¹, −R)`, negated in place ([`negate`]).

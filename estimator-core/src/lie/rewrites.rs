@@ -297,7 +297,7 @@ fn so3_jacobians<T: Real>() {
 
 /// SO(3)'s logarithm as it was: the principal quaternion with `v` negated when `w < 0`.
 fn so3_log_before<T: Real>(q: &UnitQuaternion<T>) -> (Vector3<T>, T, T, T) {
-    use super::trig::{poly, Cutoff};
+    use super::trig::Cutoff;
     let (w, v) = if q.w < T::zero() {
         (-q.w, -q.imag())
     } else {
@@ -307,7 +307,7 @@ fn so3_log_before<T: Real>(q: &UnitQuaternion<T>) -> (Vector3<T>, T, T, T) {
     let n = n2.sqrt();
     let scale = if n2 < T::lit(Cutoff::<T>::ATAN_RATIO) * w * w {
         let r2 = n2 / (w * w);
-        T::lit(2.0) / w * poly(r2, [T::lit(1.0), T::lit(-1.0 / 3.0), T::lit(1.0 / 5.0)])
+        T::lit(2.0) / w * poly_loop(r2, [T::lit(1.0), T::lit(-1.0 / 3.0), T::lit(1.0 / 5.0)])
     } else {
         T::lit(2.0) * n.arctan2(w) / n
     };
@@ -335,8 +335,27 @@ fn so3_log_and_normalize<T: Real>() {
     for_each_vector::<T>(41, |w| check(&So3::exp(w).quaternion()));
 }
 
+/// SO(3)'s exponential written out (the opt-level-3 form), against `exp` as built (through the
+/// kernel under `estimator_compact`) and `exp_jac`'s value.
+fn so3_exp<T: Real>() {
+    use super::trig::half_sinc;
+    for_each_vector::<T>(43, |w| {
+        let theta_sq = w.norm_squared();
+        let theta = theta_sq.sqrt();
+        let (s, c) = (theta * T::lit(0.5)).sincos();
+        let v = w * half_sinc(theta_sq, theta, s);
+        let want = [c, v.x, v.y, v.z];
+        for got in [So3::exp(w), So3::exp_jac(w).0] {
+            let q = got.quaternion();
+            assert!(same(&[q.w, q.i, q.j, q.k], &want));
+        }
+    });
+}
+
 #[test]
 fn so3_rewrites_are_bit_identical() {
+    so3_exp::<f32>();
+    so3_exp::<f64>();
     so3_log_and_normalize::<f32>();
     so3_log_and_normalize::<f64>();
     so3_jacobians::<f32>();
@@ -492,4 +511,234 @@ fn so2_se2_rewrites_are_bit_identical() {
     se2_values::<f64>();
     negate_and_so3_adjoints::<f32>();
     negate_and_so3_adjoints::<f64>();
+}
+
+/// Horner's loop as `poly` had it: from `acc = 0`, `acc = acc·x + pₖ` for the last coefficient
+/// first.
+fn poly_loop<T: Real, const N: usize>(x: T, coeffs: [T; N]) -> T {
+    let mut acc = T::zero();
+    for k in coeffs.iter().rev() {
+        acc = acc * x + *k;
+    }
+    acc
+}
+
+/// `poly` written out (three to six coefficients) against the loop, for finite `x ≥ 0` (every
+/// caller's argument is a square below a cutoff), the kernel's own coefficients among them.
+fn poly_unrolled<T: Real>() {
+    use super::trig::poly;
+    let mut rng = Lcg(47);
+    let mut xs = [
+        0.0, 1e-300, 1e-40, 1e-12, 1e-6, 0.01, 0.3, 1.0, 2.5, 30.0, 1e10,
+    ]
+    .to_vec();
+    xs.extend((0..200).map(|i| (rng.next() + 1.0) * [1e-4, 0.1, 1.0, 5.0][i % 4]));
+    let c: [T; 6] = [
+        1.0 / 6.0,
+        -1.0 / 120.0,
+        1.0 / 5040.0,
+        -1.0 / 362_880.0,
+        0.3,
+        -7.0,
+    ]
+    .map(T::lit);
+    let [c0, c1, c2, c3, c4, _] = c;
+    for x in xs.into_iter().map(T::lit) {
+        let got = [
+            poly(x, [c0, c1, c2]),
+            poly(x, [c0, c1, c2, c3]),
+            poly(x, [c0, c1, c2, c3, c4]),
+            poly(x, c),
+        ];
+        let want = [
+            poly_loop(x, [c0, c1, c2]),
+            poly_loop(x, [c0, c1, c2, c3]),
+            poly_loop(x, [c0, c1, c2, c3, c4]),
+            poly_loop(x, c),
+        ];
+        assert!(same(&got, &want));
+    }
+}
+
+#[test]
+fn poly_is_bit_identical_to_the_loop() {
+    poly_unrolled::<f32>();
+    poly_unrolled::<f64>();
+}
+
+/// `positive_finite` against `is_finite() && > 0` on every class of number.
+fn positive_finite_cases<T: Real>() {
+    let mut xs = [
+        0.0,
+        -0.0,
+        1e-310,
+        -1e-310,
+        1e-45,
+        1.0,
+        -1.0,
+        3.4e38,
+        1e300,
+        f64::MAX,
+        -f64::MAX,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+        -f64::NAN,
+    ]
+    .to_vec();
+    let mut rng = Lcg(53);
+    xs.extend((0..100).map(|_| rng.next() * 10f64.powf(40.0 * rng.next())));
+    for x in xs.into_iter().map(T::lit) {
+        assert_eq!(positive_finite(x), x.is_finite() && x > T::zero(), "{x:?}");
+    }
+}
+
+#[test]
+fn positive_finite_is_is_finite_and_positive() {
+    positive_finite_cases::<f32>();
+    positive_finite_cases::<f64>();
+}
+
+/// `eye` is nalgebra's identity, and the Jacobians that are `I` come from it.
+fn eye_cases<T: Real>() {
+    let (a3, b3) = (
+        So3::<T>::exp(&Vector3::new(T::lit(0.3), T::lit(-0.2), T::lit(1.1))),
+        So3::identity(),
+    );
+    assert!(same(
+        eye::<T, 3>().as_slice(),
+        Matrix3::<T>::identity().as_slice()
+    ));
+    assert!(same(
+        eye::<T, 6>().as_slice(),
+        SMatrix::<T, 6, 6>::identity().as_slice()
+    ));
+    assert!(same(
+        a3.compose_jac(&b3).2.as_slice(),
+        Matrix3::<T>::identity().as_slice()
+    ));
+    assert!(same(
+        a3.between_jac(&b3).2.as_slice(),
+        Matrix3::<T>::identity().as_slice()
+    ));
+    let a2 = Se2::<T>::new(T::lit(0.5), T::lit(-2.0), T::lit(2.0));
+    assert!(same(
+        a2.between_jac(&Se2::identity()).2.as_slice(),
+        Matrix3::<T>::identity().as_slice()
+    ));
+    let a6 = Se3::<T>::from_parts(a3, Vector3::new(T::lit(1.0), T::lit(2.0), T::lit(-3.0)));
+    let j = a6.between_jac(&Se3::identity()).2;
+    assert!(same(
+        j.as_slice(),
+        SMatrix::<T, 6, 6>::identity().as_slice()
+    ));
+}
+
+#[test]
+fn identity_jacobians_are_the_identity() {
+    eye_cases::<f32>();
+    eye_cases::<f64>();
+}
+
+/// `AngleCoeffs::of_vector(ω)` is `from_theta_sq(‖ω‖²)`, every field.
+fn of_vector_cases<T: Real>() {
+    let fields = |k: &AngleCoeffs<T>| {
+        [
+            k.theta_sq,
+            k.theta,
+            k.sin_half,
+            k.cos_half,
+            k.half_sinc,
+            k.a,
+            k.b,
+            k.c,
+        ]
+    };
+    for_each_vector::<T>(59, |w| {
+        let got = AngleCoeffs::of_vector(w);
+        let want = AngleCoeffs::from_theta_sq(w.norm_squared());
+        assert!(same(&fields(&got), &fields(&want)));
+    });
+}
+
+#[test]
+fn of_vector_is_from_theta_sq_of_the_norm() {
+    of_vector_cases::<f32>();
+    of_vector_cases::<f64>();
+}
+
+/// SE(3)'s `hat` and `matrix` entry by entry against the block copies they replace.
+fn se3_hat_cases<T: Real>() {
+    for_each_vector::<T>(61, |v| {
+        let w = Vector3::new(v.z, -v.x * T::lit(0.5), v.y);
+        let xi = SVector::<T, 6>::new(v.x, v.y, v.z, w.x, w.y, w.z);
+        let mut want = SMatrix::<T, 4, 4>::zeros();
+        want.fixed_view_mut::<3, 3>(0, 0).copy_from(&skew(&w));
+        want.fixed_view_mut::<3, 1>(0, 3).copy_from(v);
+        let got = Se3::hat(&xi);
+        assert!(got
+            .iter()
+            .zip(want.iter())
+            .all(|(a, b)| a.to_f64().to_bits() == b.to_f64().to_bits()));
+        assert!(same(Se3::vee(&got).as_slice(), xi.as_slice()));
+        // `matrix` entry by entry against the identity overwritten block by block.
+        let a = Se3::exp(&xi);
+        let mut want = SMatrix::<T, 4, 4>::identity();
+        want.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&a.rotation().rotation_matrix());
+        want.fixed_view_mut::<3, 1>(0, 3)
+            .copy_from(&a.translation());
+        assert!(a
+            .matrix()
+            .iter()
+            .zip(want.iter())
+            .all(|(x, y)| x.to_f64().to_bits() == y.to_f64().to_bits()));
+    });
+}
+
+#[test]
+fn se3_hat_is_bit_identical() {
+    se3_hat_cases::<f32>();
+    se3_hat_cases::<f64>();
+}
+
+/// `R(q*)` is `R(q)ᵀ` to the bit, signed zeros included (So3's `compose_jac`), for random,
+/// axis-aligned and sign-flipped quaternions.
+fn so3_conjugate_matrix<T: Real>() {
+    let bits_eq = |a: &Matrix3<T>, b: &Matrix3<T>| {
+        a.iter()
+            .zip(b.iter())
+            .all(|(x, y)| x.to_f64().to_bits() == y.to_f64().to_bits())
+    };
+    let (o, z, h) = (
+        T::one(),
+        T::zero(),
+        T::lit(core::f64::consts::FRAC_1_SQRT_2),
+    );
+    let mut qs = [
+        [o, z, z, z],
+        [z, o, z, z],
+        [z, z, o, z],
+        [z, z, z, o],
+        [h, h, z, z],
+        [h, z, -h, z],
+        [z, h, z, h],
+    ]
+    .map(|c| UnitQuaternion::new_unchecked(Quaternion::new(c[0], c[1], c[2], c[3])))
+    .to_vec();
+    for_each_quaternion::<T>(|q| qs.push(*q));
+    let a = So3::exp(&Vector3::new(T::lit(0.1), T::lit(0.2), T::lit(-0.3)));
+    for q in qs {
+        for q in [q, UnitQuaternion::new_unchecked(-q.into_inner())] {
+            let b = So3::from_unit_quaternion(q);
+            let want = b.rotation_matrix().transpose();
+            assert!(bits_eq(&a.compose_jac(&b).1, &want));
+        }
+    }
+}
+
+#[test]
+fn so3_conjugate_matrix_is_the_transpose() {
+    so3_conjugate_matrix::<f32>();
+    so3_conjugate_matrix::<f64>();
 }

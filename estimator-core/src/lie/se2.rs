@@ -17,7 +17,7 @@
 
 use super::so2::So2;
 use super::trig::{half_cot, poly, AngleCoeffs, Cutoff};
-use super::{all_finite, negate, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, eye, negate, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
 
 /// A planar rigid motion `T = (R, t) ∈ SE(2)`.
@@ -266,7 +266,7 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         let z = self.between(b);
         let mut j = z.inverse().adjoint();
         negate(&mut j);
-        (z, j, Matrix3::identity())
+        (z, j, eye())
     }
 
     /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))`, the last negated in place ([`negate`]).

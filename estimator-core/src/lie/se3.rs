@@ -20,7 +20,7 @@
 
 use super::so3::So3;
 use super::trig::AngleCoeffs;
-use super::{all_finite, mul_skew, skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, eye, mul_skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{ArrayStorage, Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
 
 /// A rigid motion `T = (R, t) ∈ SE(3)`; `a_from_b` maps `b` coordinates into `a`.
@@ -192,14 +192,14 @@ impl<T: Real> Se3<T> {
     #[inline(always)]
     fn jr_at(xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
         let (v, w) = split(xi);
-        Self::jr_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), &v, &w, sigma)
+        Self::jr_from(&AngleCoeffs::of_vector(&w), &v, &w, sigma)
     }
 
     /// `J_r⁻¹(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left inverse Jacobians.
     #[inline(always)]
     fn jr_inv_at(xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
         let (v, w) = split(xi);
-        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        let k = AngleCoeffs::of_vector(&w);
         Self::jr_inv_from(&k, &v, &w, sigma, T::one())
     }
 
@@ -249,6 +249,8 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     fn exp(xi: &Vector6<T>) -> Self {
         let (v, w) = split(xi);
+        // Not `of_vector`: where SE(3)'s exponential is the only user of the kernel (the PnP
+        // firmware) the squared norm inlines with it, and a call to a shared copy costs 80 bytes.
         Self::exp_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), &v, &w)
     }
 
@@ -256,12 +258,16 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         self.log_with_coeffs().0
     }
 
+    /// `[[ω]×, v], [0, 0]]` entry by entry (no `[ω]×` temporary copied into a zeroed matrix).
     fn hat(xi: &Vector6<T>) -> Matrix4<T> {
         let (v, w) = split(xi);
-        let mut m = Matrix4::zeros();
-        m.fixed_view_mut::<3, 3>(0, 0).copy_from(&skew(&w));
-        m.fixed_view_mut::<3, 1>(0, 3).copy_from(&v);
-        m
+        let z = T::zero();
+        Matrix4::new(
+            z, -w.z, w.y, v.x, //
+            w.z, z, -w.x, v.y, //
+            -w.y, w.x, z, v.z, //
+            z, z, z, z,
+        )
     }
 
     fn vee(m: &Matrix4<T>) -> Vector6<T> {
@@ -310,12 +316,17 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         Self::jr_inv_at(xi, -T::one())
     }
 
+    /// `[[R, t], [0, 1]]` entry by entry (no identity matrix overwritten block by block).
     fn matrix(&self) -> Matrix4<T> {
-        let mut m = Matrix4::identity();
-        m.fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&self.rotation.rotation_matrix());
-        m.fixed_view_mut::<3, 1>(0, 3).copy_from(&self.translation);
-        m
+        let r = self.rotation.rotation_matrix();
+        let t = &self.translation;
+        let (z, o) = (T::zero(), T::one());
+        Matrix4::new(
+            r.m11, r.m12, r.m13, t.x, //
+            r.m21, r.m22, r.m23, t.y, //
+            r.m31, r.m32, r.m33, t.z, //
+            z, z, z, o,
+        )
     }
 
     fn normalize(&self) -> Self {
@@ -344,7 +355,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     fn exp_jac(xi: &Vector6<T>) -> (Self, Matrix6<T>) {
         let (v, w) = split(xi);
-        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        let k = AngleCoeffs::of_vector(&w);
         (
             Self::exp_from(&k, &v, &w),
             Self::jr_from(&k, &v, &w, T::one()),
@@ -365,7 +376,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     /// `(z = a⁻¹·b, −Ad_{z⁻¹}, I)`.
     fn between_jac(&self, b: &Self) -> (Self, Matrix6<T>, Matrix6<T>) {
         let z = self.between(b);
-        (z, z.inverse().neg_adjoint(), Matrix6::identity())
+        (z, z.inverse().neg_adjoint(), eye())
     }
 
     /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))` with one trigonometric kernel for the log and both

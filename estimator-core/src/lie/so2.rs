@@ -4,7 +4,9 @@
 //! `exp(θ) = (cos θ, sin θ)`, `log = atan2(sin θ, cos θ) ∈ (−π, π]`. The group is commutative:
 //! `Ad = J_r = J_l = 1`. `act_jac(p) = (R p, R G¹ p, R)` (seed Theorem 5.1 with `H(p) = G¹p`).
 
-use super::{all_finite, orthogonality_error, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{
+    all_finite, orthogonality_error, positive_finite, LieGroup, Real, ORTHOGONALITY_TOLERANCE,
+};
 use nalgebra::{Matrix1, Matrix2, Matrix2x1, Vector1, Vector2};
 
 /// A planar rotation `R ∈ SO(2)`.
@@ -28,7 +30,7 @@ impl<T: Real> So2<T> {
     #[inline(never)]
     pub fn from_cos_sin(re: T, im: T) -> Option<Self> {
         let n2 = re * re + im * im;
-        if !(n2.is_finite() && n2 > T::zero()) {
+        if !positive_finite(n2) {
             return None;
         }
         let inv = T::one() / n2.sqrt();

@@ -16,12 +16,12 @@
 //! with `a, b, c, d` the coefficients of the crate's trigonometric kernel (`sin θ/θ`,
 //! `(1 − cos θ)/θ²`, `(θ − sin θ)/θ³`, `1/θ² − (1 + cos θ)/(2θ sin θ)`).
 
-use super::trig::{half_sinc, poly, AngleCoeffs, Cutoff};
+use super::trig::{poly, AngleCoeffs, Cutoff};
 use super::{
-    all_finite, mul_skew, negate, orthogonality_error, skew, skew_poly, LieGroup, Real,
-    ORTHOGONALITY_TOLERANCE,
+    all_finite, eye, mul_skew, negate, orthogonality_error, positive_finite, skew, skew_poly,
+    LieGroup, Real, ORTHOGONALITY_TOLERANCE,
 };
-use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3, Vector4};
 
 /// A 3-D rotation `R ∈ SO(3)`, stored as a unit Hamilton quaternion.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,7 +35,7 @@ impl<T: Real> So3<T> {
     #[must_use]
     pub fn from_quaternion(q: &Quaternion<T>) -> Option<Self> {
         let n2 = q.coords.norm_squared();
-        if !(n2.is_finite() && n2 > T::zero()) {
+        if !positive_finite(n2) {
             return None;
         }
         Some(Self::scaled(q, T::one() / n2.sqrt()))
@@ -105,14 +105,15 @@ impl<T: Real> So3<T> {
             m.m13 + m.m31,
             m.m23 + m.m32,
         ];
+        // `from` lists the components in nalgebra's storage order `[x, y, z, w]`.
         let (radicand, from): (T, [u8; 4]) = if trace > T::zero() {
-            (trace + one, [SELF, 0, 1, 2])
+            (trace + one, [0, 1, 2, SELF])
         } else if m.m11 > m.m22 && m.m11 > m.m33 {
-            (one + m.m11 - m.m22 - m.m33, [0, SELF, 3, 4])
+            (one + m.m11 - m.m22 - m.m33, [SELF, 3, 4, 0])
         } else if m.m22 > m.m33 {
-            (one + m.m22 - m.m11 - m.m33, [1, 3, SELF, 5])
+            (one + m.m22 - m.m11 - m.m33, [3, SELF, 5, 1])
         } else {
-            (one + m.m33 - m.m11 - m.m22, [2, 4, 5, SELF])
+            (one + m.m33 - m.m11 - m.m22, [4, 5, SELF, 2])
         };
         let s = radicand.sqrt() * T::lit(2.0);
         let mut q = [T::zero(); 4];
@@ -122,8 +123,7 @@ impl<T: Real> So3<T> {
                 None => T::lit(0.25) * s,
             };
         }
-        let [w, x, y, z] = q;
-        Self::from_wxyz(w, x, y, z)
+        Self::from_quaternion(&Quaternion::from(Vector4::from(q)))
     }
 
     /// `log` plus the half-angle sine and cosine it found, to build the kernel without trigonometry.
@@ -175,8 +175,10 @@ impl<T: Real> So3<T> {
         }
     }
 
-    /// `log` and its kernel (for SE(3)'s log, which needs `J_l⁻¹` of the same angle).
-    #[inline]
+    /// `log` and its kernel (for SE(3)'s log, which needs `J_l⁻¹` of the same angle). Out of
+    /// line under `estimator_compact` (one copy for `log_jac`, `rminus_jac` and SE(3)'s log).
+    #[cfg_attr(not(estimator_compact), inline)]
+    #[cfg_attr(estimator_compact, inline(never))]
     pub(crate) fn log_with_coeffs(&self) -> (Vector3<T>, AngleCoeffs<T>) {
         let (omega, theta, sin_half, cos_half) = self.log_parts();
         let k = AngleCoeffs::from_half_angle(theta * theta, theta, sin_half, cos_half);
@@ -233,11 +235,20 @@ impl<T: Real> LieGroup<T> for So3<T> {
         }
     }
 
+    /// Under `estimator_compact`, through the shared kernel ([`AngleCoeffs::from_theta_sq`] and
+    /// [`So3::exp_from`]): the same `θ`, `sincos(θ/2)` and `sin(θ/2)/θ`, so the same bits, without
+    /// a second inlined copy of them (the kernel's `a`, `b`, `c` are computed and unused).
+    #[cfg(estimator_compact)]
+    fn exp(w: &Vector3<T>) -> Self {
+        Self::exp_from(&AngleCoeffs::of_vector(w), w)
+    }
+
+    #[cfg(not(estimator_compact))]
     fn exp(w: &Vector3<T>) -> Self {
         let theta_sq = w.norm_squared();
         let theta = theta_sq.sqrt();
         let (s, c) = (theta * T::lit(0.5)).sincos();
-        let v = w * half_sinc(theta_sq, theta, s);
+        let v = w * super::trig::half_sinc(theta_sq, theta, s);
         Self {
             q: UnitQuaternion::new_unchecked(Quaternion::new(c, v.x, v.y, v.z)),
         }
@@ -287,22 +298,22 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn right_jacobian(w: &Vector3<T>) -> Matrix3<T> {
-        Self::jr_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), w)
+        Self::jr_from(&AngleCoeffs::of_vector(w), w)
     }
 
     fn right_jacobian_inv(w: &Vector3<T>) -> Matrix3<T> {
-        Self::jr_inv_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), w)
+        Self::jr_inv_from(&AngleCoeffs::of_vector(w), w)
     }
 
     /// `J_r(ω)ᵀ = I + b[ω]× + c[ω]×²`.
     fn left_jacobian(w: &Vector3<T>) -> Matrix3<T> {
-        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        let k = AngleCoeffs::of_vector(w);
         skew_poly(T::one(), k.b, k.c, w)
     }
 
     /// `J_r⁻¹(ω)ᵀ = I − ½[ω]× + d[ω]×²`.
     fn left_jacobian_inv(w: &Vector3<T>) -> Matrix3<T> {
-        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        let k = AngleCoeffs::of_vector(w);
         skew_poly(T::one(), T::lit(-0.5), k.d(), w)
     }
 
@@ -336,7 +347,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn exp_jac(w: &Vector3<T>) -> (Self, Matrix3<T>) {
-        let k = AngleCoeffs::from_theta_sq(w.norm_squared());
+        let k = AngleCoeffs::of_vector(w);
         (Self::exp_from(&k, w), Self::jr_from(&k, w))
     }
 
@@ -346,11 +357,9 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn compose_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
-        (
-            self.compose(b),
-            b.rotation_matrix().transpose(),
-            Matrix3::identity(),
-        )
+        // R_bᵀ as the rotation matrix of the conjugate: nalgebra's formula gives R(q*) = R(q)ᵀ bit
+        // for bit (each off-diagonal pair is x − (−y) against y + x), without a transposing copy.
+        (self.compose(b), b.inverse().rotation_matrix(), eye())
     }
 
     /// `(a⁻¹, −R)`, negated in place ([`negate`]).
@@ -365,7 +374,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
         let z = self.between(b);
         let mut j = z.inverse().adjoint();
         negate(&mut j);
-        (z, j, Matrix3::identity())
+        (z, j, eye())
     }
 
     fn rminus_jac(&self, b: &Self) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {

@@ -32,6 +32,7 @@
 
 use crate::scalar::{taylor_cutoff, Real};
 use core::marker::PhantomData;
+use nalgebra::Vector3;
 
 /// Small-angle cutoffs (in `θ²`), one per series, derived from `T::EPSILON`.
 pub(crate) struct Cutoff<T>(PhantomData<T>);
@@ -50,17 +51,32 @@ impl<T: Real> Cutoff<T> {
     pub(crate) const ATAN_RATIO: f64 = taylor_cutoff(T::EPSILON_F64, 1.0, 1.0 / 7.0, 3);
 }
 
-/// Evaluates `p₀ + p₁x + p₂x² + …` (Horner).
+/// Evaluates `p₀ + p₁x + p₂x² + …` (Horner), for `x` finite (every caller is below a cutoff).
+///
+/// Written out for the lengths in use (up to six coefficients), starting from the last
+/// coefficient: the same bits as the loop `acc = acc·x + pₖ` from `acc = 0` (whose first step
+/// `0·x + p_last` is exactly `p_last` for finite `x`), one multiply and add fewer. At opt-level "s"
+/// the loop stays rolled and stores its coefficients to the stack first (a `movw`/`movt`/`str`
+/// each); written out, each is one literal load, which is smaller for up to five coefficients
+/// and no larger for six.
 #[inline(always)]
 pub(crate) fn poly<T: Real, const N: usize>(x: T, coeffs: [T; N]) -> T {
     // Coefficients arrive as `T` (each `T::lit(literal)` folds at compile time): an `[f64; N]`
     // indexed in a loop that is not unrolled (opt-level "s") would convert at run time, which
     // is a soft-float `__aeabi_d2f` call on a Cortex-M4F.
-    let mut acc = T::zero();
-    for k in coeffs.iter().rev() {
-        acc = acc * x + *k;
+    match coeffs.as_slice() {
+        [p0, p1, p2] => (*p2 * x + *p1) * x + *p0,
+        [p0, p1, p2, p3] => ((*p3 * x + *p2) * x + *p1) * x + *p0,
+        [p0, p1, p2, p3, p4] => (((*p4 * x + *p3) * x + *p2) * x + *p1) * x + *p0,
+        [p0, p1, p2, p3, p4, p5] => ((((*p5 * x + *p4) * x + *p3) * x + *p2) * x + *p1) * x + *p0,
+        _ => {
+            let mut acc = T::zero();
+            for k in coeffs.iter().rev() {
+                acc = acc * x + *k;
+            }
+            acc
+        }
     }
-    acc
 }
 
 /// Coefficients of one rotation angle, shared by exp, the Jacobians and their inverses.
@@ -91,6 +107,21 @@ impl<T: Real> AngleCoeffs<T> {
         let theta = theta_sq.sqrt();
         let (sin_half, cos_half) = (theta * T::lit(0.5)).sincos();
         Self::from_half_angle(theta_sq, theta, sin_half, cos_half)
+    }
+
+    /// From a rotation vector `ω`: [`Self::from_theta_sq`] of `‖ω‖²`.
+    #[inline(always)]
+    pub fn of_vector(w: &Vector3<T>) -> Self {
+        Self::of_components(w.x, w.y, w.z)
+    }
+
+    /// [`Self::of_vector`] with the components passed by value (in registers, so a caller's `ω`
+    /// need not be stored to memory for the call). Out of line under `estimator_compact`: one copy
+    /// of the squared norm for every SO(3) and SE(3) kernel.
+    #[cfg_attr(not(estimator_compact), inline)]
+    #[cfg_attr(estimator_compact, inline(never))]
+    fn of_components(x: T, y: T, z: T) -> Self {
+        Self::from_theta_sq(Vector3::new(x, y, z).norm_squared())
     }
 
     /// From `θ` and the sine and cosine of `θ/2`, already known (for example the vector norm and
@@ -132,7 +163,9 @@ impl<T: Real> AngleCoeffs<T> {
     }
 
     /// `d = 1/θ² − (1 + cos θ)/(2θ sin θ)`, the coefficient of `[θ]×²` in `J_r⁻¹`; computed on
-    /// demand, since only the inverse Jacobians need it.
+    /// demand, since only the inverse Jacobians need it. Out of line under `estimator_compact`
+    /// (small enough that LLVM would otherwise inline it at each of its callers).
+    #[cfg_attr(estimator_compact, inline(never))]
     pub fn d(&self) -> T {
         let (theta_sq, theta) = (self.theta_sq, self.theta);
         if theta_sq < T::lit(Cutoff::<T>::D) {

@@ -325,3 +325,95 @@ fn mat_vec_is_nalgebras_product() {
     mat_vec_case::<f64, 1, 1>(103);
     mat_vec_case::<f64, 4, 2>(107);
 }
+
+/// The update's checks in their compact forms against the expressions they replace:
+/// `positive_finite(d)` is `d.is_finite() && d > 0` (the reset's diagonal test), and
+/// `sum_times_zero_is_zero` is the fold of `is_finite` (`finite_symmetric`), on every kind of
+/// number (signed zeros, subnormals, the largest finite, infinities, NaN).
+fn update_checks<T: Real>() {
+    use super::imu::sum_times_zero_is_zero;
+    use super::update::positive_finite;
+    let mut rng = Lcg(109);
+    let specials = [
+        T::lit(0.0),
+        T::lit(-0.0),
+        T::lit(f64::from(f32::MIN_POSITIVE) / 4.0),
+        T::lit(-f64::from(f32::MIN_POSITIVE) / 4.0),
+        T::lit(f64::from(f32::MAX)),
+        T::lit(-f64::from(f32::MAX)),
+        T::lit(f64::MAX),
+        T::lit(f64::MIN_POSITIVE / 4.0),
+    ];
+    for d in specials
+        .iter()
+        .copied()
+        .chain((0..400).map(|i| number::<T>(&mut rng, i)))
+    {
+        assert_eq!(positive_finite(d), d.is_finite() && d > T::zero());
+    }
+    for i in 0..400 {
+        let a: [T; 9] = core::array::from_fn(|r| {
+            if (i + r) % 5 == 0 {
+                number(&mut rng, i + r)
+            } else {
+                T::lit(rng.next() * 1e3)
+            }
+        });
+        for len in [0, 1, 4, 9] {
+            let s = a.get(..len).unwrap_or(&[]);
+            let old = s.iter().fold(true, |acc, x| acc & x.is_finite());
+            assert_eq!(sum_times_zero_is_zero(s), old);
+        }
+    }
+}
+
+#[test]
+fn update_checks_are_the_plain_predicates() {
+    update_checks::<f32>();
+    update_checks::<f64>();
+}
+
+/// `rows_into` (`Hᵀ` read column by column of `H`) against the former copy (written column by
+/// column of `Hᵀ`), for every row count of a core with capacity 3, and past-the-end padding.
+fn rows_into_case<T: Real, const N: usize, const M: usize>(seed: u64) {
+    use super::update::rows_into;
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    for i in 0..100 {
+        let h = SMatrix::<T, M, N>::from_fn(|r, c| number(&mut rng, i + 3 * r + c));
+        let r_in = SVector::<T, M>::from_fn(|r, _| number(&mut rng, i + r));
+        let (h, r_in) = (h.as_slice(), r_in.as_slice());
+        let mut old_ht = SMatrix::<T, N, 3>::from_element(T::lit(f64::NAN));
+        let mut old_r = SVector::<T, 3>::from_element(T::lit(f64::NAN));
+        {
+            let (ht, r) = (old_ht.as_mut_slice(), old_r.as_mut_slice());
+            let m = r_in.len().max(1);
+            let n = h.len() / m;
+            ht.fill(T::zero());
+            for (c, col) in ht.chunks_exact_mut(n.max(1)).enumerate().take(r_in.len()) {
+                for (j, e) in col.iter_mut().enumerate() {
+                    *e = h.get(j * m + c).copied().unwrap_or_else(T::zero);
+                }
+            }
+            r.fill(T::zero());
+            for (d, s) in r.iter_mut().zip(r_in) {
+                *d = *s;
+            }
+        }
+        let mut ht = SMatrix::<T, N, 3>::from_element(T::lit(f64::NAN));
+        let mut r = SVector::<T, 3>::from_element(T::lit(f64::NAN));
+        rows_into(h, r_in, ht.as_mut_slice(), r.as_mut_slice());
+        assert!(same(ht.as_slice(), old_ht.as_slice()));
+        assert!(same(r.as_slice(), old_r.as_slice()));
+    }
+}
+
+#[test]
+fn rows_into_is_the_former_copy() {
+    rows_into_case::<f32, 15, 1>(113);
+    rows_into_case::<f32, 15, 2>(127);
+    rows_into_case::<f32, 15, 3>(131);
+    rows_into_case::<f32, 6, 1>(137);
+    rows_into_case::<f64, 6, 3>(139);
+    rows_into_case::<f64, 15, 2>(149);
+}

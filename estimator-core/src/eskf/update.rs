@@ -145,12 +145,28 @@ fn spd_packed<T: Real>(a: &[T], n: usize) -> bool {
 
 /// `a` (column-major, `n × n`) is finite and symmetric to `1e-6` of its largest entry.
 fn finite_symmetric<T: Real>(a: &[T], n: usize) -> bool {
-    if a.len() != n * n || !a.iter().fold(true, |acc, x| acc & x.is_finite()) {
+    if a.len() != n * n || !slice_finite(a) {
         return false;
     }
     let tol = a.iter().fold(T::zero(), |m, x| m.max(x.abs())) * T::lit(1e-6);
     let get = |idx: usize| a.get(idx).copied().unwrap_or_else(T::zero);
     (0..n).all(|j| (j + 1..n).all(|i| (get(j * n + i) - get(i * n + j)).abs() <= tol))
+}
+
+/// Every entry of `a` is finite. Built for size, the shared out-of-line `Σ x·0 = 0` (the same
+/// answer, 32 bytes less at opt-level "s"); at opt-level 2 or 3 the fold of `is_finite` stays
+/// (its instruction counts are budgeted).
+#[cfg(estimator_compact)]
+#[inline(always)]
+fn slice_finite<T: Real>(a: &[T]) -> bool {
+    sum_times_zero_is_zero(a)
+}
+
+/// Every entry of `a` is finite (see the build for size above).
+#[cfg(not(estimator_compact))]
+#[inline(always)]
+fn slice_finite<T: Real>(a: &[T]) -> bool {
+    a.iter().fold(true, |acc, x| acc & x.is_finite())
 }
 
 /// Row capacity of the shared update core.
@@ -216,13 +232,17 @@ where
 /// Copies `H` (`m × n`, column-major in `h`, `m = r_in.len()`) into `ht` as `Hᵀ` (`n × C`,
 /// column `c` = row `c` of `H`) and the residual into `r`, zeros past `m`. Not generic over the
 /// model or its size: one copy of this code serves every model.
-fn rows_into<T: Real>(h: &[T], r_in: &[T], ht: &mut [T], r: &mut [T]) {
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn rows_into<T: Real>(h: &[T], r_in: &[T], ht: &mut [T], r: &mut [T]) {
     let m = r_in.len().max(1);
     let n = h.len() / m;
     ht.fill(T::zero());
-    for (c, col) in ht.chunks_exact_mut(n.max(1)).enumerate().take(r_in.len()) {
-        for (j, e) in col.iter_mut().enumerate() {
-            *e = h.get(j * m + c).copied().unwrap_or_else(T::zero);
+    // Column j of H (entries j·m .. j·m + m) goes to row j of Hᵀ: entry (j, c) at c·n + j.
+    for (j, col) in h.chunks_exact(m).enumerate() {
+        for (c, v) in col.iter().enumerate() {
+            if let Some(e) = ht.get_mut(c * n + j) {
+                *e = *v;
+            }
         }
     }
     r.fill(T::zero());
@@ -774,7 +794,7 @@ fn commit_shared<T: Real, const C: usize>(
     let c00 = super::imu::sym(&c00);
     // K, U, S and P are finite, so P⁺ can only fail by overflow; for a positive semi-definite
     // P⁺, |P⁺_ij| ≤ √(P⁺_ii P⁺_jj), so a finite positive diagonal bounds every entry.
-    let ok = |d: T| d.is_finite() && d > T::zero();
+    let ok = positive_finite::<T>;
     let two = T::lit(2.0);
     let diag_ok = (3..n).all(|i| {
         let d = pairs().fold(T::zero(), |acc, (vc, kc)| acc + at(vc, i) * at(kc, i));
@@ -824,6 +844,19 @@ fn commit_shared<T: Real, const C: usize>(
         }
     }
     Ok(())
+}
+
+/// `d` is finite and positive (false for NaN). Built for size, `d > 0` and `d · 0 = 0` (see
+/// [`sum_times_zero_is_zero`]): the same answer as `d.is_finite() && d > 0`, which LLVM turns
+/// into a long integer classification of the bits at opt-level "s" (136 bytes more per build).
+/// At opt-level 2 or 3 the plain form stays: the other one left a panic path in the `f64`
+/// no-panic build.
+#[inline(always)]
+pub(crate) fn positive_finite<T: Real>(d: T) -> bool {
+    #[cfg(estimator_compact)]
+    return greater(d, T::zero()) && d * T::zero() == T::zero();
+    #[cfg(not(estimator_compact))]
+    return d.is_finite() && d > T::zero();
 }
 
 /// `s[i]`, or zero past the end (never reached: every caller indexes below the length).

@@ -226,7 +226,16 @@ fn add_cross<T: Real, const N: usize>(m: &mut SMatrix<T, N, N>, i: usize, j: usi
 /// `(a + aᵀ)/2`: the symmetric part of a diagonal block (removes the rounding asymmetry).
 #[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn sym<T: Real>(a: &Matrix3<T>) -> Matrix3<T> {
-    (a + a.transpose()) * T::lit(0.5)
+    // Entry by entry over the storage: `(a_ij + a_ji)·½`, the sums and products of nalgebra's
+    // `(a + aᵀ) * ½` without its generic loops.
+    let s = a.as_slice();
+    let mut out = *a;
+    for (j, col) in out.as_mut_slice().chunks_exact_mut(3).enumerate() {
+        for (i, e) in col.iter_mut().enumerate() {
+            *e = (*e + s.get(3 * i + j).copied().unwrap_or_else(T::zero)) * T::lit(0.5);
+        }
+    }
+    out
 }
 
 /// A block column: the `15 × 3` column-major storage of block columns `3j..3j+3` of a 15-row

@@ -286,6 +286,8 @@ struct Work<T: Real, const N: usize, const C: usize> {
     s: SMatrix<T, C, C>,
     /// `K = U S⁻¹`.
     k: SMatrix<T, N, C>,
+    /// `S⁻¹` (for the NIS at the prior).
+    s_inv: SMatrix<T, C, C>,
     /// The current correction `δx`.
     dx: SVector<T, N>,
     /// The number of active rows, `M`.
@@ -360,12 +362,13 @@ where
         u: SMatrix::zeros(),
         s: SMatrix::zeros(),
         k: SMatrix::zeros(),
+        s_inv: SMatrix::zeros(),
         dx: SVector::zeros(),
         m,
     };
     linearize_into(model, x, &mut w, true)?;
-    let s_inv = gain_into(p, r_noise, &mut w)?;
-    let nis = nis(&s_inv, &w.r);
+    gain_into(p, r_noise, &mut w)?;
+    let nis = nis(&w.s_inv, &w.r);
     if !nis.is_finite() {
         return Err(EskfError::SingularInnovation);
     }
@@ -452,7 +455,7 @@ pub(crate) fn chart_jacobian<T: Real>(dx: &[T], ht: &mut [T]) {
     }
 }
 
-/// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`; returns `S⁻¹`. The per-size entry of
+/// `U = P H̃ᵀ`, `S = H̃ U + R`, `S⁻¹`, `K = U S⁻¹` into `w`. The per-size entry of
 /// [`gain_shared`] (see [`commit`] for the two builds).
 #[cfg_attr(estimator_compact, inline(always))]
 #[cfg_attr(not(estimator_compact), inline(never))]
@@ -460,7 +463,7 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
     p: &SMatrix<T, N, N>,
     r_noise: &SMatrix<T, C, C>,
     w: &mut Work<T, N, C>,
-) -> Result<SMatrix<T, C, C>, EskfError> {
+) -> Result<(), EskfError> {
     gain_shared(
         p.as_slice(),
         N,
@@ -469,6 +472,7 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
         w.ht.as_slice(),
         w.u.as_mut_slice(),
         &mut w.s,
+        &mut w.s_inv,
         w.k.as_mut_slice(),
     )
 }
@@ -487,8 +491,9 @@ fn gain_shared<T: Real, const C: usize>(
     ht: &[T],
     u: &mut [T],
     s: &mut SMatrix<T, C, C>,
+    s_inv_out: &mut SMatrix<T, C, C>,
     k: &mut [T],
-) -> Result<SMatrix<T, C, C>, EskfError> {
+) -> Result<(), EskfError> {
     // Column c of U = Σ_j P e_j H_cj over the nonzero entries of row c of H only (most models
     // touch 3–6 of the 15 error components).
     u.fill(T::zero());
@@ -518,12 +523,18 @@ fn gain_shared<T: Real, const C: usize>(
     // K = U S⁻¹ with S⁻¹ from the Cholesky factor (C × C, small); the columns past m stay zero.
     // Built for size, nalgebra's factorization and solves in plain loops (the same bits, see
     // `cholesky_inverse`); at opt-level 2 or 3, nalgebra's own, which it unrolls faster.
+    // (Written to the caller's `S⁻¹` directly: after an error the caller does not read it.)
     #[cfg(estimator_compact)]
-    let s_inv = cholesky_inverse(s).ok_or(EskfError::SingularInnovation)?;
+    {
+        *s_inv_out = cholesky_inverse(s).ok_or(EskfError::SingularInnovation)?;
+    }
     #[cfg(not(estimator_compact))]
-    let s_inv = Cholesky::new(*s)
-        .ok_or(EskfError::SingularInnovation)?
-        .inverse();
+    {
+        *s_inv_out = Cholesky::new(*s)
+            .ok_or(EskfError::SingularInnovation)?
+            .inverse();
+    }
+    let s_inv: &SMatrix<T, C, C> = s_inv_out;
     k.fill(T::zero());
     for (kc, sc) in k
         .chunks_exact_mut(n.max(1))
@@ -537,7 +548,7 @@ fn gain_shared<T: Real, const C: usize>(
     if !sum_times_zero_is_zero(k) {
         return Err(EskfError::SingularInnovation);
     }
-    Ok(s_inv)
+    Ok(())
 }
 
 /// `A⁻¹` by `nalgebra::Cholesky::new(A)?.inverse()`, operation for operation (the same bits;

@@ -11,7 +11,7 @@
 
 use super::error::EskfError;
 use super::imu::{axpy, finite, mm};
-use super::models::{add3, div3, neg3};
+use super::models::{add3, div3, dot3, neg3, norm3};
 use crate::lie::So3;
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
@@ -55,9 +55,9 @@ fn mean<T: Real>(xs: &[Vector3<T>]) -> Result<Vector3<T>, EskfError> {
 /// The unit vector along the part of `v` orthogonal to the unit `u`, if any.
 fn horizontal<T: Real>(v: &Vector3<T>, u: &Vector3<T>) -> Option<Vector3<T>> {
     // `v − u (u·v)` as `v + u·(−u·v)`: the same bits (negation is exact).
-    let h = axpy(v, u, -u.dot(v));
-    let n = h.norm();
-    if n > T::lit(1e-6) * v.norm() && n > T::zero() {
+    let h = axpy(v, u, -dot3(u, v));
+    let n = norm3(&h);
+    if n > T::lit(1e-6) * norm3(v) && n > T::zero() {
         Some(div3(&h, n))
     } else {
         None
@@ -106,7 +106,7 @@ pub fn align_at_rest<T: Real>(
     if !(finite(gravity) && rest_tolerance.is_finite()) {
         return Err(EskfError::NonFinite);
     }
-    let (nf, ng) = (f.norm(), gravity.norm());
+    let (nf, ng) = (norm3(&f), norm3(gravity));
     if !(nf > T::zero() && ng > T::zero()) {
         return Err(EskfError::ZeroNorm);
     }
@@ -204,7 +204,7 @@ pub(crate) fn prior_attitude_covariance<T: Real>(
     sigmas: &InitialSigmas<T>,
     config: &super::imu::FilterConfig<T>,
 ) -> Result<nalgebra::Matrix3<T>, EskfError> {
-    let gn = config.gravity.norm();
+    let gn = norm3(&config.gravity);
     if !super::imu::greater(gn, T::zero()) {
         return Err(EskfError::ZeroNorm);
     }

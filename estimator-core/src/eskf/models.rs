@@ -79,6 +79,19 @@ pub(crate) fn neg3<T: Real>(v: &Vector3<T>) -> Vector3<T> {
     Vector3::new(-v.x, -v.y, -v.z)
 }
 
+/// `a · b = a_x b_x + a_y b_y + a_z b_z`, summed left to right: the products and sums of
+/// nalgebra's `dot` (and `norm_squared`, which adds that to a leading zero: `0 + s = s` for a sum
+/// of squares), without its generic code.
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn dot3<T: Real>(a: &Vector3<T>, b: &Vector3<T>) -> T {
+    a.x * b.x + a.y * b.y + a.z * b.z
+}
+
+/// `‖v‖ = √(v · v)`, as nalgebra's `norm`.
+pub(crate) fn norm3<T: Real>(v: &Vector3<T>) -> T {
+    dot3(v, v).sqrt()
+}
+
 /// GNSS antenna position in the world frame, with the antenna at `lever_arm` in the body frame.
 ///
 /// `h(x) = p + R ℓ`; `H = [−R[ℓ]×, 0, I, 0, 0]` (blocks δθ, δv, δp, δb_g, δb_a).
@@ -263,7 +276,9 @@ impl<T: Real> Magnetometer<T> {
         if !(finite(&self.field) && finite(&self.reference)) {
             return Err(EskfError::NonFinite);
         }
-        if self.field.norm_squared() <= T::zero() || self.reference.norm_squared() <= T::zero() {
+        if dot3(&self.field, &self.field) <= T::zero()
+            || dot3(&self.reference, &self.reference) <= T::zero()
+        {
             return Err(EskfError::ZeroNorm);
         }
         let (hx, h_att) = in_body(attitude, &self.reference);
@@ -320,7 +335,7 @@ impl<T: Real> GravityDirection<T> {
         if !(finite(&self.accel) && finite(&self.up)) {
             return Err(EskfError::NonFinite);
         }
-        let (na, nu) = (self.accel.norm(), self.up.norm());
+        let (na, nu) = (norm3(&self.accel), norm3(&self.up));
         if !(na > T::zero() && nu > T::zero()) {
             return Err(EskfError::ZeroNorm);
         }
@@ -375,7 +390,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
         if !(finite(&self.accel) && finite(&self.gravity)) {
             return Err(EskfError::NonFinite);
         }
-        if self.accel.norm_squared() <= T::zero() {
+        if dot3(&self.accel, &self.accel) <= T::zero() {
             return Err(EskfError::ZeroNorm);
         }
         let (f, h_att) = in_body(&x.attitude, &neg3(&self.gravity));

@@ -4,7 +4,7 @@
 
 use super::align::InitialSigmas;
 use super::imu::{add33, axpy, mm, mv, ImuNoise};
-use super::models::{add3, div3, neg3, sub3};
+use super::models::{add3, div3, dot3, neg3, norm3, sub3};
 use super::state::{plus_seg, seg};
 use crate::lie::{LieGroup, So3};
 use crate::Real;
@@ -119,6 +119,9 @@ fn vector_helpers<T: Real>() {
         assert!(same(add3(&a, &b).as_slice(), (a + b).as_slice()));
         assert!(same(div3(&a, s).as_slice(), (a / s).as_slice()));
         assert!(same(neg3(&a).as_slice(), (-a).as_slice()));
+        assert!(same(&[dot3(&a, &b)], &[a.dot(&b)]));
+        assert!(same(&[dot3(&a, &a)], &[a.norm_squared()]));
+        assert!(same(&[norm3(&a)], &[a.norm()]));
         assert!(same(div3(&neg3(&a), s).as_slice(), (-a / s).as_slice()));
         let old = a - b * b.dot(&a);
         assert!(same(axpy(&a, &b, -b.dot(&a)).as_slice(), old.as_slice()));

@@ -432,3 +432,29 @@ fn rows_into_is_the_former_copy() {
     rows_into_case::<f64, 6, 3>(139);
     rows_into_case::<f64, 15, 2>(149);
 }
+
+/// `nis` (over the storage slices) against `rᵀ (S⁻¹ r)` through nalgebra's product and
+/// iterators, the former form.
+fn nis_case<T: Real, const C: usize>(seed: u64) {
+    use super::update::nis;
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    for i in 0..400 {
+        let s_inv = SMatrix::<T, C, C>::from_fn(|r, c| number(&mut rng, i / 3 + 2 * r + c));
+        let r = SVector::<T, C>::from_fn(|r, _| number(&mut rng, i / 2 + r));
+        let y = s_inv * r;
+        let old = r
+            .iter()
+            .zip(y.iter())
+            .fold(T::zero(), |acc, (a, b)| acc + *a * *b);
+        assert!(same(&[nis(&s_inv, &r)], &[old]));
+    }
+}
+
+#[test]
+fn nis_is_the_former_sum() {
+    nis_case::<f32, 3>(151);
+    nis_case::<f32, 2>(157);
+    nis_case::<f64, 3>(163);
+    nis_case::<f64, 1>(167);
+}

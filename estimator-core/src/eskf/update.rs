@@ -386,11 +386,12 @@ where
 /// `Cholesky::solve` (dynamic-range `dot`s) and `dot` keep shape asserts, panic paths at
 /// opt-level "s". Generic over the row capacity only: one copy for both filters.
 #[cfg_attr(estimator_compact, inline(never))]
-fn nis<T: Real, const C: usize>(s_inv: &SMatrix<T, C, C>, r: &SVector<T, C>) -> T {
+pub(crate) fn nis<T: Real, const C: usize>(s_inv: &SMatrix<T, C, C>, r: &SVector<T, C>) -> T {
     let mut y = SVector::<T, C>::zeros();
     mat_vec(s_inv.as_slice(), r.as_slice(), y.as_mut_slice());
-    r.iter()
-        .zip(y.iter())
+    r.as_slice()
+        .iter()
+        .zip(y.as_slice())
         .fold(T::zero(), |acc, (a, b)| acc + *a * *b)
 }
 
@@ -448,7 +449,7 @@ pub(crate) fn chart_jacobian<T: Real>(dx: &[T], ht: &mut [T]) {
         if let Some(top) = col.get_mut(0..3) {
             let h = Vector3::new(at(top, 0), at(top, 1), at(top, 2));
             let v = super::imu::mv(&jrt, &h);
-            for (e, x) in top.iter_mut().zip(v.iter()) {
+            for (e, x) in top.iter_mut().zip(v.as_slice()) {
                 *e = *x;
             }
         }
@@ -538,10 +539,10 @@ fn gain_shared<T: Real, const C: usize>(
     k.fill(T::zero());
     for (kc, sc) in k
         .chunks_exact_mut(n.max(1))
-        .zip(s_inv.column_iter())
+        .zip(s_inv.as_slice().chunks_exact(C.max(1)))
         .take(m)
     {
-        for (uc, s) in u.chunks_exact(n.max(1)).zip(sc.iter()).take(m) {
+        for (uc, s) in u.chunks_exact(n.max(1)).zip(sc).take(m) {
             axpy(kc, *s, uc);
         }
     }
@@ -630,11 +631,11 @@ pub(crate) fn gauss_newton_step<T: Real, const C: usize>(
 ) {
     let n = prev.len().max(1);
     let mut y = *r;
-    for (yc, hc) in y.iter_mut().zip(ht.chunks_exact(n)).take(m) {
+    for (yc, hc) in y.as_mut_slice().iter_mut().zip(ht.chunks_exact(n)).take(m) {
         *yc += dot(hc, prev);
     }
     next.fill(T::zero());
-    for (kc, yc) in k.chunks_exact(n).zip(y.iter()).take(m) {
+    for (kc, yc) in k.chunks_exact(n).zip(y.as_slice()).take(m) {
         axpy(next, *yc, kc);
     }
 }
@@ -794,7 +795,7 @@ fn commit_shared<T: Real, const C: usize>(
         let mut c0 = Vector3::new(at(pc, 0), at(pc, 1), at(pc, 2));
         for (vc, kc) in pairs() {
             let (vj, kj) = (at(vc, j), at(kc, j));
-            for (e, (a, b)) in c0.iter_mut().zip(vc.iter().zip(kc)) {
+            for (e, (a, b)) in c0.as_mut_slice().iter_mut().zip(vc.iter().zip(kc)) {
                 *e += *a * kj + *b * vj;
             }
         }
@@ -840,7 +841,7 @@ fn commit_shared<T: Real, const C: usize>(
         }
     }
     for (j, col) in top.iter().enumerate().take(n) {
-        for (a, v) in col.iter().enumerate() {
+        for (a, v) in col.as_slice().iter().enumerate() {
             let v = if j < 3 {
                 c00.get((a, j)).copied().unwrap_or(*v)
             } else {

@@ -10,7 +10,7 @@
 //! * Initial gyro bias: the mean angular rate `ω̄` (the body does not rotate).
 
 use super::error::EskfError;
-use super::imu::{axpy, finite, mm};
+use super::imu::{axpy, finite, mm, tr33};
 use super::models::{add3, div3, dot3, neg3, norm3};
 use crate::lie::So3;
 use crate::Real;
@@ -193,7 +193,7 @@ impl<T: Real> InitialSigmas<T> {
             e(up.z, up.y, o),
             e(up.z, up.z, t2),
         );
-        mm(&mm(&r.transpose(), &sw), &r)
+        mm(&mm(&tr33(&r), &sw), &r)
     }
 }
 

@@ -329,7 +329,7 @@ pub(crate) fn predict_ins<T: Real>(
     };
 
     let fr = FRows {
-        f00: dr.rotation_matrix().transpose(),
+        f00: tr33(&dr.rotation_matrix()),
         f03: scaled(jr, -dt),
         b: scaled(r, -dt),
         fx: skew(&f),
@@ -362,7 +362,7 @@ pub(crate) fn predict_ins<T: Real>(
         let out = fr.apply(q, t <= 5);
         for (i, m) in out.iter().enumerate() {
             if t < 5 {
-                set_blk_rc(&mut l, j, i, &m.transpose());
+                set_blk_rc(&mut l, j, i, &tr33(m));
             } else if i == j {
                 set_blk_rc(&mut l, i, j, &sym(m));
             } else if i > j {
@@ -385,7 +385,7 @@ pub(crate) fn predict_ins<T: Real>(
             let n = blk_rc(&l, k, i);
             set_blk(p, k, i, &n);
             if k > i {
-                set_blk(p, i, k, &n.transpose());
+                set_blk(p, i, k, &tr33(&n));
             }
         }
     }
@@ -431,17 +431,17 @@ pub(crate) fn predict_ahrs<T: Real>(
     let (dr, jr) = So3::exp_jac(&(axpy(gyro, &x.gyro_bias, -T::one()) * dt));
     // F00 = ΔRᵀ, so F00ᵀ = ΔR (no transpose pass).
     let f00t = dr.rotation_matrix();
-    let f00 = f00t.transpose();
+    let f00 = tr33(&f00t);
     let f01 = scaled(jr, -dt);
     let p00 = blk(p, 0, 0);
     let p01 = blk(p, 0, 1);
     let p11 = blk(p, 1, 1);
     // M0j = F00 P0j + F01 P1j; P⁺00 = M00 F00ᵀ + M01 F01ᵀ; P⁺01 = M01; P⁺11 = P11.
-    let m00 = add33(&mm(&f00, &p00), &mm(&f01, &p01.transpose()));
+    let m00 = add33(&mm(&f00, &p00), &mm(&f01, &tr33(&p01)));
     let m01 = add33(&mm(&f00, &p01), &mm(&f01, &p11));
     // N00 = M00 F00ᵀ + M01 F01ᵀ is symmetric: its upper triangle, mirrored (exactly symmetric
     // without a separate symmetrization; at opt-level 3 the unused lower products are dead).
-    let n = add33(&mm(&m00, &f00t), &mm(&m01, &f01.transpose()));
+    let n = add33(&mm(&m00, &f00t), &mm(&m01, &tr33(&f01)));
     let n00 = Matrix3::new(
         n.m11, n.m12, n.m13, n.m12, n.m22, n.m23, n.m13, n.m23, n.m33,
     );
@@ -451,7 +451,7 @@ pub(crate) fn predict_ahrs<T: Real>(
     }
     set_blk(p, 0, 0, &n00);
     set_blk(p, 0, 1, &m01);
-    set_blk(p, 1, 0, &m01.transpose());
+    set_blk(p, 1, 0, &tr33(&m01));
     let n = &cfg.imu_noise;
     add_diag(
         p,
@@ -469,6 +469,15 @@ fn scaled<T: Real>(mut m: Matrix3<T>, s: T) -> Matrix3<T> {
         *x *= s;
     }
     m
+}
+
+/// `mᵀ` for a 3×3 matrix, entry by entry (out of line when built for size: nalgebra's
+/// `transpose` is a generic loop inlined at every site).
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn tr33<T: Real>(m: &Matrix3<T>) -> Matrix3<T> {
+    Matrix3::new(
+        m.m11, m.m21, m.m31, m.m12, m.m22, m.m32, m.m13, m.m23, m.m33,
+    )
 }
 
 /// `r f`, entry by entry (the sums of nalgebra's `r * f`, without its generic product loop).

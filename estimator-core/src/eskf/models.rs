@@ -5,7 +5,7 @@
 //! `R[−b]×`).
 
 use super::error::EskfError;
-use super::imu::{finite, greater, mm};
+use super::imu::{finite, greater, mm, tr33};
 use super::state::{ErrorState, InsState};
 use super::update::{Linearization, Measurement};
 use crate::lie::{skew, LieGroup, Se3, So3};
@@ -559,12 +559,8 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
             return Err(EskfError::NonFinite);
         }
         let (uv, c, q) = self.project_parts(x)?;
-        let rcb = self
-            .body_from_camera
-            .rotation()
-            .rotation_matrix()
-            .transpose();
-        let rt = x.attitude.rotation_matrix().transpose();
+        let rcb = tr33(&self.body_from_camera.rotation().rotation_matrix());
+        let rt = tr33(&x.attitude.rotation_matrix());
         let iz = T::one() / c.z;
         let z = T::zero();
         // ∂π/∂c with a zero third row, so that the 3×3 `mm` serves (rows 0, 1 are used).

@@ -182,6 +182,10 @@ fn products<T: Real>() {
         assert!(same(add33(&a, &b).as_slice(), (a + b).as_slice()));
         let old = a * b.transpose();
         assert!(same(mm(&a, &b.transpose()).as_slice(), old.as_slice()));
+        assert!(same(
+            super::imu::tr33(&a).as_slice(),
+            a.transpose().as_slice()
+        ));
         let old = (a + a.transpose()) * T::lit(0.5);
         assert!(same(super::imu::sym(&a).as_slice(), old.as_slice()));
         let old = Matrix3::from_columns(&[f, g, f.cross(&g)]);

@@ -444,7 +444,7 @@ where
 #[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn chart_jacobian<T: Real>(dx: &[T], ht: &mut [T]) {
     let dth = Vector3::new(at(dx, 0), at(dx, 1), at(dx, 2));
-    let jrt = So3::right_jacobian(&dth).transpose();
+    let jrt = super::imu::tr33(&So3::right_jacobian(&dth));
     for col in ht.chunks_exact_mut(dx.len().max(1)) {
         if let Some(top) = col.get_mut(0..3) {
             let h = Vector3::new(at(top, 0), at(top, 1), at(top, 2));
@@ -802,7 +802,10 @@ fn commit_shared<T: Real, const C: usize>(
         *t = super::imu::mv(&gr, &c0);
     }
     let [t0, t1, t2, ..] = top;
-    let c00 = super::imu::mm(&Matrix3::from_columns(&[t0, t1, t2]), &gr.transpose());
+    let c00 = super::imu::mm(
+        &Matrix3::from_columns(&[t0, t1, t2]),
+        &super::imu::tr33(&gr),
+    );
     let c00 = super::imu::sym(&c00);
     // K, U, S and P are finite, so P⁺ can only fail by overflow; for a positive semi-definite
     // P⁺, |P⁺_ij| ≤ √(P⁺_ii P⁺_jj), so a finite positive diagonal bounds every entry.

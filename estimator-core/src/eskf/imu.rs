@@ -288,12 +288,27 @@ impl<T: Real> FRows<T> {
         } else {
             Matrix3::zeros()
         };
-        [
-            top,
-            add33(&q1, &c),
-            col_blk(q, 2) + (q1 + c * T::lit(0.5)) * self.dt,
-        ]
+        let p_row = row_p(col_blk(q, 2), &q1, &c, self.dt);
+        [top, add33(&q1, &c), p_row]
     }
+}
+
+/// `q2 + (q1 + c·½)·dt` entry by entry over the storage: the operations of nalgebra's
+/// `q2 + (q1 + c * ½) * dt` without its generic loops.
+#[inline(always)]
+pub(crate) fn row_p<T: Real>(
+    mut q2: Matrix3<T>,
+    q1: &Matrix3<T>,
+    c: &Matrix3<T>,
+    dt: T,
+) -> Matrix3<T> {
+    let (q1, c) = (q1.as_slice(), c.as_slice());
+    for (k, e) in q2.as_mut_slice().iter_mut().enumerate() {
+        if let (Some(a), Some(b)) = (q1.get(k), c.get(k)) {
+            *e += (*a + *b * T::lit(0.5)) * dt;
+        }
+    }
+    q2
 }
 
 /// The 15-state prediction; writes only after every check passed.

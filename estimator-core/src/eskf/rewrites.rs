@@ -186,6 +186,10 @@ fn products<T: Real>() {
             super::imu::tr33(&a).as_slice(),
             a.transpose().as_slice()
         ));
+        let dt = number::<T>(&mut rng, i / 11);
+        let old = a + (b + (a * b) * T::lit(0.5)) * dt;
+        let new = super::imu::row_p(a, &b, &(a * b), dt);
+        assert!(same(new.as_slice(), old.as_slice()));
         let old = (a + a.transpose()) * T::lit(0.5);
         assert!(same(super::imu::sym(&a).as_slice(), old.as_slice()));
         let old = Matrix3::from_columns(&[f, g, f.cross(&g)]);

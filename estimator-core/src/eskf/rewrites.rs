@@ -466,3 +466,28 @@ fn nis_is_the_former_sum() {
     nis_case::<f64, 3>(163);
     nis_case::<f64, 1>(167);
 }
+
+/// The gain's `symmetrize` against nalgebra's `s += sᵀ; s *= ½` on `C × C` matrices.
+fn symmetrize_case<T: Real, const C: usize>(seed: u64) {
+    use super::update::symmetrize;
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    for i in 0..400 {
+        let a = SMatrix::<T, C, C>::from_fn(|r, c| number(&mut rng, i / 3 + 2 * r + c));
+        let mut old = a;
+        let st = old.transpose();
+        old += st;
+        old *= T::lit(0.5);
+        let mut new = a;
+        symmetrize(&mut new);
+        assert!(same(new.as_slice(), old.as_slice()));
+    }
+}
+
+#[test]
+fn symmetrize_is_nalgebras() {
+    symmetrize_case::<f32, 3>(173);
+    symmetrize_case::<f32, 2>(179);
+    symmetrize_case::<f64, 3>(181);
+    symmetrize_case::<f64, 4>(191);
+}

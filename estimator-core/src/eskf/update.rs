@@ -518,9 +518,7 @@ fn gain_shared<T: Real, const C: usize>(
             }
         }
     }
-    let st = s.transpose();
-    *s += st;
-    *s *= T::lit(0.5);
+    symmetrize(s);
     // K = U S⁻¹ with S⁻¹ from the Cholesky factor (C × C, small); the columns past m stay zero.
     // Built for size, nalgebra's factorization and solves in plain loops (the same bits, see
     // `cholesky_inverse`); at opt-level 2 or 3, nalgebra's own, which it unrolls faster.
@@ -550,6 +548,18 @@ fn gain_shared<T: Real, const C: usize>(
         return Err(EskfError::SingularInnovation);
     }
     Ok(())
+}
+
+/// `S ← (S + Sᵀ)·½` entry by entry over the storage, `(s_ij + s_ji)·½` from a copy of `S`:
+/// nalgebra's `s += sᵀ; s *= ½`, without its generic loops.
+#[inline(always)]
+pub(crate) fn symmetrize<T: Real, const C: usize>(s: &mut SMatrix<T, C, C>) {
+    let s0 = *s;
+    for (j, col) in s.as_mut_slice().chunks_exact_mut(C.max(1)).enumerate() {
+        for (i, e) in col.iter_mut().enumerate() {
+            *e = (*e + at(s0.as_slice(), i * C + j)) * T::lit(0.5);
+        }
+    }
 }
 
 /// `A⁻¹` by `nalgebra::Cholesky::new(A)?.inverse()`, operation for operation (the same bits;

@@ -491,3 +491,75 @@ fn symmetrize_is_nalgebras() {
     symmetrize_case::<f64, 3>(181);
     symmetrize_case::<f64, 4>(191);
 }
+
+/// `spd_packed` (the packed rows as slices) against the former indexing of the packed lower
+/// triangle, on symmetric positive definite, indefinite, nearly singular, asymmetric and
+/// non-finite `n × n` matrices.
+fn spd_packed_case<T: Real, const N: usize>(seed: u64) {
+    use super::update::spd_packed;
+    use nalgebra::SMatrix;
+    fn old<T: Real>(a: &[T], n: usize) -> bool {
+        let get = |s: &[T], idx: usize| s.get(idx).copied().unwrap_or_else(T::zero);
+        if a.len() != n * n || !a.iter().all(|x| x.is_finite()) {
+            return false;
+        }
+        let tol = a.iter().fold(T::zero(), |m, x| m.max(x.abs())) * T::lit(1e-6);
+        let sym = (0..n)
+            .all(|j| (j + 1..n).all(|i| (get(a, j * n + i) - get(a, i * n + j)).abs() <= tol));
+        if !sym {
+            return false;
+        }
+        let mut l = [T::zero(); 120];
+        let at = |l: &[T], i: usize, j: usize| get(l, i * (i + 1) / 2 + j);
+        for i in 0..n {
+            for j in 0..=i {
+                let mut s = get(a, j * n + i);
+                for k in 0..j {
+                    s -= at(&l, i, k) * at(&l, j, k);
+                }
+                let v = if i == j {
+                    if !super::imu::greater(s, T::zero()) {
+                        return false;
+                    }
+                    s.sqrt()
+                } else {
+                    s / at(&l, j, j)
+                };
+                if let Some(e) = l.get_mut(i * (i + 1) / 2 + j) {
+                    *e = v;
+                }
+            }
+        }
+        true
+    }
+    let mut rng = Lcg(seed);
+    let mut accepted = 0;
+    for i in 0..300 {
+        let b = SMatrix::<T, N, N>::from_fn(|_, _| T::lit(rng.next()));
+        let shift = T::lit([1e-9, 1e-3, 0.1, 1.0, -0.05][i % 5]);
+        let mut a = b * b.transpose() + SMatrix::<T, N, N>::identity() * shift;
+        if i % 7 == 0 {
+            if let Some(e) = a.get_mut((N - 1, 0)) {
+                *e = number(&mut rng, i);
+            }
+        }
+        if i % 11 == 0 {
+            if let Some(e) = a.get_mut((1, 1)) {
+                *e = -*e;
+            }
+        }
+        let new = spd_packed(a.as_slice(), N);
+        assert_eq!(new, old(a.as_slice(), N));
+        accepted += usize::from(new);
+    }
+    assert!(accepted > 50);
+}
+
+#[test]
+fn spd_packed_is_the_former_recurrence() {
+    spd_packed_case::<f32, 3>(193);
+    spd_packed_case::<f32, 6>(197);
+    spd_packed_case::<f32, 15>(199);
+    spd_packed_case::<f64, 15>(211);
+    spd_packed_case::<f64, 1>(223);
+}

@@ -113,18 +113,21 @@ const PACKED_MAX_DIM: usize = MAX_STATE;
 /// row: `(i, j) ↦ i(i+1)/2 + j`), 480 bytes for `f32` instead of a full copy. Not generic over
 /// the size: one copy of this code serves every matrix.
 #[inline(never)]
-fn spd_packed<T: Real>(a: &[T], n: usize) -> bool {
+pub(crate) fn spd_packed<T: Real>(a: &[T], n: usize) -> bool {
     if !finite_symmetric(a, n) {
         return false;
     }
-    let get = |s: &[T], idx: usize| s.get(idx).copied().unwrap_or_else(T::zero);
     let mut l = [T::zero(); PACKED_MAX_DIM * (PACKED_MAX_DIM + 1) / 2];
-    let at = |l: &[T], i: usize, j: usize| get(l, i * (i + 1) / 2 + j);
     for i in 0..n {
+        let ri = i * (i + 1) / 2;
         for j in 0..=i {
-            let mut s = get(a, j * n + i);
-            for k in 0..j {
-                s -= at(&l, i, k) * at(&l, j, k);
+            let rj = j * (j + 1) / 2;
+            let mut s = at(a, j * n + i);
+            // Σ_k<j L_ik L_jk over the packed rows i and j, k ascending.
+            if let (Some(li), Some(lj)) = (l.get(ri..ri + j), l.get(rj..rj + j)) {
+                for (x, y) in li.iter().zip(lj) {
+                    s -= *x * *y;
+                }
             }
             let v = if i == j {
                 if !greater(s, T::zero()) {
@@ -132,9 +135,9 @@ fn spd_packed<T: Real>(a: &[T], n: usize) -> bool {
                 }
                 s.sqrt()
             } else {
-                s / at(&l, j, j)
+                s / at(&l, rj + j)
             };
-            match l.get_mut(i * (i + 1) / 2 + j) {
+            match l.get_mut(ri + j) {
                 Some(e) => *e = v,
                 None => return false,
             }

@@ -6,7 +6,7 @@ use super::error::EskfError;
 use super::state::{AhrsState, InsState};
 use crate::lie::{skew, LieGroup, So3};
 use crate::Real;
-use nalgebra::{Matrix3, SMatrix, Vector3};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 /// One IMU sample: body angular rate `ω_m` (rad/s), specific force `f_m` (m/s²), and the interval
 /// `dt` (s) over which both are taken as constant.
@@ -484,6 +484,21 @@ fn scaled<T: Real>(mut m: Matrix3<T>, s: T) -> Matrix3<T> {
         *x *= s;
     }
     m
+}
+
+/// `√max(P_ii, 0)` for each `i`: a filter's 1-σ, entry by entry over the storage (nalgebra's
+/// `diagonal().map(..)` without its generic loops).
+pub(crate) fn sigmas<T: Real, const N: usize>(p: &SMatrix<T, N, N>) -> SVector<T, N> {
+    let mut out = SVector::<T, N>::zeros();
+    for (i, e) in out.as_mut_slice().iter_mut().enumerate() {
+        let d = p
+            .as_slice()
+            .get(i * (N + 1))
+            .copied()
+            .unwrap_or_else(T::zero);
+        *e = d.max(T::zero()).sqrt();
+    }
+    out
 }
 
 /// `mᵀ` for a 3×3 matrix, entry by entry (out of line when built for size: nalgebra's

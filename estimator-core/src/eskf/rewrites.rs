@@ -563,3 +563,22 @@ fn spd_packed_is_the_former_recurrence() {
     spd_packed_case::<f64, 15>(211);
     spd_packed_case::<f64, 1>(223);
 }
+
+/// `imu::sigmas` against `diagonal().map(|d| d.max(0).sqrt())`, the former `sigmas()` body.
+fn sigmas_case<T: Real, const N: usize>(seed: u64) {
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    for i in 0..200 {
+        let p = SMatrix::<T, N, N>::from_fn(|r, c| number(&mut rng, i / 2 + 3 * r + c));
+        let old = p.diagonal().map(|d| d.max(T::zero()).sqrt());
+        assert!(same(super::imu::sigmas(&p).as_slice(), old.as_slice()));
+    }
+}
+
+#[test]
+fn sigmas_are_the_diagonal_map() {
+    sigmas_case::<f32, 15>(227);
+    sigmas_case::<f32, 6>(229);
+    sigmas_case::<f64, 15>(233);
+    sigmas_case::<f64, 6>(239);
+}

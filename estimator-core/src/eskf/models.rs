@@ -553,7 +553,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
         let all = [k.fx, k.fy, k.cx, k.cy, self.min_depth];
         if !(finite(&self.pixel)
             && finite(&self.landmark)
-            && all.iter().all(|v| v.is_finite())
+            && super::imu::sum_times_zero_is_zero(&all)
             && self.body_from_camera.is_finite())
         {
             return Err(EskfError::NonFinite);
@@ -576,9 +576,14 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
             z,
         );
         let jc = mm(&jpi, &rcb);
+        // −(J_c Rᵀ), negated entry by entry over the storage (nalgebra's `-m` is a generic loop).
+        let mut jp = mm(&jc, &rt);
+        for e in jp.as_mut_slice() {
+            *e = -*e;
+        }
         Ok(Linearization {
             residual: Vector2::new(self.pixel.x - uv.x, self.pixel.y - uv.y),
-            jacobian: jacobian(&[(0, mm(&jc, &skew(&q))), (6, -mm(&jc, &rt))]),
+            jacobian: jacobian(&[(0, mm(&jc, &skew(&q))), (6, jp)]),
         })
     }
     fn noise(&self) -> Matrix2<T> {

@@ -582,3 +582,91 @@ fn sigmas_are_the_diagonal_map() {
     sigmas_case::<f64, 15>(233);
     sigmas_case::<f64, 6>(239);
 }
+
+/// `CameraLandmark::linearize` against its former body (nalgebra's `transpose`, `-m` and the
+/// finiteness iterator): the same residual and Jacobian bits.
+fn camera_case<T: Real>(seed: u64) {
+    use super::models::{CameraLandmark, PinholeIntrinsics};
+    use super::state::InsState;
+    use super::update::Measurement;
+    use crate::lie::{skew, Se3};
+    use nalgebra::{SMatrix, Vector2};
+    let mut rng = Lcg(seed);
+    let rot = |rng: &mut Lcg| {
+        let axis = Vector3::new(rng.next(), rng.next(), rng.next());
+        let q = UnitQuaternion::from_scaled_axis(axis * 3.0)
+            .coords
+            .map(T::lit);
+        So3::from_unit_quaternion(UnitQuaternion::new_unchecked(q.into()))
+    };
+    let mut accepted = 0;
+    for i in 0..400 {
+        let x = InsState {
+            attitude: rot(&mut rng),
+            position: Vector3::new(rng.next(), rng.next(), rng.next()).map(T::lit),
+            ..InsState::identity()
+        };
+        let cam = CameraLandmark::new(
+            Vector2::new(T::lit(300.0 * rng.next()), T::lit(200.0 * rng.next())),
+            Vector3::new(3.0 * rng.next(), 3.0 * rng.next(), 3.0 * rng.next()).map(T::lit),
+            PinholeIntrinsics {
+                fx: T::lit(400.0),
+                fy: T::lit(380.0 + rng.next()),
+                cx: T::lit(320.0),
+                cy: number(&mut rng, i),
+            },
+            Se3::from_parts(
+                rot(&mut rng),
+                Vector3::new(rng.next(), 0.0, 0.1).map(T::lit),
+            ),
+            T::lit(1.5),
+        );
+        let (Ok(lin), Ok((uv, c))) = (cam.linearize(&x), cam.project(&x)) else {
+            continue;
+        };
+        accepted += 1;
+        let k = &cam.intrinsics;
+        let q = x.attitude.inverse().act(&(cam.landmark - x.position));
+        let rcb = cam
+            .body_from_camera
+            .rotation()
+            .rotation_matrix()
+            .transpose();
+        let rt = x.attitude.rotation_matrix().transpose();
+        let iz = T::one() / c.z;
+        let z = T::zero();
+        let jpi = Matrix3::new(
+            k.fx * iz,
+            z,
+            -k.fx * c.x * iz * iz,
+            z,
+            k.fy * iz,
+            -k.fy * c.y * iz * iz,
+            z,
+            z,
+            z,
+        );
+        let jc = mm(&jpi, &rcb);
+        let (ja, jp) = (mm(&jc, &skew(&q)), -mm(&jc, &rt));
+        let mut old = SMatrix::<T, 2, 15>::zeros();
+        for r in 0..2 {
+            for cc in 0..3 {
+                for (col, src) in [(cc, &ja), (6 + cc, &jp)] {
+                    if let (Some(e), Some(v)) = (old.get_mut((r, col)), src.get((r, cc))) {
+                        *e = *v;
+                    }
+                }
+            }
+        }
+        assert!(same(lin.jacobian.as_slice(), old.as_slice()));
+        let res = Vector2::new(cam.pixel.x - uv.x, cam.pixel.y - uv.y);
+        assert!(same(lin.residual.as_slice(), res.as_slice()));
+    }
+    assert!(accepted > 50);
+}
+
+#[test]
+fn camera_linearization_is_the_former_body() {
+    camera_case::<f32>(241);
+    camera_case::<f64>(251);
+}

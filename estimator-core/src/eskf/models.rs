@@ -520,7 +520,12 @@ impl<T: Real> CameraLandmark<T> {
             landmark,
             intrinsics,
             body_from_camera,
-            noise: Matrix2::identity() * (sigma_px * sigma_px),
+            noise: {
+                // `I·σ²` entry by entry (the products of nalgebra's `identity() * σ²`).
+                let s = sigma_px * sigma_px;
+                let (d, o) = (T::one() * s, T::zero() * s);
+                Matrix2::new(d, o, o, d)
+            },
             min_depth: T::lit(0.01),
         }
     }

@@ -670,3 +670,34 @@ fn camera_linearization_is_the_former_body() {
     camera_case::<f32>(241);
     camera_case::<f64>(251);
 }
+
+/// `CameraLandmark::new`'s noise against the former `Matrix2::identity() * σ²`.
+fn camera_noise<T: Real>() {
+    use super::models::{CameraLandmark, PinholeIntrinsics};
+    use crate::lie::Se3;
+    use nalgebra::{Matrix2, Vector2};
+    let mut rng = Lcg(257);
+    for i in 0..200 {
+        let sigma = number::<T>(&mut rng, i);
+        let cam = CameraLandmark::new(
+            Vector2::zeros(),
+            Vector3::zeros(),
+            PinholeIntrinsics {
+                fx: T::one(),
+                fy: T::one(),
+                cx: T::zero(),
+                cy: T::zero(),
+            },
+            Se3::identity(),
+            sigma,
+        );
+        let old = Matrix2::<T>::identity() * (sigma * sigma);
+        assert!(same(cam.noise.as_slice(), old.as_slice()));
+    }
+}
+
+#[test]
+fn camera_noise_is_the_scaled_identity() {
+    camera_noise::<f32>();
+    camera_noise::<f64>();
+}

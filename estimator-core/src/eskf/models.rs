@@ -13,6 +13,7 @@ use crate::Real;
 use nalgebra::{Matrix1, Matrix2, Matrix3, SMatrix, Vector1, Vector2, Vector3};
 
 /// `σ² I` (written out: nalgebra's `identity() * s` is a generic loop at opt-level "s").
+#[cfg_attr(estimator_compact, inline(never))]
 fn iso3<T: Real>(sigma: T) -> Matrix3<T> {
     let (s, z) = (sigma * sigma, T::zero());
     Matrix3::new(s, z, z, z, s, z, z, z, s)

@@ -224,10 +224,11 @@ fn add_cross<T: Real, const N: usize>(m: &mut SMatrix<T, N, N>, i: usize, j: usi
 }
 
 /// `(a + aᵀ)/2`: the symmetric part of a diagonal block (removes the rounding asymmetry).
-#[cfg_attr(estimator_compact, inline(never))]
+/// Built for size, entry by entry over the storage: `(a_ij + a_ji)·½`, the sums and products
+/// of nalgebra's `(a + aᵀ) * ½` without its generic loops.
+#[cfg(estimator_compact)]
+#[inline(never)]
 pub(crate) fn sym<T: Real>(a: &Matrix3<T>) -> Matrix3<T> {
-    // Entry by entry over the storage: `(a_ij + a_ji)·½`, the sums and products of nalgebra's
-    // `(a + aᵀ) * ½` without its generic loops.
     let s = a.as_slice();
     let mut out = *a;
     for (j, col) in out.as_mut_slice().chunks_exact_mut(3).enumerate() {
@@ -236,6 +237,13 @@ pub(crate) fn sym<T: Real>(a: &Matrix3<T>) -> Matrix3<T> {
         }
     }
     out
+}
+
+/// `(a + aᵀ)/2` (see the build for size above); at opt-level 2 or 3 nalgebra's expression, with
+/// which the prediction's instruction counts are budgeted.
+#[cfg(not(estimator_compact))]
+pub(crate) fn sym<T: Real>(a: &Matrix3<T>) -> Matrix3<T> {
+    (a + a.transpose()) * T::lit(0.5)
 }
 
 /// A block column: the `15 × 3` column-major storage of block columns `3j..3j+3` of a 15-row
@@ -293,8 +301,9 @@ impl<T: Real> FRows<T> {
     }
 }
 
-/// `q2 + (q1 + c·½)·dt` entry by entry over the storage: the operations of nalgebra's
-/// `q2 + (q1 + c * ½) * dt` without its generic loops.
+/// `q2 + (q1 + c·½)·dt` entry by entry over the storage when built for size: the operations of
+/// nalgebra's `q2 + (q1 + c * ½) * dt` without its generic loops.
+#[cfg(estimator_compact)]
 #[inline(always)]
 pub(crate) fn row_p<T: Real>(
     mut q2: Matrix3<T>,
@@ -309,6 +318,14 @@ pub(crate) fn row_p<T: Real>(
         }
     }
     q2
+}
+
+/// `q2 + (q1 + c·½)·dt`; at opt-level 2 or 3 nalgebra's expression, with which the prediction's
+/// instruction counts are budgeted.
+#[cfg(not(estimator_compact))]
+#[inline(always)]
+pub(crate) fn row_p<T: Real>(q2: Matrix3<T>, q1: &Matrix3<T>, c: &Matrix3<T>, dt: T) -> Matrix3<T> {
+    q2 + (q1 + c * T::lit(0.5)) * dt
 }
 
 /// The 15-state prediction; writes only after every check passed.
@@ -501,13 +518,22 @@ pub(crate) fn sigmas<T: Real, const N: usize>(p: &SMatrix<T, N, N>) -> SVector<T
     out
 }
 
-/// `mᵀ` for a 3×3 matrix, entry by entry (out of line when built for size: nalgebra's
+/// `mᵀ` for a 3×3 matrix, entry by entry (built for size: out of line, where nalgebra's
 /// `transpose` is a generic loop inlined at every site).
-#[cfg_attr(estimator_compact, inline(never))]
+#[cfg(estimator_compact)]
+#[inline(never)]
 pub(crate) fn tr33<T: Real>(m: &Matrix3<T>) -> Matrix3<T> {
     Matrix3::new(
         m.m11, m.m21, m.m31, m.m12, m.m22, m.m32, m.m13, m.m23, m.m33,
     )
+}
+
+/// `mᵀ`; at opt-level 2 or 3 nalgebra's `transpose`, with which the instruction counts are
+/// budgeted.
+#[cfg(not(estimator_compact))]
+#[inline(always)]
+pub(crate) fn tr33<T: Real>(m: &Matrix3<T>) -> Matrix3<T> {
+    m.transpose()
 }
 
 /// `r f`, entry by entry (the sums of nalgebra's `r * f`, without its generic product loop).

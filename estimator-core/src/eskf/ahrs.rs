@@ -81,7 +81,7 @@ impl<T: Real> Ahrs<T> {
     /// `√diag(P)`.
     #[must_use]
     pub fn sigmas(&self) -> SVector<T, 6> {
-        self.covariance.diagonal().map(|d| d.max(T::zero()).sqrt())
+        super::imu::sigmas(&self.covariance)
     }
 
     /// Propagates with one gyro sample: `R⁺ = R exp((ω_m − b_g) dt)`, `P⁺ = F P Fᵀ + Q`

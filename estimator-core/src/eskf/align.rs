@@ -10,8 +10,8 @@
 //! * Initial gyro bias: the mean angular rate `ω̄` (the body does not rotate).
 
 use super::error::EskfError;
-use super::imu::{axpy, finite, mm};
-use super::models::{add3, div3, neg3};
+use super::imu::{axpy, finite, mm, tr33};
+use super::models::{add3, div3, dot3, neg3, norm3};
 use crate::lie::So3;
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
@@ -55,9 +55,9 @@ fn mean<T: Real>(xs: &[Vector3<T>]) -> Result<Vector3<T>, EskfError> {
 /// The unit vector along the part of `v` orthogonal to the unit `u`, if any.
 fn horizontal<T: Real>(v: &Vector3<T>, u: &Vector3<T>) -> Option<Vector3<T>> {
     // `v − u (u·v)` as `v + u·(−u·v)`: the same bits (negation is exact).
-    let h = axpy(v, u, -u.dot(v));
-    let n = h.norm();
-    if n > T::lit(1e-6) * v.norm() && n > T::zero() {
+    let h = axpy(v, u, -dot3(u, v));
+    let n = norm3(&h);
+    if n > T::lit(1e-6) * norm3(v) && n > T::zero() {
         Some(div3(&h, n))
     } else {
         None
@@ -68,6 +68,23 @@ fn horizontal<T: Real>(v: &Vector3<T>, u: &Vector3<T>) -> Option<Vector3<T>> {
 /// `x` is along `u` (module docs).
 fn level_axis<T: Real>(u: &Vector3<T>) -> Option<Vector3<T>> {
     horizontal(&Vector3::x(), u).or_else(|| horizontal(&Vector3::y(), u))
+}
+
+/// The triad `[u, h, u × h]` (columns), or its transpose (rows) when `transposed`; the cross
+/// product written out as nalgebra's `cross` (the same products and differences), without its
+/// generic code.
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn triad<T: Real>(u: &Vector3<T>, h: &Vector3<T>, transposed: bool) -> Matrix3<T> {
+    let c = Vector3::new(
+        u.y * h.z - u.z * h.y,
+        u.z * h.x - u.x * h.z,
+        u.x * h.y - u.y * h.x,
+    );
+    if transposed {
+        Matrix3::new(u.x, u.y, u.z, h.x, h.y, h.z, c.x, c.y, c.z)
+    } else {
+        Matrix3::new(u.x, h.x, c.x, u.y, h.y, c.y, u.z, h.z, c.z)
+    }
 }
 
 /// Static alignment from samples at rest.
@@ -89,7 +106,7 @@ pub fn align_at_rest<T: Real>(
     if !(finite(gravity) && rest_tolerance.is_finite()) {
         return Err(EskfError::NonFinite);
     }
-    let (nf, ng) = (f.norm(), gravity.norm());
+    let (nf, ng) = (norm3(&f), norm3(gravity));
     if !(nf > T::zero() && ng > T::zero()) {
         return Err(EskfError::ZeroNorm);
     }
@@ -112,10 +129,9 @@ pub fn align_at_rest<T: Real>(
         return Err(EskfError::ZeroNorm);
     };
     let from_mag = mag.is_some();
-    let b = Matrix3::from_columns(&[ub, hb, ub.cross(&hb)]);
-    let wm = Matrix3::from_columns(&[uw, hw, uw.cross(&hw)]);
-    let attitude =
-        So3::from_rotation_matrix(&mm(&wm, &b.transpose())).ok_or(EskfError::NonFinite)?;
+    // R = W Bᵀ, W = [u_w, h_w, u_w × h_w], B = [u_b, h_b, u_b × h_b] (columns).
+    let attitude = So3::from_rotation_matrix(&mm(&triad(&uw, &hw, false), &triad(&ub, &hb, true)))
+        .ok_or(EskfError::NonFinite)?;
     Ok(Alignment {
         attitude,
         gyro_bias: w,
@@ -177,7 +193,7 @@ impl<T: Real> InitialSigmas<T> {
             e(up.z, up.y, o),
             e(up.z, up.z, t2),
         );
-        mm(&mm(&r.transpose(), &sw), &r)
+        mm(&mm(&tr33(&r), &sw), &r)
     }
 }
 
@@ -188,7 +204,7 @@ pub(crate) fn prior_attitude_covariance<T: Real>(
     sigmas: &InitialSigmas<T>,
     config: &super::imu::FilterConfig<T>,
 ) -> Result<nalgebra::Matrix3<T>, EskfError> {
-    let gn = config.gravity.norm();
+    let gn = norm3(&config.gravity);
     if !super::imu::greater(gn, T::zero()) {
         return Err(EskfError::ZeroNorm);
     }

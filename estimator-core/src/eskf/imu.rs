@@ -6,7 +6,7 @@ use super::error::EskfError;
 use super::state::{AhrsState, InsState};
 use crate::lie::{skew, LieGroup, So3};
 use crate::Real;
-use nalgebra::{Matrix3, SMatrix, Vector3};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 /// One IMU sample: body angular rate `ω_m` (rad/s), specific force `f_m` (m/s²), and the interval
 /// `dt` (s) over which both are taken as constant.
@@ -224,7 +224,24 @@ fn add_cross<T: Real, const N: usize>(m: &mut SMatrix<T, N, N>, i: usize, j: usi
 }
 
 /// `(a + aᵀ)/2`: the symmetric part of a diagonal block (removes the rounding asymmetry).
-#[cfg_attr(estimator_compact, inline(never))]
+/// Built for size, entry by entry over the storage: `(a_ij + a_ji)·½`, the sums and products
+/// of nalgebra's `(a + aᵀ) * ½` without its generic loops.
+#[cfg(estimator_compact)]
+#[inline(never)]
+pub(crate) fn sym<T: Real>(a: &Matrix3<T>) -> Matrix3<T> {
+    let s = a.as_slice();
+    let mut out = *a;
+    for (j, col) in out.as_mut_slice().chunks_exact_mut(3).enumerate() {
+        for (i, e) in col.iter_mut().enumerate() {
+            *e = (*e + s.get(3 * i + j).copied().unwrap_or_else(T::zero)) * T::lit(0.5);
+        }
+    }
+    out
+}
+
+/// `(a + aᵀ)/2` (see the build for size above); at opt-level 2 or 3 nalgebra's expression, with
+/// which the prediction's instruction counts are budgeted.
+#[cfg(not(estimator_compact))]
 pub(crate) fn sym<T: Real>(a: &Matrix3<T>) -> Matrix3<T> {
     (a + a.transpose()) * T::lit(0.5)
 }
@@ -279,12 +296,36 @@ impl<T: Real> FRows<T> {
         } else {
             Matrix3::zeros()
         };
-        [
-            top,
-            add33(&q1, &c),
-            col_blk(q, 2) + (q1 + c * T::lit(0.5)) * self.dt,
-        ]
+        let p_row = row_p(col_blk(q, 2), &q1, &c, self.dt);
+        [top, add33(&q1, &c), p_row]
     }
+}
+
+/// `q2 + (q1 + c·½)·dt` entry by entry over the storage when built for size: the operations of
+/// nalgebra's `q2 + (q1 + c * ½) * dt` without its generic loops.
+#[cfg(estimator_compact)]
+#[inline(always)]
+pub(crate) fn row_p<T: Real>(
+    mut q2: Matrix3<T>,
+    q1: &Matrix3<T>,
+    c: &Matrix3<T>,
+    dt: T,
+) -> Matrix3<T> {
+    let (q1, c) = (q1.as_slice(), c.as_slice());
+    for (k, e) in q2.as_mut_slice().iter_mut().enumerate() {
+        if let (Some(a), Some(b)) = (q1.get(k), c.get(k)) {
+            *e += (*a + *b * T::lit(0.5)) * dt;
+        }
+    }
+    q2
+}
+
+/// `q2 + (q1 + c·½)·dt`; at opt-level 2 or 3 nalgebra's expression, with which the prediction's
+/// instruction counts are budgeted.
+#[cfg(not(estimator_compact))]
+#[inline(always)]
+pub(crate) fn row_p<T: Real>(q2: Matrix3<T>, q1: &Matrix3<T>, c: &Matrix3<T>, dt: T) -> Matrix3<T> {
+    q2 + (q1 + c * T::lit(0.5)) * dt
 }
 
 /// The 15-state prediction; writes only after every check passed.
@@ -320,7 +361,7 @@ pub(crate) fn predict_ins<T: Real>(
     };
 
     let fr = FRows {
-        f00: dr.rotation_matrix().transpose(),
+        f00: tr33(&dr.rotation_matrix()),
         f03: scaled(jr, -dt),
         b: scaled(r, -dt),
         fx: skew(&f),
@@ -353,7 +394,7 @@ pub(crate) fn predict_ins<T: Real>(
         let out = fr.apply(q, t <= 5);
         for (i, m) in out.iter().enumerate() {
             if t < 5 {
-                set_blk_rc(&mut l, j, i, &m.transpose());
+                set_blk_rc(&mut l, j, i, &tr33(m));
             } else if i == j {
                 set_blk_rc(&mut l, i, j, &sym(m));
             } else if i > j {
@@ -376,7 +417,7 @@ pub(crate) fn predict_ins<T: Real>(
             let n = blk_rc(&l, k, i);
             set_blk(p, k, i, &n);
             if k > i {
-                set_blk(p, i, k, &n.transpose());
+                set_blk(p, i, k, &tr33(&n));
             }
         }
     }
@@ -422,17 +463,17 @@ pub(crate) fn predict_ahrs<T: Real>(
     let (dr, jr) = So3::exp_jac(&(axpy(gyro, &x.gyro_bias, -T::one()) * dt));
     // F00 = ΔRᵀ, so F00ᵀ = ΔR (no transpose pass).
     let f00t = dr.rotation_matrix();
-    let f00 = f00t.transpose();
+    let f00 = tr33(&f00t);
     let f01 = scaled(jr, -dt);
     let p00 = blk(p, 0, 0);
     let p01 = blk(p, 0, 1);
     let p11 = blk(p, 1, 1);
     // M0j = F00 P0j + F01 P1j; P⁺00 = M00 F00ᵀ + M01 F01ᵀ; P⁺01 = M01; P⁺11 = P11.
-    let m00 = add33(&mm(&f00, &p00), &mm(&f01, &p01.transpose()));
+    let m00 = add33(&mm(&f00, &p00), &mm(&f01, &tr33(&p01)));
     let m01 = add33(&mm(&f00, &p01), &mm(&f01, &p11));
     // N00 = M00 F00ᵀ + M01 F01ᵀ is symmetric: its upper triangle, mirrored (exactly symmetric
     // without a separate symmetrization; at opt-level 3 the unused lower products are dead).
-    let n = add33(&mm(&m00, &f00t), &mm(&m01, &f01.transpose()));
+    let n = add33(&mm(&m00, &f00t), &mm(&m01, &tr33(&f01)));
     let n00 = Matrix3::new(
         n.m11, n.m12, n.m13, n.m12, n.m22, n.m23, n.m13, n.m23, n.m33,
     );
@@ -442,7 +483,7 @@ pub(crate) fn predict_ahrs<T: Real>(
     }
     set_blk(p, 0, 0, &n00);
     set_blk(p, 0, 1, &m01);
-    set_blk(p, 1, 0, &m01.transpose());
+    set_blk(p, 1, 0, &tr33(&m01));
     let n = &cfg.imu_noise;
     add_diag(
         p,
@@ -460,6 +501,39 @@ fn scaled<T: Real>(mut m: Matrix3<T>, s: T) -> Matrix3<T> {
         *x *= s;
     }
     m
+}
+
+/// `√max(P_ii, 0)` for each `i`: a filter's 1-σ, entry by entry over the storage (nalgebra's
+/// `diagonal().map(..)` without its generic loops).
+pub(crate) fn sigmas<T: Real, const N: usize>(p: &SMatrix<T, N, N>) -> SVector<T, N> {
+    let mut out = SVector::<T, N>::zeros();
+    for (i, e) in out.as_mut_slice().iter_mut().enumerate() {
+        let d = p
+            .as_slice()
+            .get(i * (N + 1))
+            .copied()
+            .unwrap_or_else(T::zero);
+        *e = d.max(T::zero()).sqrt();
+    }
+    out
+}
+
+/// `mᵀ` for a 3×3 matrix, entry by entry (built for size: out of line, where nalgebra's
+/// `transpose` is a generic loop inlined at every site).
+#[cfg(estimator_compact)]
+#[inline(never)]
+pub(crate) fn tr33<T: Real>(m: &Matrix3<T>) -> Matrix3<T> {
+    Matrix3::new(
+        m.m11, m.m21, m.m31, m.m12, m.m22, m.m32, m.m13, m.m23, m.m33,
+    )
+}
+
+/// `mᵀ`; at opt-level 2 or 3 nalgebra's `transpose`, with which the instruction counts are
+/// budgeted.
+#[cfg(not(estimator_compact))]
+#[inline(always)]
+pub(crate) fn tr33<T: Real>(m: &Matrix3<T>) -> Matrix3<T> {
+    m.transpose()
 }
 
 /// `r f`, entry by entry (the sums of nalgebra's `r * f`, without its generic product loop).

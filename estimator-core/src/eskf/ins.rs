@@ -89,7 +89,7 @@ impl<T: Real> Ins<T> {
     /// `√diag(P)`, the 1-σ of each error-state component.
     #[must_use]
     pub fn sigmas(&self) -> SVector<T, 15> {
-        self.covariance.diagonal().map(|d| d.max(T::zero()).sqrt())
+        super::imu::sigmas(&self.covariance)
     }
 
     /// Propagates with one IMU sample (module docs: nominal integration, `P⁺ = F P Fᵀ + Q`).

@@ -5,7 +5,7 @@
 //! `R[−b]×`).
 
 use super::error::EskfError;
-use super::imu::{finite, greater, mm};
+use super::imu::{finite, greater, mm, tr33};
 use super::state::{ErrorState, InsState};
 use super::update::{Linearization, Measurement};
 use crate::lie::{skew, LieGroup, Se3, So3};
@@ -13,6 +13,7 @@ use crate::Real;
 use nalgebra::{Matrix1, Matrix2, Matrix3, SMatrix, Vector1, Vector2, Vector3};
 
 /// `σ² I` (written out: nalgebra's `identity() * s` is a generic loop at opt-level "s").
+#[cfg_attr(estimator_compact, inline(never))]
 fn iso3<T: Real>(sigma: T) -> Matrix3<T> {
     let (s, z) = (sigma * sigma, T::zero());
     Matrix3::new(s, z, z, z, s, z, z, z, s)
@@ -77,6 +78,19 @@ pub(crate) fn div3<T: Real>(v: &Vector3<T>, s: T) -> Vector3<T> {
 #[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn neg3<T: Real>(v: &Vector3<T>) -> Vector3<T> {
     Vector3::new(-v.x, -v.y, -v.z)
+}
+
+/// `a · b = a_x b_x + a_y b_y + a_z b_z`, summed left to right: the products and sums of
+/// nalgebra's `dot` (and `norm_squared`, which adds that to a leading zero: `0 + s = s` for a sum
+/// of squares), without its generic code.
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn dot3<T: Real>(a: &Vector3<T>, b: &Vector3<T>) -> T {
+    a.x * b.x + a.y * b.y + a.z * b.z
+}
+
+/// `‖v‖ = √(v · v)`, as nalgebra's `norm`.
+pub(crate) fn norm3<T: Real>(v: &Vector3<T>) -> T {
+    dot3(v, v).sqrt()
 }
 
 /// GNSS antenna position in the world frame, with the antenna at `lever_arm` in the body frame.
@@ -263,7 +277,9 @@ impl<T: Real> Magnetometer<T> {
         if !(finite(&self.field) && finite(&self.reference)) {
             return Err(EskfError::NonFinite);
         }
-        if self.field.norm_squared() <= T::zero() || self.reference.norm_squared() <= T::zero() {
+        if dot3(&self.field, &self.field) <= T::zero()
+            || dot3(&self.reference, &self.reference) <= T::zero()
+        {
             return Err(EskfError::ZeroNorm);
         }
         let (hx, h_att) = in_body(attitude, &self.reference);
@@ -320,7 +336,7 @@ impl<T: Real> GravityDirection<T> {
         if !(finite(&self.accel) && finite(&self.up)) {
             return Err(EskfError::NonFinite);
         }
-        let (na, nu) = (self.accel.norm(), self.up.norm());
+        let (na, nu) = (norm3(&self.accel), norm3(&self.up));
         if !(na > T::zero() && nu > T::zero()) {
             return Err(EskfError::ZeroNorm);
         }
@@ -375,7 +391,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
         if !(finite(&self.accel) && finite(&self.gravity)) {
             return Err(EskfError::NonFinite);
         }
-        if self.accel.norm_squared() <= T::zero() {
+        if dot3(&self.accel, &self.accel) <= T::zero() {
             return Err(EskfError::ZeroNorm);
         }
         let (f, h_att) = in_body(&x.attitude, &neg3(&self.gravity));
@@ -505,7 +521,12 @@ impl<T: Real> CameraLandmark<T> {
             landmark,
             intrinsics,
             body_from_camera,
-            noise: Matrix2::identity() * (sigma_px * sigma_px),
+            noise: {
+                // `I·σ²` entry by entry (the products of nalgebra's `identity() * σ²`).
+                let s = sigma_px * sigma_px;
+                let (d, o) = (T::one() * s, T::zero() * s);
+                Matrix2::new(d, o, o, d)
+            },
             min_depth: T::lit(0.01),
         }
     }
@@ -538,18 +559,14 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
         let all = [k.fx, k.fy, k.cx, k.cy, self.min_depth];
         if !(finite(&self.pixel)
             && finite(&self.landmark)
-            && all.iter().all(|v| v.is_finite())
+            && super::imu::sum_times_zero_is_zero(&all)
             && self.body_from_camera.is_finite())
         {
             return Err(EskfError::NonFinite);
         }
         let (uv, c, q) = self.project_parts(x)?;
-        let rcb = self
-            .body_from_camera
-            .rotation()
-            .rotation_matrix()
-            .transpose();
-        let rt = x.attitude.rotation_matrix().transpose();
+        let rcb = tr33(&self.body_from_camera.rotation().rotation_matrix());
+        let rt = tr33(&x.attitude.rotation_matrix());
         let iz = T::one() / c.z;
         let z = T::zero();
         // ∂π/∂c with a zero third row, so that the 3×3 `mm` serves (rows 0, 1 are used).
@@ -565,9 +582,14 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
             z,
         );
         let jc = mm(&jpi, &rcb);
+        // −(J_c Rᵀ), negated entry by entry over the storage (nalgebra's `-m` is a generic loop).
+        let mut jp = mm(&jc, &rt);
+        for e in jp.as_mut_slice() {
+            *e = -*e;
+        }
         Ok(Linearization {
             residual: Vector2::new(self.pixel.x - uv.x, self.pixel.y - uv.y),
-            jacobian: jacobian(&[(0, mm(&jc, &skew(&q))), (6, -mm(&jc, &rt))]),
+            jacobian: jacobian(&[(0, mm(&jc, &skew(&q))), (6, jp)]),
         })
     }
     fn noise(&self) -> Matrix2<T> {

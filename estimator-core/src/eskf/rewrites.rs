@@ -4,7 +4,7 @@
 
 use super::align::InitialSigmas;
 use super::imu::{add33, axpy, mm, mv, ImuNoise};
-use super::models::{add3, div3, neg3, sub3};
+use super::models::{add3, div3, dot3, neg3, norm3, sub3};
 use super::state::{plus_seg, seg};
 use crate::lie::{LieGroup, So3};
 use crate::Real;
@@ -119,6 +119,9 @@ fn vector_helpers<T: Real>() {
         assert!(same(add3(&a, &b).as_slice(), (a + b).as_slice()));
         assert!(same(div3(&a, s).as_slice(), (a / s).as_slice()));
         assert!(same(neg3(&a).as_slice(), (-a).as_slice()));
+        assert!(same(&[dot3(&a, &b)], &[a.dot(&b)]));
+        assert!(same(&[dot3(&a, &a)], &[a.norm_squared()]));
+        assert!(same(&[norm3(&a)], &[a.norm()]));
         assert!(same(div3(&neg3(&a), s).as_slice(), (-a / s).as_slice()));
         let old = a - b * b.dot(&a);
         assert!(same(axpy(&a, &b, -b.dot(&a)).as_slice(), old.as_slice()));
@@ -179,6 +182,26 @@ fn products<T: Real>() {
         assert!(same(add33(&a, &b).as_slice(), (a + b).as_slice()));
         let old = a * b.transpose();
         assert!(same(mm(&a, &b.transpose()).as_slice(), old.as_slice()));
+        assert!(same(
+            super::imu::tr33(&a).as_slice(),
+            a.transpose().as_slice()
+        ));
+        let dt = number::<T>(&mut rng, i / 11);
+        let old = a + (b + (a * b) * T::lit(0.5)) * dt;
+        let new = super::imu::row_p(a, &b, &(a * b), dt);
+        assert!(same(new.as_slice(), old.as_slice()));
+        let old = (a + a.transpose()) * T::lit(0.5);
+        assert!(same(super::imu::sym(&a).as_slice(), old.as_slice()));
+        let old = Matrix3::from_columns(&[f, g, f.cross(&g)]);
+        assert!(same(
+            super::align::triad(&f, &g, false).as_slice(),
+            old.as_slice()
+        ));
+        let old = old.transpose();
+        assert!(same(
+            super::align::triad(&f, &g, true).as_slice(),
+            old.as_slice()
+        ));
     }
 }
 
@@ -324,4 +347,357 @@ fn mat_vec_is_nalgebras_product() {
     mat_vec_case::<f64, 15, 3>(101);
     mat_vec_case::<f64, 1, 1>(103);
     mat_vec_case::<f64, 4, 2>(107);
+}
+
+/// The update's checks in their compact forms against the expressions they replace:
+/// `positive_finite(d)` is `d.is_finite() && d > 0` (the reset's diagonal test), and
+/// `sum_times_zero_is_zero` is the fold of `is_finite` (`finite_symmetric`), on every kind of
+/// number (signed zeros, subnormals, the largest finite, infinities, NaN).
+fn update_checks<T: Real>() {
+    use super::imu::sum_times_zero_is_zero;
+    use super::update::positive_finite;
+    let mut rng = Lcg(109);
+    let specials = [
+        T::lit(0.0),
+        T::lit(-0.0),
+        T::lit(f64::from(f32::MIN_POSITIVE) / 4.0),
+        T::lit(-f64::from(f32::MIN_POSITIVE) / 4.0),
+        T::lit(f64::from(f32::MAX)),
+        T::lit(-f64::from(f32::MAX)),
+        T::lit(f64::MAX),
+        T::lit(f64::MIN_POSITIVE / 4.0),
+    ];
+    for d in specials
+        .iter()
+        .copied()
+        .chain((0..400).map(|i| number::<T>(&mut rng, i)))
+    {
+        assert_eq!(positive_finite(d), d.is_finite() && d > T::zero());
+    }
+    for i in 0..400 {
+        let a: [T; 9] = core::array::from_fn(|r| {
+            if (i + r) % 5 == 0 {
+                number(&mut rng, i + r)
+            } else {
+                T::lit(rng.next() * 1e3)
+            }
+        });
+        for len in [0, 1, 4, 9] {
+            let s = a.get(..len).unwrap_or(&[]);
+            let old = s.iter().fold(true, |acc, x| acc & x.is_finite());
+            assert_eq!(sum_times_zero_is_zero(s), old);
+        }
+    }
+}
+
+#[test]
+fn update_checks_are_the_plain_predicates() {
+    update_checks::<f32>();
+    update_checks::<f64>();
+}
+
+/// `rows_into` (`Hᵀ` read column by column of `H`) against the former copy (written column by
+/// column of `Hᵀ`), for every row count of a core with capacity 3, and past-the-end padding.
+fn rows_into_case<T: Real, const N: usize, const M: usize>(seed: u64) {
+    use super::update::rows_into;
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    for i in 0..100 {
+        let h = SMatrix::<T, M, N>::from_fn(|r, c| number(&mut rng, i + 3 * r + c));
+        let r_in = SVector::<T, M>::from_fn(|r, _| number(&mut rng, i + r));
+        let (h, r_in) = (h.as_slice(), r_in.as_slice());
+        let mut old_ht = SMatrix::<T, N, 3>::from_element(T::lit(f64::NAN));
+        let mut old_r = SVector::<T, 3>::from_element(T::lit(f64::NAN));
+        {
+            let (ht, r) = (old_ht.as_mut_slice(), old_r.as_mut_slice());
+            let m = r_in.len().max(1);
+            let n = h.len() / m;
+            ht.fill(T::zero());
+            for (c, col) in ht.chunks_exact_mut(n.max(1)).enumerate().take(r_in.len()) {
+                for (j, e) in col.iter_mut().enumerate() {
+                    *e = h.get(j * m + c).copied().unwrap_or_else(T::zero);
+                }
+            }
+            r.fill(T::zero());
+            for (d, s) in r.iter_mut().zip(r_in) {
+                *d = *s;
+            }
+        }
+        let mut ht = SMatrix::<T, N, 3>::from_element(T::lit(f64::NAN));
+        let mut r = SVector::<T, 3>::from_element(T::lit(f64::NAN));
+        rows_into(h, r_in, ht.as_mut_slice(), r.as_mut_slice());
+        assert!(same(ht.as_slice(), old_ht.as_slice()));
+        assert!(same(r.as_slice(), old_r.as_slice()));
+    }
+}
+
+#[test]
+fn rows_into_is_the_former_copy() {
+    rows_into_case::<f32, 15, 1>(113);
+    rows_into_case::<f32, 15, 2>(127);
+    rows_into_case::<f32, 15, 3>(131);
+    rows_into_case::<f32, 6, 1>(137);
+    rows_into_case::<f64, 6, 3>(139);
+    rows_into_case::<f64, 15, 2>(149);
+}
+
+/// `nis` (over the storage slices) against `rᵀ (S⁻¹ r)` through nalgebra's product and
+/// iterators, the former form.
+fn nis_case<T: Real, const C: usize>(seed: u64) {
+    use super::update::nis;
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    for i in 0..400 {
+        let s_inv = SMatrix::<T, C, C>::from_fn(|r, c| number(&mut rng, i / 3 + 2 * r + c));
+        let r = SVector::<T, C>::from_fn(|r, _| number(&mut rng, i / 2 + r));
+        let y = s_inv * r;
+        let old = r
+            .iter()
+            .zip(y.iter())
+            .fold(T::zero(), |acc, (a, b)| acc + *a * *b);
+        assert!(same(&[nis(&s_inv, &r)], &[old]));
+    }
+}
+
+#[test]
+fn nis_is_the_former_sum() {
+    nis_case::<f32, 3>(151);
+    nis_case::<f32, 2>(157);
+    nis_case::<f64, 3>(163);
+    nis_case::<f64, 1>(167);
+}
+
+/// The gain's `symmetrize` against nalgebra's `s += sᵀ; s *= ½` on `C × C` matrices.
+fn symmetrize_case<T: Real, const C: usize>(seed: u64) {
+    use super::update::symmetrize;
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    for i in 0..400 {
+        let a = SMatrix::<T, C, C>::from_fn(|r, c| number(&mut rng, i / 3 + 2 * r + c));
+        let mut old = a;
+        let st = old.transpose();
+        old += st;
+        old *= T::lit(0.5);
+        let mut new = a;
+        symmetrize(&mut new);
+        assert!(same(new.as_slice(), old.as_slice()));
+    }
+}
+
+#[test]
+fn symmetrize_is_nalgebras() {
+    symmetrize_case::<f32, 3>(173);
+    symmetrize_case::<f32, 2>(179);
+    symmetrize_case::<f64, 3>(181);
+    symmetrize_case::<f64, 4>(191);
+}
+
+/// `spd_packed` (the packed rows as slices) against the former indexing of the packed lower
+/// triangle, on symmetric positive definite, indefinite, nearly singular, asymmetric and
+/// non-finite `n × n` matrices.
+fn spd_packed_case<T: Real, const N: usize>(seed: u64) {
+    use super::update::spd_packed;
+    use nalgebra::SMatrix;
+    fn old<T: Real>(a: &[T], n: usize) -> bool {
+        let get = |s: &[T], idx: usize| s.get(idx).copied().unwrap_or_else(T::zero);
+        if a.len() != n * n || !a.iter().all(|x| x.is_finite()) {
+            return false;
+        }
+        let tol = a.iter().fold(T::zero(), |m, x| m.max(x.abs())) * T::lit(1e-6);
+        let sym = (0..n)
+            .all(|j| (j + 1..n).all(|i| (get(a, j * n + i) - get(a, i * n + j)).abs() <= tol));
+        if !sym {
+            return false;
+        }
+        let mut l = [T::zero(); 120];
+        let at = |l: &[T], i: usize, j: usize| get(l, i * (i + 1) / 2 + j);
+        for i in 0..n {
+            for j in 0..=i {
+                let mut s = get(a, j * n + i);
+                for k in 0..j {
+                    s -= at(&l, i, k) * at(&l, j, k);
+                }
+                let v = if i == j {
+                    if !super::imu::greater(s, T::zero()) {
+                        return false;
+                    }
+                    s.sqrt()
+                } else {
+                    s / at(&l, j, j)
+                };
+                if let Some(e) = l.get_mut(i * (i + 1) / 2 + j) {
+                    *e = v;
+                }
+            }
+        }
+        true
+    }
+    let mut rng = Lcg(seed);
+    let mut accepted = 0;
+    for i in 0..300 {
+        let b = SMatrix::<T, N, N>::from_fn(|_, _| T::lit(rng.next()));
+        let shift = T::lit([1e-9, 1e-3, 0.1, 1.0, -0.05][i % 5]);
+        let mut a = b * b.transpose() + SMatrix::<T, N, N>::identity() * shift;
+        if i % 7 == 0 {
+            if let Some(e) = a.get_mut((N - 1, 0)) {
+                *e = number(&mut rng, i);
+            }
+        }
+        if i % 11 == 0 {
+            if let Some(e) = a.get_mut((1, 1)) {
+                *e = -*e;
+            }
+        }
+        let new = spd_packed(a.as_slice(), N);
+        assert_eq!(new, old(a.as_slice(), N));
+        accepted += usize::from(new);
+    }
+    assert!(accepted > 50);
+}
+
+#[test]
+fn spd_packed_is_the_former_recurrence() {
+    spd_packed_case::<f32, 3>(193);
+    spd_packed_case::<f32, 6>(197);
+    spd_packed_case::<f32, 15>(199);
+    spd_packed_case::<f64, 15>(211);
+    spd_packed_case::<f64, 1>(223);
+}
+
+/// `imu::sigmas` against `diagonal().map(|d| d.max(0).sqrt())`, the former `sigmas()` body.
+fn sigmas_case<T: Real, const N: usize>(seed: u64) {
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    for i in 0..200 {
+        let p = SMatrix::<T, N, N>::from_fn(|r, c| number(&mut rng, i / 2 + 3 * r + c));
+        let old = p.diagonal().map(|d| d.max(T::zero()).sqrt());
+        assert!(same(super::imu::sigmas(&p).as_slice(), old.as_slice()));
+    }
+}
+
+#[test]
+fn sigmas_are_the_diagonal_map() {
+    sigmas_case::<f32, 15>(227);
+    sigmas_case::<f32, 6>(229);
+    sigmas_case::<f64, 15>(233);
+    sigmas_case::<f64, 6>(239);
+}
+
+/// `CameraLandmark::linearize` against its former body (nalgebra's `transpose`, `-m` and the
+/// finiteness iterator): the same residual and Jacobian bits.
+fn camera_case<T: Real>(seed: u64) {
+    use super::models::{CameraLandmark, PinholeIntrinsics};
+    use super::state::InsState;
+    use super::update::Measurement;
+    use crate::lie::{skew, Se3};
+    use nalgebra::{SMatrix, Vector2};
+    let mut rng = Lcg(seed);
+    let rot = |rng: &mut Lcg| {
+        let axis = Vector3::new(rng.next(), rng.next(), rng.next());
+        let q = UnitQuaternion::from_scaled_axis(axis * 3.0)
+            .coords
+            .map(T::lit);
+        So3::from_unit_quaternion(UnitQuaternion::new_unchecked(q.into()))
+    };
+    let mut accepted = 0;
+    for i in 0..400 {
+        let x = InsState {
+            attitude: rot(&mut rng),
+            position: Vector3::new(rng.next(), rng.next(), rng.next()).map(T::lit),
+            ..InsState::identity()
+        };
+        let cam = CameraLandmark::new(
+            Vector2::new(T::lit(300.0 * rng.next()), T::lit(200.0 * rng.next())),
+            Vector3::new(3.0 * rng.next(), 3.0 * rng.next(), 3.0 * rng.next()).map(T::lit),
+            PinholeIntrinsics {
+                fx: T::lit(400.0),
+                fy: T::lit(380.0 + rng.next()),
+                cx: T::lit(320.0),
+                cy: number(&mut rng, i),
+            },
+            Se3::from_parts(
+                rot(&mut rng),
+                Vector3::new(rng.next(), 0.0, 0.1).map(T::lit),
+            ),
+            T::lit(1.5),
+        );
+        let (Ok(lin), Ok((uv, c))) = (cam.linearize(&x), cam.project(&x)) else {
+            continue;
+        };
+        accepted += 1;
+        let k = &cam.intrinsics;
+        let q = x.attitude.inverse().act(&(cam.landmark - x.position));
+        let rcb = cam
+            .body_from_camera
+            .rotation()
+            .rotation_matrix()
+            .transpose();
+        let rt = x.attitude.rotation_matrix().transpose();
+        let iz = T::one() / c.z;
+        let z = T::zero();
+        let jpi = Matrix3::new(
+            k.fx * iz,
+            z,
+            -k.fx * c.x * iz * iz,
+            z,
+            k.fy * iz,
+            -k.fy * c.y * iz * iz,
+            z,
+            z,
+            z,
+        );
+        let jc = mm(&jpi, &rcb);
+        let (ja, jp) = (mm(&jc, &skew(&q)), -mm(&jc, &rt));
+        let mut old = SMatrix::<T, 2, 15>::zeros();
+        for r in 0..2 {
+            for cc in 0..3 {
+                for (col, src) in [(cc, &ja), (6 + cc, &jp)] {
+                    if let (Some(e), Some(v)) = (old.get_mut((r, col)), src.get((r, cc))) {
+                        *e = *v;
+                    }
+                }
+            }
+        }
+        assert!(same(lin.jacobian.as_slice(), old.as_slice()));
+        let res = Vector2::new(cam.pixel.x - uv.x, cam.pixel.y - uv.y);
+        assert!(same(lin.residual.as_slice(), res.as_slice()));
+    }
+    assert!(accepted > 50);
+}
+
+#[test]
+fn camera_linearization_is_the_former_body() {
+    camera_case::<f32>(241);
+    camera_case::<f64>(251);
+}
+
+/// `CameraLandmark::new`'s noise against the former `Matrix2::identity() * σ²`.
+fn camera_noise<T: Real>() {
+    use super::models::{CameraLandmark, PinholeIntrinsics};
+    use crate::lie::Se3;
+    use nalgebra::{Matrix2, Vector2};
+    let mut rng = Lcg(257);
+    for i in 0..200 {
+        let sigma = number::<T>(&mut rng, i);
+        let cam = CameraLandmark::new(
+            Vector2::zeros(),
+            Vector3::zeros(),
+            PinholeIntrinsics {
+                fx: T::one(),
+                fy: T::one(),
+                cx: T::zero(),
+                cy: T::zero(),
+            },
+            Se3::identity(),
+            sigma,
+        );
+        let old = Matrix2::<T>::identity() * (sigma * sigma);
+        assert!(same(cam.noise.as_slice(), old.as_slice()));
+    }
+}
+
+#[test]
+fn camera_noise_is_the_scaled_identity() {
+    camera_noise::<f32>();
+    camera_noise::<f64>();
 }

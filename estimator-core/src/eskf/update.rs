@@ -113,18 +113,21 @@ const PACKED_MAX_DIM: usize = MAX_STATE;
 /// row: `(i, j) ↦ i(i+1)/2 + j`), 480 bytes for `f32` instead of a full copy. Not generic over
 /// the size: one copy of this code serves every matrix.
 #[inline(never)]
-fn spd_packed<T: Real>(a: &[T], n: usize) -> bool {
+pub(crate) fn spd_packed<T: Real>(a: &[T], n: usize) -> bool {
     if !finite_symmetric(a, n) {
         return false;
     }
-    let get = |s: &[T], idx: usize| s.get(idx).copied().unwrap_or_else(T::zero);
     let mut l = [T::zero(); PACKED_MAX_DIM * (PACKED_MAX_DIM + 1) / 2];
-    let at = |l: &[T], i: usize, j: usize| get(l, i * (i + 1) / 2 + j);
     for i in 0..n {
+        let ri = i * (i + 1) / 2;
         for j in 0..=i {
-            let mut s = get(a, j * n + i);
-            for k in 0..j {
-                s -= at(&l, i, k) * at(&l, j, k);
+            let rj = j * (j + 1) / 2;
+            let mut s = at(a, j * n + i);
+            // Σ_k<j L_ik L_jk over the packed rows i and j, k ascending.
+            if let (Some(li), Some(lj)) = (l.get(ri..ri + j), l.get(rj..rj + j)) {
+                for (x, y) in li.iter().zip(lj) {
+                    s -= *x * *y;
+                }
             }
             let v = if i == j {
                 if !greater(s, T::zero()) {
@@ -132,9 +135,9 @@ fn spd_packed<T: Real>(a: &[T], n: usize) -> bool {
                 }
                 s.sqrt()
             } else {
-                s / at(&l, j, j)
+                s / at(&l, rj + j)
             };
-            match l.get_mut(i * (i + 1) / 2 + j) {
+            match l.get_mut(ri + j) {
                 Some(e) => *e = v,
                 None => return false,
             }
@@ -145,12 +148,28 @@ fn spd_packed<T: Real>(a: &[T], n: usize) -> bool {
 
 /// `a` (column-major, `n × n`) is finite and symmetric to `1e-6` of its largest entry.
 fn finite_symmetric<T: Real>(a: &[T], n: usize) -> bool {
-    if a.len() != n * n || !a.iter().fold(true, |acc, x| acc & x.is_finite()) {
+    if a.len() != n * n || !slice_finite(a) {
         return false;
     }
     let tol = a.iter().fold(T::zero(), |m, x| m.max(x.abs())) * T::lit(1e-6);
     let get = |idx: usize| a.get(idx).copied().unwrap_or_else(T::zero);
     (0..n).all(|j| (j + 1..n).all(|i| (get(j * n + i) - get(i * n + j)).abs() <= tol))
+}
+
+/// Every entry of `a` is finite. Built for size, the shared out-of-line `Σ x·0 = 0` (the same
+/// answer, 32 bytes less at opt-level "s"); at opt-level 2 or 3 the fold of `is_finite` stays
+/// (its instruction counts are budgeted).
+#[cfg(estimator_compact)]
+#[inline(always)]
+fn slice_finite<T: Real>(a: &[T]) -> bool {
+    sum_times_zero_is_zero(a)
+}
+
+/// Every entry of `a` is finite (see the build for size above).
+#[cfg(not(estimator_compact))]
+#[inline(always)]
+fn slice_finite<T: Real>(a: &[T]) -> bool {
+    a.iter().fold(true, |acc, x| acc & x.is_finite())
 }
 
 /// Row capacity of the shared update core.
@@ -216,13 +235,17 @@ where
 /// Copies `H` (`m × n`, column-major in `h`, `m = r_in.len()`) into `ht` as `Hᵀ` (`n × C`,
 /// column `c` = row `c` of `H`) and the residual into `r`, zeros past `m`. Not generic over the
 /// model or its size: one copy of this code serves every model.
-fn rows_into<T: Real>(h: &[T], r_in: &[T], ht: &mut [T], r: &mut [T]) {
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn rows_into<T: Real>(h: &[T], r_in: &[T], ht: &mut [T], r: &mut [T]) {
     let m = r_in.len().max(1);
     let n = h.len() / m;
     ht.fill(T::zero());
-    for (c, col) in ht.chunks_exact_mut(n.max(1)).enumerate().take(r_in.len()) {
-        for (j, e) in col.iter_mut().enumerate() {
-            *e = h.get(j * m + c).copied().unwrap_or_else(T::zero);
+    // Column j of H (entries j·m .. j·m + m) goes to row j of Hᵀ: entry (j, c) at c·n + j.
+    for (j, col) in h.chunks_exact(m).enumerate() {
+        for (c, v) in col.iter().enumerate() {
+            if let Some(e) = ht.get_mut(c * n + j) {
+                *e = *v;
+            }
         }
     }
     r.fill(T::zero());
@@ -266,6 +289,8 @@ struct Work<T: Real, const N: usize, const C: usize> {
     s: SMatrix<T, C, C>,
     /// `K = U S⁻¹`.
     k: SMatrix<T, N, C>,
+    /// `S⁻¹` (for the NIS at the prior).
+    s_inv: SMatrix<T, C, C>,
     /// The current correction `δx`.
     dx: SVector<T, N>,
     /// The number of active rows, `M`.
@@ -340,12 +365,13 @@ where
         u: SMatrix::zeros(),
         s: SMatrix::zeros(),
         k: SMatrix::zeros(),
+        s_inv: SMatrix::zeros(),
         dx: SVector::zeros(),
         m,
     };
     linearize_into(model, x, &mut w, true)?;
-    let s_inv = gain_into(p, r_noise, &mut w)?;
-    let nis = nis(&s_inv, &w.r);
+    gain_into(p, r_noise, &mut w)?;
+    let nis = nis(&w.s_inv, &w.r);
     if !nis.is_finite() {
         return Err(EskfError::SingularInnovation);
     }
@@ -363,11 +389,12 @@ where
 /// `Cholesky::solve` (dynamic-range `dot`s) and `dot` keep shape asserts, panic paths at
 /// opt-level "s". Generic over the row capacity only: one copy for both filters.
 #[cfg_attr(estimator_compact, inline(never))]
-fn nis<T: Real, const C: usize>(s_inv: &SMatrix<T, C, C>, r: &SVector<T, C>) -> T {
+pub(crate) fn nis<T: Real, const C: usize>(s_inv: &SMatrix<T, C, C>, r: &SVector<T, C>) -> T {
     let mut y = SVector::<T, C>::zeros();
     mat_vec(s_inv.as_slice(), r.as_slice(), y.as_mut_slice());
-    r.iter()
-        .zip(y.iter())
+    r.as_slice()
+        .iter()
+        .zip(y.as_slice())
         .fold(T::zero(), |acc, (a, b)| acc + *a * *b)
 }
 
@@ -420,19 +447,19 @@ where
 #[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn chart_jacobian<T: Real>(dx: &[T], ht: &mut [T]) {
     let dth = Vector3::new(at(dx, 0), at(dx, 1), at(dx, 2));
-    let jrt = So3::right_jacobian(&dth).transpose();
+    let jrt = super::imu::tr33(&So3::right_jacobian(&dth));
     for col in ht.chunks_exact_mut(dx.len().max(1)) {
         if let Some(top) = col.get_mut(0..3) {
             let h = Vector3::new(at(top, 0), at(top, 1), at(top, 2));
             let v = super::imu::mv(&jrt, &h);
-            for (e, x) in top.iter_mut().zip(v.iter()) {
+            for (e, x) in top.iter_mut().zip(v.as_slice()) {
                 *e = *x;
             }
         }
     }
 }
 
-/// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`; returns `S⁻¹`. The per-size entry of
+/// `U = P H̃ᵀ`, `S = H̃ U + R`, `S⁻¹`, `K = U S⁻¹` into `w`. The per-size entry of
 /// [`gain_shared`] (see [`commit`] for the two builds).
 #[cfg_attr(estimator_compact, inline(always))]
 #[cfg_attr(not(estimator_compact), inline(never))]
@@ -440,7 +467,7 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
     p: &SMatrix<T, N, N>,
     r_noise: &SMatrix<T, C, C>,
     w: &mut Work<T, N, C>,
-) -> Result<SMatrix<T, C, C>, EskfError> {
+) -> Result<(), EskfError> {
     gain_shared(
         p.as_slice(),
         N,
@@ -449,6 +476,7 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
         w.ht.as_slice(),
         w.u.as_mut_slice(),
         &mut w.s,
+        &mut w.s_inv,
         w.k.as_mut_slice(),
     )
 }
@@ -467,8 +495,9 @@ fn gain_shared<T: Real, const C: usize>(
     ht: &[T],
     u: &mut [T],
     s: &mut SMatrix<T, C, C>,
+    s_inv_out: &mut SMatrix<T, C, C>,
     k: &mut [T],
-) -> Result<SMatrix<T, C, C>, EskfError> {
+) -> Result<(), EskfError> {
     // Column c of U = Σ_j P e_j H_cj over the nonzero entries of row c of H only (most models
     // touch 3–6 of the 15 error components).
     u.fill(T::zero());
@@ -492,32 +521,48 @@ fn gain_shared<T: Real, const C: usize>(
             }
         }
     }
-    let st = s.transpose();
-    *s += st;
-    *s *= T::lit(0.5);
+    symmetrize(s);
     // K = U S⁻¹ with S⁻¹ from the Cholesky factor (C × C, small); the columns past m stay zero.
     // Built for size, nalgebra's factorization and solves in plain loops (the same bits, see
     // `cholesky_inverse`); at opt-level 2 or 3, nalgebra's own, which it unrolls faster.
+    // (Written to the caller's `S⁻¹` directly: after an error the caller does not read it.)
     #[cfg(estimator_compact)]
-    let s_inv = cholesky_inverse(s).ok_or(EskfError::SingularInnovation)?;
+    {
+        *s_inv_out = cholesky_inverse(s).ok_or(EskfError::SingularInnovation)?;
+    }
     #[cfg(not(estimator_compact))]
-    let s_inv = Cholesky::new(*s)
-        .ok_or(EskfError::SingularInnovation)?
-        .inverse();
+    {
+        *s_inv_out = Cholesky::new(*s)
+            .ok_or(EskfError::SingularInnovation)?
+            .inverse();
+    }
+    let s_inv: &SMatrix<T, C, C> = s_inv_out;
     k.fill(T::zero());
     for (kc, sc) in k
         .chunks_exact_mut(n.max(1))
-        .zip(s_inv.column_iter())
+        .zip(s_inv.as_slice().chunks_exact(C.max(1)))
         .take(m)
     {
-        for (uc, s) in u.chunks_exact(n.max(1)).zip(sc.iter()).take(m) {
+        for (uc, s) in u.chunks_exact(n.max(1)).zip(sc).take(m) {
             axpy(kc, *s, uc);
         }
     }
     if !sum_times_zero_is_zero(k) {
         return Err(EskfError::SingularInnovation);
     }
-    Ok(s_inv)
+    Ok(())
+}
+
+/// `S ← (S + Sᵀ)·½` entry by entry over the storage, `(s_ij + s_ji)·½` from a copy of `S`:
+/// nalgebra's `s += sᵀ; s *= ½`, without its generic loops.
+#[inline(always)]
+pub(crate) fn symmetrize<T: Real, const C: usize>(s: &mut SMatrix<T, C, C>) {
+    let s0 = *s;
+    for (j, col) in s.as_mut_slice().chunks_exact_mut(C.max(1)).enumerate() {
+        for (i, e) in col.iter_mut().enumerate() {
+            *e = (*e + at(s0.as_slice(), i * C + j)) * T::lit(0.5);
+        }
+    }
 }
 
 /// `A⁻¹` by `nalgebra::Cholesky::new(A)?.inverse()`, operation for operation (the same bits;
@@ -599,11 +644,11 @@ pub(crate) fn gauss_newton_step<T: Real, const C: usize>(
 ) {
     let n = prev.len().max(1);
     let mut y = *r;
-    for (yc, hc) in y.iter_mut().zip(ht.chunks_exact(n)).take(m) {
+    for (yc, hc) in y.as_mut_slice().iter_mut().zip(ht.chunks_exact(n)).take(m) {
         *yc += dot(hc, prev);
     }
     next.fill(T::zero());
-    for (kc, yc) in k.chunks_exact(n).zip(y.iter()).take(m) {
+    for (kc, yc) in k.chunks_exact(n).zip(y.as_slice()).take(m) {
         axpy(next, *yc, kc);
     }
 }
@@ -763,18 +808,21 @@ fn commit_shared<T: Real, const C: usize>(
         let mut c0 = Vector3::new(at(pc, 0), at(pc, 1), at(pc, 2));
         for (vc, kc) in pairs() {
             let (vj, kj) = (at(vc, j), at(kc, j));
-            for (e, (a, b)) in c0.iter_mut().zip(vc.iter().zip(kc)) {
+            for (e, (a, b)) in c0.as_mut_slice().iter_mut().zip(vc.iter().zip(kc)) {
                 *e += *a * kj + *b * vj;
             }
         }
         *t = super::imu::mv(&gr, &c0);
     }
     let [t0, t1, t2, ..] = top;
-    let c00 = super::imu::mm(&Matrix3::from_columns(&[t0, t1, t2]), &gr.transpose());
+    let c00 = super::imu::mm(
+        &Matrix3::from_columns(&[t0, t1, t2]),
+        &super::imu::tr33(&gr),
+    );
     let c00 = super::imu::sym(&c00);
     // K, U, S and P are finite, so P⁺ can only fail by overflow; for a positive semi-definite
     // P⁺, |P⁺_ij| ≤ √(P⁺_ii P⁺_jj), so a finite positive diagonal bounds every entry.
-    let ok = |d: T| d.is_finite() && d > T::zero();
+    let ok = positive_finite::<T>;
     let two = T::lit(2.0);
     let diag_ok = (3..n).all(|i| {
         let d = pairs().fold(T::zero(), |acc, (vc, kc)| acc + at(vc, i) * at(kc, i));
@@ -809,7 +857,7 @@ fn commit_shared<T: Real, const C: usize>(
         }
     }
     for (j, col) in top.iter().enumerate().take(n) {
-        for (a, v) in col.iter().enumerate() {
+        for (a, v) in col.as_slice().iter().enumerate() {
             let v = if j < 3 {
                 c00.get((a, j)).copied().unwrap_or(*v)
             } else {
@@ -824,6 +872,19 @@ fn commit_shared<T: Real, const C: usize>(
         }
     }
     Ok(())
+}
+
+/// `d` is finite and positive (false for NaN). Built for size, `d > 0` and `d · 0 = 0` (see
+/// [`sum_times_zero_is_zero`]): the same answer as `d.is_finite() && d > 0`, which LLVM turns
+/// into a long integer classification of the bits at opt-level "s" (136 bytes more per build).
+/// At opt-level 2 or 3 the plain form stays: the other one left a panic path in the `f64`
+/// no-panic build.
+#[inline(always)]
+pub(crate) fn positive_finite<T: Real>(d: T) -> bool {
+    #[cfg(estimator_compact)]
+    return greater(d, T::zero()) && d * T::zero() == T::zero();
+    #[cfg(not(estimator_compact))]
+    return d.is_finite() && d > T::zero();
 }
 
 /// `s[i]`, or zero past the end (never reached: every caller indexes below the length).

@@ -27,5 +27,7 @@ pub mod eskf;
 pub mod gn;
 pub mod lie;
 pub mod scalar;
+#[cfg(test)]
+mod test_support;
 
 pub use scalar::Real;

@@ -7,29 +7,9 @@ use super::imu::{add33, axpy, mm, mv, ImuNoise};
 use super::models::{add3, div3, dot3, neg3, norm3, sub3};
 use super::state::{plus_seg, seg};
 use crate::lie::{LieGroup, So3};
+use crate::test_support::{same_bits as same, Lcg};
 use crate::Real;
 use nalgebra::{Matrix3, SVector, UnitQuaternion, Vector3};
-
-/// Deterministic numbers in `[-1, 1)` (64-bit LCG).
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        ((self.0 >> 11) as f64) / ((1u64 << 52) as f64) - 1.0
-    }
-}
-
-/// Equal bits, or both NaN.
-fn same<T: Real>(a: &[T], b: &[T]) -> bool {
-    a.len() == b.len()
-        && a.iter().zip(b).all(|(x, y)| {
-            let (x, y) = (x.to_f64(), y.to_f64());
-            x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan())
-        })
-}
 
 /// Numbers of magnitudes from `1e-6` to `1e3`, and signed zeros, infinities and NaN.
 fn number<T: Real>(rng: &mut Lcg, i: usize) -> T {

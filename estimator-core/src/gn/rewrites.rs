@@ -3,33 +3,9 @@
 
 use super::rotation::{triad, triad_start, unit};
 use super::*;
+use crate::test_support::{same_bits as same, Lcg};
 use crate::Real;
 use nalgebra::Vector3;
-
-/// Deterministic numbers in `[-1, 1)` (64-bit LCG).
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        ((self.0 >> 11) as f64) / ((1u64 << 52) as f64) - 1.0
-    }
-
-    fn vector<T: Real>(&mut self, scale: f64) -> Vector3<T> {
-        Vector3::new(self.next(), self.next(), self.next()).map(|x| T::lit(scale * x))
-    }
-}
-
-/// Equal bits, entry by entry (any two `NaN`s count as equal).
-fn same<T: Real>(a: &[T], b: &[T]) -> bool {
-    a.len() == b.len()
-        && a.iter().zip(b).all(|(x, y)| {
-            let (x, y) = (x.to_f64(), y.to_f64());
-            x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan())
-        })
-}
 
 /// [`check_point_spread`] before the scalar sums: nalgebra's `sum += p`, `sum * inv_n`, `p − mean`.
 fn check_point_spread_before<T: Real>(points: &[Vector3<T>]) -> Result<(), SolveError> {

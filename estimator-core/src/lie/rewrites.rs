@@ -3,29 +3,8 @@
 
 use super::trig::AngleCoeffs;
 use super::*;
+use crate::test_support::{same_up_to_zero_sign as same, Lcg};
 use nalgebra::{Matrix2, Quaternion, UnitQuaternion, Vector2};
-
-/// Deterministic numbers in `[-1, 1)` (64-bit LCG).
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        ((self.0 >> 11) as f64) / ((1u64 << 52) as f64) - 1.0
-    }
-}
-
-/// The same numbers: equal bits, except that `0.0` and `−0.0` count as equal (the old
-/// `−(…)` of a whole block also negated its structural zeros) and any two `NaN`s do.
-fn same<T: Real>(a: &[T], b: &[T]) -> bool {
-    a.len() == b.len()
-        && a.iter().zip(b).all(|(x, y)| {
-            let (x, y) = (x.to_f64(), y.to_f64());
-            x.to_bits() == y.to_bits() || x == y || (x.is_nan() && y.is_nan())
-        })
-}
 
 /// Rotation matrices of every Shepperd branch (angles up to and at π about each axis and
 /// random axes), perturbed ones, and arbitrary matrices.

@@ -254,14 +254,14 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         (Self::exp_from(&k, tau), Self::jr_from(&k, tau))
     }
 
-    /// `(a⁻¹, −Ad_a)`, negated in place ([`negate`]).
+    /// `(a⁻¹, −Ad_a)`, negated in place (`negate`).
     fn inverse_jac(&self) -> (Self, Matrix3<T>) {
         let mut j = self.adjoint();
         negate(&mut j);
         (self.inverse(), j)
     }
 
-    /// `(z = a⁻¹·b, −Ad_{z⁻¹}, I)`, negated in place ([`negate`]).
+    /// `(z = a⁻¹·b, −Ad_{z⁻¹}, I)`, negated in place (`negate`).
     fn between_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
         let z = self.between(b);
         let mut j = z.inverse().adjoint();
@@ -269,7 +269,7 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         (z, j, eye())
     }
 
-    /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))`, the last negated in place ([`negate`]).
+    /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))`, the last negated in place (`negate`).
     fn rminus_jac(&self, b: &Self) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {
         let tau = self.rminus(b);
         let mut jl = Self::left_jacobian_inv(&tau);

@@ -362,14 +362,14 @@ impl<T: Real> LieGroup<T> for So3<T> {
         (self.compose(b), b.inverse().rotation_matrix(), eye())
     }
 
-    /// `(a⁻¹, −R)`, negated in place ([`negate`]).
+    /// `(a⁻¹, −R)`, negated in place (`negate`).
     fn inverse_jac(&self) -> (Self, Matrix3<T>) {
         let mut j = self.adjoint();
         negate(&mut j);
         (self.inverse(), j)
     }
 
-    /// `(z = a⁻¹·b, −R_{z⁻¹}, I)`, negated in place ([`negate`]).
+    /// `(z = a⁻¹·b, −R_{z⁻¹}, I)`, negated in place (`negate`).
     fn between_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
         let z = self.between(b);
         let mut j = z.inverse().adjoint();

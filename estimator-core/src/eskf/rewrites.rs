@@ -335,7 +335,7 @@ fn mat_vec_is_nalgebras_product() {
 /// number (signed zeros, subnormals, the largest finite, infinities, NaN).
 fn update_checks<T: Real>() {
     use super::imu::sum_times_zero_is_zero;
-    use super::update::positive_finite;
+    use crate::scalar::positive_finite;
     let mut rng = Lcg(109);
     let specials = [
         T::lit(0.0),

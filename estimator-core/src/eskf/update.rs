@@ -6,6 +6,7 @@ use super::gate::{Gate, GateProbability};
 use super::imu::{finite_vec, greater, sum_times_zero_is_zero};
 use super::state::ErrorState;
 use crate::lie::{LieGroup, So3};
+use crate::scalar::positive_finite;
 use crate::Real;
 use nalgebra::{Cholesky, Matrix3, SMatrix, SVector, Vector3};
 
@@ -872,19 +873,6 @@ fn commit_shared<T: Real, const C: usize>(
         }
     }
     Ok(())
-}
-
-/// `d` is finite and positive (false for NaN). Built for size, `d > 0` and `d · 0 = 0` (see
-/// [`sum_times_zero_is_zero`]): the same answer as `d.is_finite() && d > 0`, which LLVM turns
-/// into a long integer classification of the bits at opt-level "s" (136 bytes more per build).
-/// At opt-level 2 or 3 the plain form stays: the other one left a panic path in the `f64`
-/// no-panic build.
-#[inline(always)]
-pub(crate) fn positive_finite<T: Real>(d: T) -> bool {
-    #[cfg(estimator_compact)]
-    return greater(d, T::zero()) && d * T::zero() == T::zero();
-    #[cfg(not(estimator_compact))]
-    return d.is_finite() && d > T::zero();
 }
 
 /// `s[i]`, or zero past the end (never reached: every caller indexes below the length).

@@ -319,17 +319,7 @@ pub(crate) fn skew_poly<T: Real>(s: T, p: T, q: T, w: &Vector3<T>) -> Matrix3<T>
     )
 }
 
-pub(crate) use crate::scalar::all_finite;
-
-/// `0 < x < ∞`: the same answer as `x.is_finite() && x > 0` for every `x`, as two floating-point
-/// comparisons: `x·0` is `±0` for finite `x` and `NaN` for `±∞` and `NaN` (which compare unequal
-/// to 0). Written that way because LLVM turns `x < ∞` (or `is_finite`) next to `x > 0` into
-/// integer tests of the bit pattern, which take about 60 bytes on a Cortex-M4F.
-#[inline]
-#[must_use]
-pub(crate) fn positive_finite<T: Real>(x: T) -> bool {
-    x > T::zero() && x * T::zero() == T::zero()
-}
+pub(crate) use crate::scalar::{all_finite, positive_finite};
 
 /// `m ← −m`, entry by entry: the same bits as `-m`. Out of line under `estimator_compact`: one
 /// short loop shared by every negated Jacobian instead of an unrolled load, negate and store per

@@ -16,6 +16,8 @@
 mod expected {
     include!(concat!(env!("OUT_DIR"), "/expected.rs"));
 }
+#[path = "../vectors.rs"]
+mod vectors;
 #[path = "../scenario.rs"]
 mod scenario;
 

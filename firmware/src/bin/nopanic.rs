@@ -409,3 +409,6 @@ fn main() -> ! {
 
 #[path = "../no_panic_handler.rs"]
 mod no_panic_handler;
+
+#[path = "../vectors.rs"]
+mod vectors;

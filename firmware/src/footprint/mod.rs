@@ -31,3 +31,6 @@ pub fn keep<X>(x: &X) {
 
 #[path = "../no_panic_handler.rs"]
 mod no_panic_handler;
+
+#[path = "../vectors.rs"]
+mod vectors;

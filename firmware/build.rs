@@ -8,7 +8,11 @@ fn main() {
     println!("cargo:rerun-if-changed=memory.x");
     // cortex-m-rt's `device` feature makes link.x include device.x (a PAC's weak aliases for its
     // interrupt handlers). Our table (src/vectors.rs) names DefaultHandler directly: nothing to alias.
-    fs::write(out.join("device.x"), "/* interrupt vectors: src/vectors.rs */\n").unwrap();
+    fs::write(
+        out.join("device.x"),
+        "/* interrupt vectors: src/vectors.rs */\n",
+    )
+    .unwrap();
     // The expected results the demo checks: src/expected.rs (committed), or the file named by
     // FIRMWARE_EXPECTED (CI regenerates it on the host from the current estimator-core).
     let expected = env::var("FIRMWARE_EXPECTED").unwrap_or_else(|_| "src/expected.rs".into());

@@ -16,10 +16,10 @@
 mod expected {
     include!(concat!(env!("OUT_DIR"), "/expected.rs"));
 }
-#[path = "../vectors.rs"]
-mod vectors;
 #[path = "../scenario.rs"]
 mod scenario;
+#[path = "../vectors.rs"]
+mod vectors;
 
 use core::hint::black_box;
 use core::mem::size_of;
@@ -234,7 +234,10 @@ fn run_benchmarks(w: &scenario::Workload<f32>) {
         black_box(libm::sqrtf(black_box(x)));
     });
     bench(&mut i, "atan2_f32", || {
-        black_box(estimator_core::scalar::atan2_f32(black_box(x), black_box(0.3f32)));
+        black_box(estimator_core::scalar::atan2_f32(
+            black_box(x),
+            black_box(0.3f32),
+        ));
     });
 
     let tau = Vector3::new(0.3f32, -0.2, 0.9);

@@ -363,6 +363,9 @@ impl<T: Real, S: Copy, const N: usize> Solution<T, S, N> {
 /// `Result`, which matters for the stack on embedded targets. On error `out` may hold a partial
 /// result.
 ///
+/// Only the storage and the problem-specific steps ([`Candidate`]) are per problem; the rest
+/// ([`drive`]) is compiled once.
+///
 /// # Errors
 /// As [`solve`].
 pub(crate) fn solve_into<T, S, P, const N: usize, const K: usize>(
@@ -376,12 +379,6 @@ where
     S: Manifold<T, N>,
     P: Problem<T, S, N, K> + ?Sized,
 {
-    if !options.is_valid() {
-        return Err(SolveError::InvalidOptions);
-    }
-    if !initial.all_finite() {
-        return Err(SolveError::NonFiniteGuess);
-    }
     let mut run = Run::<T, S, P, N, K> {
         problem,
         loss: options.loss,
@@ -392,21 +389,69 @@ where
         trial: NormalEquations::zeros(),
         step: SVector::zeros(),
     };
-    run.ne.rebuild(problem, &run.state, &run.loss)?;
-    let initial_cost = run.ne.cost;
-    let (iterations, status) = iterate(&mut run, options)?;
-    let state = run.state;
-    let ne = &run.ne;
-    if !state.all_finite() || !ne.cost.is_finite() {
+    let done = drive(&mut run, options, out.covariance.as_mut_slice())?;
+    out.state = run.state;
+    out.iterations = done.iterations;
+    out.initial_cost = done.initial_cost;
+    out.final_cost = done.final_cost;
+    out.status = done.status;
+    Ok(())
+}
+
+/// The scalar results of [`drive`].
+struct Done<T> {
+    iterations: usize,
+    initial_cost: T,
+    final_cost: T,
+    status: Status,
+}
+
+/// [`solve_into`] past the allocation of its storage: validation, the linearization at the
+/// guess, [`iterate`], and the covariance `A⁻¹` of the last linearization into `cov`
+/// (column-major). One copy of the code for every problem and dimension.
+///
+/// # Errors
+/// As [`solve`].
+fn drive<T: Real>(
+    run: &mut dyn Candidate<T>,
+    options: &SolverOptions<T>,
+    cov: &mut [T],
+) -> Result<Done<T>, SolveError> {
+    if !options.is_valid() {
+        return Err(SolveError::InvalidOptions);
+    }
+    if !run.finite() {
+        return Err(SolveError::NonFiniteGuess);
+    }
+    // The candidate is the guess: its linearization becomes the current one.
+    run.linearize()?;
+    run.accept(true);
+    let initial_cost = run.parts().cost;
+    let (iterations, status) = iterate(run, options)?;
+    let finite = run.finite();
+    let p = run.parts();
+    if !finite || !p.cost.is_finite() {
         return Err(SolveError::NonFiniteResidual);
     }
-    covariance_into(&ne.information, &mut out.covariance)?;
-    out.state = state;
-    out.iterations = iterations;
-    out.initial_cost = initial_cost;
-    out.final_cost = ne.cost;
-    out.status = status;
-    Ok(())
+    // `Factor::new` then `Factor::inverse_into`, on the trial's information as scratch (a copy
+    // of `A`; the trial linearization is no longer needed).
+    let n = p.step.len();
+    copy(p.scratch, p.information);
+    linalg::cholesky_in_place(p.scratch, n)?;
+    linalg::inverse_in_place(p.scratch, n, cov)?;
+    Ok(Done {
+        iterations,
+        initial_cost,
+        final_cost: p.cost,
+        status,
+    })
+}
+
+/// `dst ← src` entry by entry (the shorter length; no panic on a mismatch).
+fn copy<T: Real>(dst: &mut [T], src: &[T]) {
+    for (d, &s) in dst.iter_mut().zip(src) {
+        *d = s;
+    }
 }
 
 /// What [`iterate`] needs of a step `ξ`: `‖ξ‖`, the model decrease terms `ξᵀAξ` and `ξᵀg`.
@@ -417,17 +462,31 @@ struct StepStats<T> {
     gradient: T,
 }
 
-/// The problem- and dimension-dependent half of an iteration of [`solve_into`], behind `dyn`, so
-/// that the iteration itself ([`iterate`]: damping, gain ratio, acceptance, convergence) is
+/// The storage of a [`Candidate`] as slices over its column-major arrays (`n` the length of
+/// `step`): the current linearization, the trial one's information as scratch, the step.
+struct Parts<'a, T> {
+    /// `A` (`n × n`) of the current linearization.
+    information: &'a [T],
+    /// `g` of the current linearization.
+    gradient: &'a [T],
+    /// `F` of the current linearization.
+    cost: T,
+    /// The trial linearization's `A` (`n × n`), scratch between linearizations.
+    scratch: &'a mut [T],
+    /// `F` of the trial linearization.
+    trial_cost: T,
+    /// The step `ξ`.
+    step: &'a mut [T],
+}
+
+/// The problem- and dimension-dependent half of [`solve_into`], behind `dyn`, so that the rest
+/// ([`drive`], [`iterate`]: damping, gain ratio, acceptance, convergence, covariance) is
 /// compiled once, not once per problem or per dimension.
 trait Candidate<T: Real> {
-    /// The cost `F` of the current linearization.
-    fn cost(&self) -> T;
-    /// The cost of the trial linearization.
-    fn trial_cost(&self) -> T;
-    /// Solves for the step `ξ` from the current linearization with damping `λ` (see
-    /// [`damped_step`]) and keeps it.
-    fn solve_step(&mut self, lambda: T, lm: bool) -> Result<StepStats<T>, StepError>;
+    /// The storage, as slices.
+    fn parts(&mut self) -> Parts<'_, T>;
+    /// `true` when the current state is finite.
+    fn finite(&self) -> bool;
     /// Forms the candidate `a ⊕ ξ` (seed eq. 4.5) from the current state and the kept step;
     /// `true` when it is finite.
     fn propose(&mut self) -> bool;
@@ -456,16 +515,19 @@ where
     S: Manifold<T, N>,
     P: Problem<T, S, N, K> + ?Sized,
 {
-    fn cost(&self) -> T {
-        self.ne.cost
+    fn parts(&mut self) -> Parts<'_, T> {
+        Parts {
+            information: self.ne.information.as_slice(),
+            gradient: self.ne.gradient.as_slice(),
+            cost: self.ne.cost,
+            scratch: self.trial.information.as_mut_slice(),
+            trial_cost: self.trial.cost,
+            step: self.step.as_mut_slice(),
+        }
     }
 
-    fn trial_cost(&self) -> T {
-        self.trial.cost
-    }
-
-    fn solve_step(&mut self, lambda: T, lm: bool) -> Result<StepStats<T>, StepError> {
-        damped_step(&self.ne, lambda, lm, &mut self.step)
+    fn finite(&self) -> bool {
+        self.state.all_finite()
     }
 
     fn propose(&mut self) -> bool {
@@ -506,12 +568,13 @@ fn iterate<T: Real>(
 
     while iterations < options.max_iterations {
         iterations += 1;
-        let cost = run.cost();
+        let cost = run.parts().cost;
         if cost <= T::zero() {
             status = Status::CostConverged;
             break;
         }
-        let step = match run.solve_step(lambda, lm) {
+        let p = run.parts();
+        let step = match damped_step(p.scratch, p.information, p.gradient, lambda, lm, p.step) {
             Ok(s) => s,
             Err(StepError::Solve(e)) => return Err(e),
             Err(StepError::Factor(e)) if !lm => return Err(e),
@@ -545,7 +608,7 @@ fn iterate<T: Real>(
         } else {
             Err(SolveError::NonFiniteResidual)
         };
-        let trial_cost = run.trial_cost();
+        let trial_cost = run.parts().trial_cost;
         let accepted = match built {
             Ok(()) => {
                 if lm {
@@ -596,24 +659,6 @@ fn iterate<T: Real>(
     Ok((iterations, status))
 }
 
-/// The covariance `A⁻¹` of the last linearization, written into `cov`. Out of line (see
-/// [`damped_step`]): the factor's temporaries live in its own frame, not in the iteration's;
-/// per dimension `N`, not per problem.
-///
-/// # Errors
-/// Those of [`Factor::new`](super::Factor::new) and [`Factor::inverse`](super::Factor::inverse)
-/// (then `cov` may hold a partial result).
-#[inline(never)]
-fn covariance_into<T: Real, const N: usize>(
-    information: &SMatrix<T, N, N>,
-    cov: &mut SMatrix<T, N, N>,
-) -> Result<(), SolveError> {
-    // `Factor::new` then `Factor::inverse_into`, on one local copy of `A` (the smallest frame).
-    let mut l = *information;
-    linalg::cholesky_in_place(l.as_mut_slice(), N)?;
-    linalg::inverse_in_place(l.as_slice(), N, cov.as_mut_slice())
-}
-
 /// Why [`damped_step`] produced no step.
 enum StepError {
     /// The (damped) information did not factorize.
@@ -623,33 +668,10 @@ enum StepError {
 }
 
 /// The step `ξ` of one iteration, into `step`: `(A + λ diag A) ξ = −g` (Levenberg-Marquardt,
-/// `lm`) or `A ξ = −g` (Gauss-Newton), with the figures [`iterate`] needs. Kept out of line so
-/// its `N × N` temporary (the damped matrix and its factor) does not share a frame with the
-/// linearization; one copy per dimension `N`.
-#[inline(never)]
-fn damped_step<T: Real, const N: usize>(
-    ne: &NormalEquations<T, N>,
-    lambda: T,
-    lm: bool,
-    step: &mut SVector<T, N>,
-) -> Result<StepStats<T>, StepError> {
-    let mut damped = ne.information;
-    damped_step_shared(
-        damped.as_mut_slice(),
-        ne.information.as_slice(),
-        ne.gradient.as_slice(),
-        lambda,
-        lm,
-        step.as_mut_slice(),
-    )
-}
-
-/// [`damped_step`] on the column-major storage: `damped` holds a copy of the `n × n`
-/// information `a` and is overwritten by the factor, `g` is the gradient and `step` receives
-/// `ξ` (`n` their length). One copy of the code for every dimension.
-#[cfg_attr(estimator_compact, inline(never))]
-#[cfg_attr(not(estimator_compact), inline(always))]
-fn damped_step_shared<T: Real>(
+/// `lm`) or `A ξ = −g` (Gauss-Newton), with the figures [`iterate`] needs, on the column-major
+/// storage: `a` is the `n × n` information, `g` the gradient, `damped` scratch for the damped
+/// matrix and its factor (`n` the length of `step`). One copy of the code for every dimension.
+fn damped_step<T: Real>(
     damped: &mut [T],
     a: &[T],
     g: &[T],
@@ -658,11 +680,12 @@ fn damped_step_shared<T: Real>(
     step: &mut [T],
 ) -> Result<StepStats<T>, StepError> {
     let n = step.len();
+    copy(damped, a);
     if lm {
         damp(damped, n, lambda);
     }
     // Factorized in place (what `Factor::new` and `Factor::solve` do, without a second
-    // `N × N` copy in this frame).
+    // `N × N` copy).
     linalg::cholesky_in_place(damped, n).map_err(StepError::Factor)?;
     for (x, &gk) in step.iter_mut().zip(g) {
         *x = -gk;

@@ -349,12 +349,12 @@ fn cauchy_retry<T: Real>(
     };
     // One buffer serves both solves: only the Huber state is kept for the second.
     let mut c = Solution::placeholder(guess);
-    if solve_into(problem, guess, &huber, &mut c).is_err() {
+    if solve_into(problem, &huber, &mut c).is_err() {
         return 0;
     }
     let mut iterations = c.iterations;
-    let start = c.state;
-    if solve_into(problem, &start, options, &mut c).is_ok() {
+    // From the Huber state, in place.
+    if solve_into(problem, options, &mut c).is_ok() {
         iterations += c.iterations;
         if c.final_cost < best.0.final_cost {
             if let Ok(m) = inlier_mask(problem, &c.state, inlier_chi2) {
@@ -444,7 +444,7 @@ pub fn solve_pnp<T: Real>(
         initial_damping: SolverOptions::<T>::default().initial_damping,
     };
     let mut sol = Solution::placeholder(camera_from_world_guess);
-    solve_into(&problem, camera_from_world_guess, &solver_options, &mut sol)?;
+    solve_into(&problem, &solver_options, &mut sol)?;
     let mut inliers = inlier_mask(&problem, &sol.state, options.inlier_chi2)?;
     let mut iterations = sol.iterations;
 

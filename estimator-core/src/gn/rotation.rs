@@ -189,7 +189,7 @@ pub fn solve_rotation_from_vectors<T: Real>(
         None => start,
     };
     let mut sol = Solution::placeholder(&start);
-    solve_into(&RotProblem { pairs }, &start, options, &mut sol)?;
+    solve_into(&RotProblem { pairs }, options, &mut sol)?;
     let r = sol.state.normalize();
     if !r.is_finite() {
         return Err(SolveError::NonFiniteResidual);

@@ -339,7 +339,7 @@ where
     P: Problem<T, S, N, K> + ?Sized,
 {
     let mut out = Solution::placeholder(initial);
-    solve_into(problem, initial, options, &mut out)?;
+    solve_into(problem, options, &mut out)?;
     Ok(out)
 }
 
@@ -358,10 +358,10 @@ impl<T: Real, S: Copy, const N: usize> Solution<T, S, N> {
     }
 }
 
-/// [`solve`] writing its result into `out` (every field, on success) instead of returning it:
-/// callers that keep a solution avoid the by-value copies of the `N × N` covariance through
-/// `Result`, which matters for the stack on embedded targets. On error `out` may hold a partial
-/// result.
+/// [`solve`] from the guess `out.state`, writing its result into `out` (every field, on
+/// success) instead of returning it: callers that keep a solution avoid the by-value copies of
+/// the `N × N` covariance through `Result`, which matters for the stack on embedded targets; the
+/// state is iterated in place. On error `out` may hold a partial result.
 ///
 /// Only the storage and the problem-specific steps ([`Candidate`]) are per problem; the rest
 /// ([`drive`]) is compiled once.
@@ -370,7 +370,6 @@ impl<T: Real, S: Copy, const N: usize> Solution<T, S, N> {
 /// As [`solve`].
 pub(crate) fn solve_into<T, S, P, const N: usize, const K: usize>(
     problem: &P,
-    initial: &S,
     options: &SolverOptions<T>,
     out: &mut Solution<T, S, N>,
 ) -> Result<(), SolveError>
@@ -379,18 +378,20 @@ where
     S: Manifold<T, N>,
     P: Problem<T, S, N, K> + ?Sized,
 {
+    let Solution {
+        state, covariance, ..
+    } = out;
     let mut run = Run::<T, S, P, N, K> {
         problem,
         loss: options.loss,
-        state: *initial,
-        candidate: *initial,
+        candidate: *state,
+        state,
         ne: NormalEquations::zeros(),
         // The trial linearization, reused across iterations.
         trial: NormalEquations::zeros(),
         step: SVector::zeros(),
     };
-    let done = drive(&mut run, options, out.covariance.as_mut_slice())?;
-    out.state = run.state;
+    let done = drive(&mut run, options, covariance.as_mut_slice())?;
     out.iterations = done.iterations;
     out.initial_cost = done.initial_cost;
     out.final_cost = done.final_cost;
@@ -502,7 +503,7 @@ trait Candidate<T: Real> {
 struct Run<'a, T: Real, S, P: ?Sized, const N: usize, const K: usize> {
     problem: &'a P,
     loss: Loss<T>,
-    state: S,
+    state: &'a mut S,
     candidate: S,
     ne: NormalEquations<T, N>,
     trial: NormalEquations<T, N>,
@@ -541,7 +542,7 @@ where
     }
 
     fn accept(&mut self, adopt_trial: bool) {
-        self.state = self.candidate;
+        *self.state = self.candidate;
         if adopt_trial {
             core::mem::swap(&mut self.ne, &mut self.trial);
         }

@@ -189,7 +189,7 @@ pub fn triangulate<T: Real>(
         ..SolverOptions::default()
     };
     let mut sol = Solution::placeholder(&start);
-    solve_into(&problem, &start, &solver_options, &mut sol)?;
+    solve_into(&problem, &solver_options, &mut sol)?;
     // The solver evaluated every view at its last linearization; the final (converged) step is
     // re-checked here so that a returned point is in front of every camera.
     let in_front = cameras_from_world

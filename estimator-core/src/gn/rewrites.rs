@@ -162,3 +162,45 @@ fn triad_start_is_the_carried_form() {
     rotation_start::<f32>();
     rotation_start::<f64>();
 }
+
+/// `all_positive` and `all_non_negative` (size form: `x · 0 = 0` as the finiteness test)
+/// against `x > 0 && x.is_finite()` and `x ≥ 0 && x.is_finite()` on every class of number.
+fn sign_checks<T: Real>() {
+    let mut xs = [
+        0.0,
+        -0.0,
+        1e-310,
+        -1e-310,
+        1e-45,
+        -1e-45,
+        1.0,
+        -1.0,
+        3.4e38,
+        -3.4e38,
+        1e300,
+        f64::MAX,
+        -f64::MAX,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+        -f64::NAN,
+    ]
+    .to_vec();
+    let mut rng = Lcg(29);
+    xs.extend((0..200).map(|_| (rng.next() - 0.5) * 10f64.powf(80.0 * rng.next() - 40.0)));
+    for x in xs.into_iter().map(T::lit) {
+        let positive = x > T::zero() && x.is_finite();
+        let non_negative = x >= T::zero() && x.is_finite();
+        assert_eq!(all_positive(&[x]), positive, "{x:?}");
+        assert_eq!(all_non_negative(&[x]), non_negative, "{x:?}");
+        assert_eq!(non_negative_finite(x), non_negative, "{x:?}");
+        assert_eq!(all_positive(&[T::one(), x]), positive, "{x:?}");
+        assert_eq!(all_non_negative(&[x, T::one()]), non_negative, "{x:?}");
+    }
+}
+
+#[test]
+fn sign_checks_are_the_class_tests() {
+    sign_checks::<f32>();
+    sign_checks::<f64>();
+}

@@ -18,7 +18,7 @@
 use super::solver::{solve_into, Problem, Solution, SolverOptions, Status};
 use super::SolveError;
 use crate::lie::{skew, LieGroup, So3};
-use crate::scalar::all_finite;
+use crate::scalar::{all_finite, positive_finite};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
@@ -67,7 +67,7 @@ pub fn vector_pair_error<T: Real>(
 
 pub(super) fn unit<T: Real>(v: &Vector3<T>) -> Option<Vector3<T>> {
     let n = v.norm();
-    if n.is_finite() && n > T::zero() {
+    if positive_finite(n) {
         Some(v / n)
     } else {
         None

@@ -10,9 +10,8 @@
 //!   `∂eᵢ/∂p = Jπ(xᵢ) Rᵢ / σ` (seed Theorem 5.1: `∂(T p)/∂p = R`), and `p ⊕ δ = p + δ`.
 //! * **Covariance**: `(Σ wᵢ JᵢᵀJᵢ)⁻¹` at the solution (m²).
 
-use super::pnp::camera_point;
 use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
-use super::{Factor, Loss, PinholeCamera, SolveError};
+use super::{reprojection_error, Factor, Loss, PinholeCamera, SolveError};
 use crate::lie::{LieGroup, Se3};
 use crate::scalar::all_finite;
 use crate::Real;
@@ -73,11 +72,19 @@ pub fn point_reprojection_error<T: Real>(
     inv_sigma: T,
     min_depth: T,
 ) -> Option<(Vector2<T>, Matrix2x3<T>)> {
-    // `x = R p + t` and `∂x/∂p = R` (what `act_jac` gives, without its pose Jacobian).
+    // `x = R p + t` and `∂x/∂p = R`: the translation block `(Jπ/σ) R` of the pose Jacobian of
+    // [`reprojection_error`] (one copy of the projection code for both).
     let r = camera_from_world.rotation().rotation_matrix();
-    let x = camera_point(&r, &camera_from_world.translation(), p);
-    let (uv, jpi) = camera.project_jac(&x, min_depth)?;
-    Some(((uv - z) * inv_sigma, jpi * r * inv_sigma))
+    let (e, j) = reprojection_error(
+        camera,
+        &r,
+        &camera_from_world.translation(),
+        p,
+        z,
+        inv_sigma,
+        min_depth,
+    )?;
+    Some((e, j.fixed_view::<2, 3>(0, 0).into_owned()))
 }
 
 struct TriProblem<'a, T: Real> {

@@ -204,3 +204,33 @@ fn sign_checks_are_the_class_tests() {
     sign_checks::<f32>();
     sign_checks::<f64>();
 }
+
+/// `unit` (through `normalized`) against its former body: `n = ‖v‖`, `v / n` if `n` is finite
+/// and positive.
+fn unit_cases<T: Real>() {
+    let mut rng = Lcg(41);
+    for i in 0..2000 {
+        let mut d = rng.vector::<T>([1.0, 1e-30, 1e30, 1e38, 1e300, 1e-300][i % 6]);
+        match i % 13 {
+            1 => d.x = T::lit(f64::INFINITY),
+            2 => d.y = T::lit(f64::NAN),
+            3 => d = Vector3::zeros(),
+            4 => d.z = T::lit(-0.0),
+            _ => {}
+        }
+        let n = d.norm();
+        let old = (n.is_finite() && n > T::zero()).then(|| d / n);
+        match (unit(&d), old) {
+            (Some(u), Some(o)) => assert!(same(u.as_slice(), o.as_slice()), "{d:?}"),
+            (u, o) => assert!(u.is_none() && o.is_none(), "{d:?}"),
+        }
+        let (u, m) = super::rotation::normalized(&d);
+        assert!(same(u.as_slice(), (d / d.norm()).as_slice()) && same(&[m], &[n]));
+    }
+}
+
+#[test]
+fn unit_is_the_division_by_the_norm() {
+    unit_cases::<f32>();
+    unit_cases::<f64>();
+}

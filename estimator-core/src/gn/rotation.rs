@@ -66,12 +66,16 @@ pub fn vector_pair_error<T: Real>(
 }
 
 pub(super) fn unit<T: Real>(v: &Vector3<T>) -> Option<Vector3<T>> {
+    let (u, n) = normalized(v);
+    positive_finite(n).then_some(u)
+}
+
+/// `(v / ‖v‖, ‖v‖)`, whatever the norm (one copy of the code for [`unit`] and the rays of
+/// [`triangulate`](super::triangulate)).
+#[cfg_attr(estimator_compact, inline(never))]
+pub(super) fn normalized<T: Real>(v: &Vector3<T>) -> (Vector3<T>, T) {
     let n = v.norm();
-    if positive_finite(n) {
-        Some(v / n)
-    } else {
-        None
-    }
+    (v / n, n)
 }
 
 /// The orthonormal triad `(u, u×v/‖u×v‖, u×(u×v)/‖u×v‖)` of the unit vector `u` and a second

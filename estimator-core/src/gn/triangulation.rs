@@ -11,6 +11,7 @@
 //! * **Covariance**: `(Σ wᵢ JᵢᵀJᵢ)⁻¹` at the solution (m²).
 
 use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
+use super::rotation::normalized;
 use super::{reprojection_error, Factor, Loss, PinholeCamera, SolveError};
 use crate::lie::{LieGroup, Se3};
 use crate::scalar::all_finite;
@@ -160,7 +161,7 @@ pub fn triangulate<T: Real>(
         let world_from_camera = pose.inverse();
         let c = world_from_camera.translation();
         let d = world_from_camera.rotation().act(&camera.unproject(z));
-        let d = d / d.norm();
+        let (d, _) = normalized(&d);
         // `Pᵢ = I − d dᵀ` is symmetric and `Factor::new` reads only the lower triangle of `m`:
         // its six distinct entries, then `m += Pᵢ` (lower triangle), `b += Pᵢ cᵢ`, each entry
         // with the arithmetic of nalgebra's `identity() − d * dᵀ` and `proj * c`.

@@ -157,16 +157,40 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
     where
         P: Problem<T, S, N, K> + ?Sized,
     {
+        self.accumulate(problem, state, loss)?;
+        finite_sums(
+            self.information.as_slice(),
+            self.gradient.as_slice(),
+            self.cost,
+        )
+    }
+
+    /// [`Self::rebuild`] without the finiteness test (which [`solve_into`] runs in its shared
+    /// part).
+    ///
+    /// # Errors
+    /// The problem's own error.
+    fn accumulate<S, P, const K: usize>(
+        &mut self,
+        problem: &P,
+        state: &S,
+        loss: &Loss<T>,
+    ) -> Result<(), SolveError>
+    where
+        P: Problem<T, S, N, K> + ?Sized,
+    {
         *self = Self::zeros();
-        problem.linearize(state, |e, j| self.add(loss, e, j))?;
-        if self.cost.is_finite()
-            && linalg::all_finite(self.gradient.as_slice())
-            && linalg::all_finite(self.information.as_slice())
-        {
-            Ok(())
-        } else {
-            Err(SolveError::NonFiniteResidual)
-        }
+        problem.linearize(state, |e, j| self.add(loss, e, j))
+    }
+}
+
+/// [`SolveError::NonFiniteResidual`] unless the cost, the gradient and the information of a
+/// linearization are finite.
+fn finite_sums<T: Real>(information: &[T], gradient: &[T], cost: T) -> Result<(), SolveError> {
+    if cost.is_finite() && linalg::all_finite(gradient) && linalg::all_finite(information) {
+        Ok(())
+    } else {
+        Err(SolveError::NonFiniteResidual)
     }
 }
 
@@ -425,7 +449,7 @@ fn drive<T: Real>(
         return Err(SolveError::NonFiniteGuess);
     }
     // The candidate is the guess: its linearization becomes the current one.
-    run.linearize()?;
+    linearize(run)?;
     run.accept(true);
     let initial_cost = run.parts().cost;
     let (iterations, status) = iterate(run, options)?;
@@ -446,6 +470,17 @@ fn drive<T: Real>(
         final_cost: p.cost,
         status,
     })
+}
+
+/// [`NormalEquations::rebuild`] at the candidate of `run`, into its trial linearization: the
+/// problem-specific accumulation, then the shared finiteness test.
+///
+/// # Errors
+/// As [`NormalEquations::rebuild`].
+fn linearize<T: Real>(run: &mut dyn Candidate<T>) -> Result<(), SolveError> {
+    run.linearize()?;
+    let p = run.parts();
+    finite_sums(p.scratch, p.trial_gradient, p.trial_cost)
 }
 
 /// `dst ← src` entry by entry (the shorter length; no panic on a mismatch).
@@ -474,6 +509,8 @@ struct Parts<'a, T> {
     cost: T,
     /// The trial linearization's `A` (`n × n`), scratch between linearizations.
     scratch: &'a mut [T],
+    /// `g` of the trial linearization.
+    trial_gradient: &'a [T],
     /// `F` of the trial linearization.
     trial_cost: T,
     /// The step `ξ`.
@@ -491,7 +528,7 @@ trait Candidate<T: Real> {
     /// Forms the candidate `a ⊕ ξ` (seed eq. 4.5) from the current state and the kept step;
     /// `true` when it is finite.
     fn propose(&mut self) -> bool;
-    /// The normal equations at the candidate, into the trial ([`NormalEquations::rebuild`]).
+    /// The normal equations at the candidate, into the trial, unchecked (see [`linearize`]).
     fn linearize(&mut self) -> Result<(), SolveError>;
     /// The candidate becomes the state; with `adopt_trial` the trial linearization becomes the
     /// current one (the old one is scratch from then on).
@@ -522,6 +559,7 @@ where
             gradient: self.ne.gradient.as_slice(),
             cost: self.ne.cost,
             scratch: self.trial.information.as_mut_slice(),
+            trial_gradient: self.trial.gradient.as_slice(),
             trial_cost: self.trial.cost,
             step: self.step.as_mut_slice(),
         }
@@ -538,7 +576,7 @@ where
 
     fn linearize(&mut self) -> Result<(), SolveError> {
         self.trial
-            .rebuild(self.problem, &self.candidate, &self.loss)
+            .accumulate(self.problem, &self.candidate, &self.loss)
     }
 
     fn accept(&mut self, adopt_trial: bool) {
@@ -605,7 +643,7 @@ fn iterate<T: Real>(
             break;
         }
         let built = if candidate_finite {
-            run.linearize()
+            linearize(run)
         } else {
             Err(SolveError::NonFiniteResidual)
         };

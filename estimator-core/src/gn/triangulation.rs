@@ -4,7 +4,7 @@
 //!
 //! * **Start** (closed form): the point closest to all rays in the least-squares sense. The ray
 //!   of view `i` leaves the centre `cᵢ = −Rᵢᵀ tᵢ` along `dᵢ = Rᵢᵀ K⁻¹[u, v, 1]ᵀ / ‖·‖`; with the
-//!   projector `Pᵢ = I − dᵢdᵢᵀ`, `(Σ Pᵢ) p = Σ Pᵢ cᵢ`, a 3×3 system factorized by [`Factor`]
+//!   projector `Pᵢ = I − dᵢdᵢᵀ`, `(Σ Pᵢ) p = Σ Pᵢ cᵢ`, a 3×3 system factorized by [`Factor`](super::Factor)
 //!   (singular for parallel rays).
 //! * **Refinement**: the residual `eᵢ = (K π(Tᵢ p) − zᵢ)/σ` with Jacobian
 //!   `∂eᵢ/∂p = Jπ(xᵢ) Rᵢ / σ` (seed Theorem 5.1: `∂(T p)/∂p = R`), and `p ⊕ δ = p + δ`.
@@ -12,7 +12,7 @@
 
 use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
 use super::rotation::normalized;
-use super::{reprojection_error, Factor, Loss, PinholeCamera, SolveError};
+use super::{linalg, reprojection_error, Loss, PinholeCamera, SolveError};
 use crate::lie::{LieGroup, Se3};
 use crate::scalar::all_finite;
 use crate::Real;
@@ -178,9 +178,13 @@ pub fn triangulate<T: Real>(
         b.y += c.x * pxy + c.y * pyy + c.z * pyz;
         b.z += c.x * pxz + c.y * pyz + c.z * pzz;
     }
-    let start = Factor::new(&m)
-        .and_then(|f| f.solve(&b))
-        .map_err(|_| SolveError::DegenerateGeometry)?;
+    // `Factor::new(&m)` and `Factor::solve(&b)` in place (any failure is degenerate geometry).
+    let mut start = b;
+    linalg::cholesky_in_place(m.as_mut_slice(), 3).map_err(|_| SolveError::DegenerateGeometry)?;
+    linalg::substitute(m.as_slice(), 3, start.as_mut_slice());
+    if !all_finite(start.as_slice()) {
+        return Err(SolveError::DegenerateGeometry);
+    }
 
     let inv_sigma = T::one() / options.sigma_px;
     let problem = TriProblem {

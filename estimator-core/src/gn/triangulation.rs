@@ -85,7 +85,7 @@ pub fn point_reprojection_error<T: Real>(
         inv_sigma,
         min_depth,
     )?;
-    Some((e, j.fixed_view::<2, 3>(0, 0).into_owned()))
+    Some((e, Matrix2x3::new(j.m11, j.m12, j.m13, j.m21, j.m22, j.m23)))
 }
 
 struct TriProblem<'a, T: Real> {

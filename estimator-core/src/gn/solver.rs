@@ -607,92 +607,89 @@ fn iterate<T: Real>(
 
     while iterations < options.max_iterations {
         iterations += 1;
-        let cost = run.parts().cost;
+        let p = run.parts();
+        let cost = p.cost;
         if cost <= T::zero() {
             status = Status::CostConverged;
             break;
         }
-        let p = run.parts();
+        // `None`: the damped information did not factorize (Levenberg-Marquardt only), and the
+        // step is rejected like one that does not lower the cost.
         let step = match damped_step(p.scratch, p.information, p.gradient, lambda, lm, p.step) {
-            Ok(s) => s,
+            Ok(s) => Some(s),
             Err(StepError::Solve(e)) => return Err(e),
             Err(StepError::Factor(e)) if !lm => return Err(e),
-            Err(StepError::Factor(_)) => {
-                lambda *= nu;
-                nu *= T::lit(2.0);
-                if lambda > T::lit(MAX_DAMPING) {
-                    status = Status::DampingSaturated;
+            Err(StepError::Factor(_)) => None,
+        };
+        if let Some(step) = step {
+            let small_step = step.norm <= options.step_tolerance
+                || step.info <= options.information_step_tolerance;
+            let candidate_finite = run.propose();
+            // A converged step (Gauss-Newton, or Levenberg-Marquardt with little damping) is
+            // taken without another pass over the residuals: it moves the state by at most
+            // `√information_step_tolerance` standard deviations, so the information, cost and
+            // covariance of the current linearization hold to that order.
+            if step.info <= options.information_step_tolerance
+                && (!lm || lambda <= T::one())
+                && candidate_finite
+            {
+                run.accept(false);
+                status = Status::StepConverged;
+                break;
+            }
+            let built = if candidate_finite {
+                linearize(run)
+            } else {
+                Err(SolveError::NonFiniteResidual)
+            };
+            let trial_cost = run.parts().trial_cost;
+            let accepted = match built {
+                Ok(()) => {
+                    if lm {
+                        // Gain ratio of the actual to the predicted decrease of the weighted
+                        // model F(ξ) ≈ F + 2ξᵀg + ξᵀAξ: predicted = −2ξᵀg − ξᵀAξ.
+                        let actual = cost - trial_cost;
+                        let predicted = -(step.gradient * T::lit(2.0)) - step.info;
+                        if actual > T::zero() && predicted > T::zero() {
+                            let r = actual / predicted;
+                            let c = T::lit(2.0) * r - T::one();
+                            lambda *= (T::one() - c * c * c).max(T::lit(1.0 / 3.0));
+                            nu = T::lit(2.0);
+                            true
+                        } else {
+                            false
+                        }
+                    } else {
+                        true
+                    }
+                }
+                Err(e) if !lm => return Err(e),
+                Err(_) => false,
+            };
+            if accepted {
+                let decrease = cost - trial_cost;
+                run.accept(true);
+                if small_step {
+                    status = Status::StepConverged;
+                    break;
+                }
+                if decrease >= T::zero() && decrease <= options.cost_tolerance * cost {
+                    status = Status::CostConverged;
                     break;
                 }
                 continue;
             }
-        };
-        let small_step =
-            step.norm <= options.step_tolerance || step.info <= options.information_step_tolerance;
-        let candidate_finite = run.propose();
-        // A converged step (Gauss-Newton, or Levenberg-Marquardt with little damping) is taken
-        // without another pass over the residuals: it moves the state by at most
-        // `√information_step_tolerance` standard deviations, so the information, cost and
-        // covariance of the current linearization hold to that order.
-        if step.info <= options.information_step_tolerance
-            && (!lm || lambda <= T::one())
-            && candidate_finite
-        {
-            run.accept(false);
-            status = Status::StepConverged;
-            break;
+            if small_step {
+                status = Status::StepConverged;
+                break;
+            }
         }
-        let built = if candidate_finite {
-            linearize(run)
-        } else {
-            Err(SolveError::NonFiniteResidual)
-        };
-        let trial_cost = run.parts().trial_cost;
-        let accepted = match built {
-            Ok(()) => {
-                if lm {
-                    // Gain ratio of the actual to the predicted decrease of the weighted model
-                    // F(ξ) ≈ F + 2ξᵀg + ξᵀAξ: predicted = −2ξᵀg − ξᵀAξ.
-                    let actual = cost - trial_cost;
-                    let predicted = -(step.gradient * T::lit(2.0)) - step.info;
-                    if actual > T::zero() && predicted > T::zero() {
-                        let r = actual / predicted;
-                        let c = T::lit(2.0) * r - T::one();
-                        lambda *= (T::one() - c * c * c).max(T::lit(1.0 / 3.0));
-                        nu = T::lit(2.0);
-                        true
-                    } else {
-                        false
-                    }
-                } else {
-                    true
-                }
-            }
-            Err(e) if !lm => return Err(e),
-            Err(_) => false,
-        };
-        if accepted {
-            let decrease = cost - trial_cost;
-            run.accept(true);
-            if small_step {
-                status = Status::StepConverged;
-                break;
-            }
-            if decrease >= T::zero() && decrease <= options.cost_tolerance * cost {
-                status = Status::CostConverged;
-                break;
-            }
-        } else {
-            if small_step {
-                status = Status::StepConverged;
-                break;
-            }
-            lambda *= nu;
-            nu *= T::lit(2.0);
-            if lambda > T::lit(MAX_DAMPING) {
-                status = Status::DampingSaturated;
-                break;
-            }
+        // Rejected: more damping.
+        lambda *= nu;
+        nu *= T::lit(2.0);
+        if lambda > T::lit(MAX_DAMPING) {
+            status = Status::DampingSaturated;
+            break;
         }
     }
     Ok((iterations, status))

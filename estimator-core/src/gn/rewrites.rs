@@ -234,3 +234,33 @@ fn unit_is_the_division_by_the_norm() {
     unit_cases::<f32>();
     unit_cases::<f64>();
 }
+
+/// `mul_transpose(w, b)` (TRIAD's `W Bᵀ`) against nalgebra's `w * b.transpose()`: random
+/// entries of every magnitude, signed zeros and infinities.
+fn mul_transpose_cases<T: Real>() {
+    let mut rng = Lcg(17);
+    for i in 0..3000 {
+        let mut m = [nalgebra::Matrix3::<T>::zeros(); 2];
+        for (h, x) in m.iter_mut().flat_map(|m| m.iter_mut()).enumerate() {
+            let scale = [1.0, 1e-30, 1e30, 1e200, 1e-200][(i + h) % 5];
+            *x = T::lit((rng.next() - 0.5) * scale);
+            match (i * 7 + h * 3) % 23 {
+                0 => *x = T::zero(),
+                1 => *x = T::lit(-0.0),
+                2 if i % 5 == 0 => *x = T::lit(f64::INFINITY),
+                3 if i % 7 == 0 => *x = T::lit(f64::NEG_INFINITY),
+                _ => {}
+            }
+        }
+        let [w, b] = m;
+        let got = super::rotation::mul_transpose(&w, &b);
+        let want = w * b.transpose();
+        assert!(same(got.as_slice(), want.as_slice()), "{w:?} {b:?}");
+    }
+}
+
+#[test]
+fn mul_transpose_is_the_nalgebra_product() {
+    mul_transpose_cases::<f32>();
+    mul_transpose_cases::<f64>();
+}

@@ -102,7 +102,25 @@ pub(super) fn triad<T: Real>(
 ) -> Option<So3<T>> {
     let b = triad_frame(b1, b2)?;
     let w = triad_frame(w1, w2)?;
-    So3::from_rotation_matrix(&(w * b.transpose()))
+    So3::from_rotation_matrix(&mul_transpose(&w, &b))
+}
+
+/// `w bᵀ` for 3×3 matrices as the sum of the outer products of their columns,
+/// `Σₖ wₖ bₖᵀ`, entry `(r, c)` = `(w_r0 b_c0 + w_r1 b_c1) + w_r2 b_c2`: nalgebra's product
+/// `w * b.transpose()` sums the same three products as `p₂ + (p₁ + p₀)`, the same bits for
+/// finite entries (addition is commutative), without the transpose and with a short loop.
+pub(super) fn mul_transpose<T: Real>(w: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    let mut out = Matrix3::zeros();
+    let columns = w.as_slice().chunks_exact(3).zip(b.as_slice().chunks_exact(3));
+    for (k, (wk, bk)) in columns.enumerate() {
+        for (oc, &bkc) in out.as_mut_slice().chunks_exact_mut(3).zip(bk) {
+            for (o, &wkr) in oc.iter_mut().zip(wk) {
+                // The first product is written, not added to zero (`0 + −0 = +0`).
+                *o = if k == 0 { wkr * bkc } else { *o + wkr * bkc };
+            }
+        }
+    }
+    out
 }
 
 /// [`triad`] of the unit vectors of two pairs; `None` for a zero vector or parallel directions.

@@ -62,7 +62,12 @@ pub fn vector_pair_error<T: Real>(
     inv_sigma: T,
 ) -> (Vector3<T>, Matrix3<T>) {
     let pred = world_from_body.inverse().act(world_unit);
-    ((pred - body_unit) * inv_sigma, skew(&pred) * inv_sigma)
+    let e = Vector3::new(
+        (pred.x - body_unit.x) * inv_sigma,
+        (pred.y - body_unit.y) * inv_sigma,
+        (pred.z - body_unit.z) * inv_sigma,
+    );
+    (e, skew(&pred) * inv_sigma)
 }
 
 pub(super) fn unit<T: Real>(v: &Vector3<T>) -> Option<Vector3<T>> {

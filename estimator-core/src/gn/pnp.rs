@@ -190,7 +190,8 @@ pub fn reprojection_error<T: Real>(
     j.m24 = r1.x;
     j.m25 = r1.y;
     j.m26 = r1.z;
-    Some(((uv - z) * inv_sigma, j))
+    let e = Vector2::new((uv.x - z.x) * inv_sigma, (uv.y - z.y) * inv_sigma);
+    Some((e, j))
 }
 
 /// `R p + t`: a world point in the camera frame (one copy of the code for every caller in a

@@ -312,7 +312,10 @@ fn inlier_mask<T: Real>(
             .camera
             .project(&camera_point(&r, &t, p), problem.min_depth)
             .ok_or(SolveError::PointBehindCamera)?;
-        let e = (uv - z) * problem.inv_sigma;
+        let e = Vector2::new(
+            (uv.x - z.x) * problem.inv_sigma,
+            (uv.y - z.y) * problem.inv_sigma,
+        );
         if e.norm_squared() <= chi2 {
             if let Some(w) = words.get_mut(k / 32) {
                 *w |= 1 << (k % 32);

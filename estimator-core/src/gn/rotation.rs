@@ -80,7 +80,7 @@ pub(super) fn unit<T: Real>(v: &Vector3<T>) -> Option<Vector3<T>> {
 #[cfg_attr(estimator_compact, inline(never))]
 pub(super) fn normalized<T: Real>(v: &Vector3<T>) -> (Vector3<T>, T) {
     let n = v.norm();
-    (v / n, n)
+    (Vector3::new(v.x / n, v.y / n, v.z / n), n)
 }
 
 /// The orthonormal triad `(u, u×v/‖u×v‖, u×(u×v)/‖u×v‖)` of the unit vector `u` and a second

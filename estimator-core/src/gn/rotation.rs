@@ -94,7 +94,7 @@ fn triad_frame<T: Real>(u: &Vector3<T>, v: &Vector3<T>) -> Option<Matrix3<T>> {
     if !not_parallel {
         return None;
     }
-    let s = n / nn;
+    let s = Vector3::new(n.x / nn, n.y / nn, n.z / nn);
     Some(Matrix3::from_columns(&[*u, s, u.cross(&s)]))
 }
 

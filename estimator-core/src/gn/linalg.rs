@@ -140,6 +140,13 @@ fn axpy<T: Real>(y: &mut [T], x: &[T], f: T) {
     }
 }
 
+/// `Σ xᵢyᵢ` over the common length, from zero, left to right: the back substitution's sums and
+/// those of the solver's step statistics (one copy when built for size).
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn dot<T: Real>(x: &[T], y: &[T]) -> T {
+    x.iter().zip(y).fold(T::zero(), |acc, (&p, &q)| acc + p * q)
+}
+
 /// `b ← (L Lᵀ)⁻¹ b` for the factor `l` (column-major `n × n`, lower triangle): forward
 /// substitution `L y = b` by columns (`y_i = b_i / L_ii`, then `b_{i+1..} −= y_i L_{i+1.., i}`),
 /// then back substitution `Lᵀ x = y` by dot products, as nalgebra's `Cholesky::solve_mut`.
@@ -161,11 +168,10 @@ pub(crate) fn substitute<T: Real>(l: &[T], n: usize, b: &mut [T]) {
         let Some(col) = l.get(i * n..i * n + n) else {
             continue;
         };
-        let dot = col
-            .iter()
-            .zip(b.iter())
-            .skip(i + 1)
-            .fold(T::zero(), |acc, (&x, &y)| acc + x * y);
+        let dot = match (col.get(i + 1..), b.get(i + 1..)) {
+            (Some(x), Some(y)) => dot(x, y),
+            _ => T::zero(),
+        };
         let diag = col.get(i).copied().unwrap_or_else(T::one);
         if let Some(b_i) = b.get_mut(i) {
             *b_i = (*b_i - dot) / diag;

@@ -733,17 +733,11 @@ fn damped_step<T: Real>(
     Ok(step_stats(a, g, step))
 }
 
-/// `Σ xᵢyᵢ` from zero, left to right (built for size, one copy for the three sums of
-/// [`step_stats`]).
-#[cfg_attr(estimator_compact, inline(never))]
-fn dot<T: Real>(x: &[T], y: &[T]) -> T {
-    x.iter().zip(y).fold(T::zero(), |acc, (&p, &q)| acc + p * q)
-}
-
 /// `‖ξ‖`, `ξᵀAξ` and `ξᵀg` for the column-major `n × n` matrix `a` (`n` the length of `step`):
 /// one copy of the code for every dimension.
 #[inline(never)]
 fn step_stats<T: Real>(a: &[T], g: &[T], step: &[T]) -> StepStats<T> {
+    use linalg::dot;
     let n = step.len();
     // ξᵀAξ = Σ_c ξ_c (A ξ)_c, with (A ξ)_c = Σ_r A_rc ξ_r for the symmetric A (column c of A).
     let info = if n == 0 {

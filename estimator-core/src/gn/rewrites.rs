@@ -264,3 +264,43 @@ fn mul_transpose_is_the_nalgebra_product() {
     mul_transpose_cases::<f32>();
     mul_transpose_cases::<f64>();
 }
+
+/// `Product::split` (slice copies) against its former body: entry by entry through `get`, zero
+/// past the end of `ξ`, entries beyond `NA + NB` ignored.
+fn split_before<T: Real, const NA: usize, const NB: usize, const N: usize>(
+    xi: &nalgebra::SVector<T, N>,
+) -> (nalgebra::SVector<T, NA>, nalgebra::SVector<T, NB>) {
+    let mut xa = nalgebra::SVector::<T, NA>::zeros();
+    let mut xb = nalgebra::SVector::<T, NB>::zeros();
+    for (k, d) in xa.iter_mut().enumerate() {
+        *d = xi.get(k).copied().unwrap_or_else(T::zero);
+    }
+    for (k, d) in xb.iter_mut().enumerate() {
+        *d = xi.get(NA + k).copied().unwrap_or_else(T::zero);
+    }
+    (xa, xb)
+}
+
+fn split_case<T: Real, const NA: usize, const NB: usize, const N: usize>(rng: &mut Lcg) {
+    let mut xi = nalgebra::SVector::<T, N>::from_fn(|_, _| T::lit(rng.next() - 0.5));
+    if let Some(x) = xi.get_mut(0) {
+        *x = T::lit(-0.0);
+    }
+    let (a, b) = Product::<(), (), NA, NB>::split::<T, N>(&xi);
+    let (a0, b0) = split_before::<T, NA, NB, N>(&xi);
+    assert!(same(a.as_slice(), a0.as_slice()) && same(b.as_slice(), b0.as_slice()));
+}
+
+#[test]
+fn split_is_the_indexed_copy() {
+    let mut rng = Lcg(5);
+    for _ in 0..20 {
+        split_case::<f64, 3, 3, 6>(&mut rng);
+        split_case::<f32, 3, 3, 6>(&mut rng);
+        split_case::<f64, 2, 4, 6>(&mut rng);
+        split_case::<f64, 3, 3, 4>(&mut rng);
+        split_case::<f32, 1, 3, 8>(&mut rng);
+        split_case::<f64, 4, 2, 3>(&mut rng);
+        split_case::<f64, 0, 2, 2>(&mut rng);
+    }
+}

@@ -230,10 +230,13 @@ impl<T: Real> Problem<T, Se3<T>, 6, 2> for PnpProblem<'_, T> {
         let r = state.rotation().rotation_matrix();
         let t = state.translation();
         for (p, z) in self.world_points.iter().zip(self.pixels) {
-            let (e, j) =
-                reprojection_error(&self.camera, &r, &t, p, z, self.inv_sigma, self.min_depth)
-                    .ok_or(SolveError::PointBehindCamera)?;
-            sink(&e, &j);
+            // Borrowed where it lies (no move out of the `Option`).
+            let block =
+                reprojection_error(&self.camera, &r, &t, p, z, self.inv_sigma, self.min_depth);
+            let Some((e, j)) = &block else {
+                return Err(SolveError::PointBehindCamera);
+            };
+            sink(e, j);
         }
         Ok(())
     }

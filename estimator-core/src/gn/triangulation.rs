@@ -102,16 +102,19 @@ impl<T: Real> Problem<T, Vector3<T>, 3, 2> for TriProblem<'_, T> {
         F: FnMut(&SVector<T, 2>, &SMatrix<T, 2, 3>),
     {
         for (pose, z) in self.poses.iter().zip(self.pixels) {
-            let (e, j) = point_reprojection_error(
+            // Borrowed where it lies (no move out of the `Option`).
+            let block = point_reprojection_error(
                 &self.camera,
                 pose,
                 state,
                 z,
                 self.inv_sigma,
                 self.min_depth,
-            )
-            .ok_or(SolveError::PointBehindCamera)?;
-            sink(&e, &j);
+            );
+            let Some((e, j)) = &block else {
+                return Err(SolveError::PointBehindCamera);
+            };
+            sink(e, j);
         }
         Ok(())
     }

@@ -171,8 +171,8 @@ impl<T: Real> Problem<T, So3<T>, 3, 3> for RotProblem<'_, T> {
         for pair in self.pairs {
             let b = unit(&pair.body).ok_or(SolveError::DegenerateGeometry)?;
             let w = unit(&pair.world).ok_or(SolveError::DegenerateGeometry)?;
-            let (e, j) = vector_pair_error(state, &b, &w, T::one() / pair.sigma);
-            sink(&e, &j);
+            let block = vector_pair_error(state, &b, &w, T::one() / pair.sigma);
+            sink(&block.0, &block.1);
         }
         Ok(())
     }

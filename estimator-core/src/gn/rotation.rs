@@ -169,9 +169,10 @@ impl<T: Real> Problem<T, So3<T>, 3, 3> for RotProblem<'_, T> {
         F: FnMut(&SVector<T, 3>, &SMatrix<T, 3, 3>),
     {
         for pair in self.pairs {
-            let b = unit(&pair.body).ok_or(SolveError::DegenerateGeometry)?;
-            let w = unit(&pair.world).ok_or(SolveError::DegenerateGeometry)?;
-            let block = vector_pair_error(state, &b, &w, T::one() / pair.sigma);
+            let (Some(b), Some(w)) = (&unit(&pair.body), &unit(&pair.world)) else {
+                return Err(SolveError::DegenerateGeometry);
+            };
+            let block = vector_pair_error(state, b, w, T::one() / pair.sigma);
             sink(&block.0, &block.1);
         }
         Ok(())

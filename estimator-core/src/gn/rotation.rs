@@ -116,7 +116,10 @@ pub(super) fn triad<T: Real>(
 /// finite entries (addition is commutative), without the transpose and with a short loop.
 pub(super) fn mul_transpose<T: Real>(w: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
     let mut out = Matrix3::zeros();
-    let columns = w.as_slice().chunks_exact(3).zip(b.as_slice().chunks_exact(3));
+    let columns = w
+        .as_slice()
+        .chunks_exact(3)
+        .zip(b.as_slice().chunks_exact(3));
     for (k, (wk, bk)) in columns.enumerate() {
         for (oc, &bkc) in out.as_mut_slice().chunks_exact_mut(3).zip(bk) {
             for (o, &wkr) in oc.iter_mut().zip(wk) {

@@ -10,8 +10,8 @@
 //!   `∂eᵢ/∂p = Jπ(xᵢ) Rᵢ / σ` (seed Theorem 5.1: `∂(T p)/∂p = R`), and `p ⊕ δ = p + δ`.
 //! * **Covariance**: `(Σ wᵢ JᵢᵀJᵢ)⁻¹` at the solution (m²).
 
-use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
 use super::rotation::normalized;
+use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
 use super::{linalg, reprojection_error, Loss, PinholeCamera, SolveError};
 use crate::lie::{LieGroup, Se3};
 use crate::scalar::all_finite;

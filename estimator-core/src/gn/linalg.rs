@@ -108,9 +108,7 @@ pub(crate) fn cholesky_in_place<T: Real>(a: &mut [T], n: usize) -> Result<(), So
                 continue;
             };
             let factor = -col_k.first().copied().unwrap_or_else(T::zero);
-            for (y, &x) in col_j.iter_mut().zip(col_k) {
-                *y = x * factor + *y;
-            }
+            axpy(col_j, col_k, factor);
         }
         let d = col_j.first().copied().unwrap_or_else(T::zero);
         // Written so that a NaN pivot (which compares false) is refused too.
@@ -133,6 +131,22 @@ pub(crate) fn cholesky_in_place<T: Real>(a: &mut [T], n: usize) -> Result<(), So
     Ok(())
 }
 
+/// `yₖ ← xₖ·f + yₖ` over the common length: the column update of [`cholesky_in_place`] and of
+/// the forward substitution (one copy when built for size).
+#[cfg_attr(estimator_compact, inline(never))]
+fn axpy<T: Real>(y: &mut [T], x: &[T], f: T) {
+    for (y, &x) in y.iter_mut().zip(x) {
+        *y = x * f + *y;
+    }
+}
+
+/// `Σ xᵢyᵢ` over the common length, from zero, left to right: the back substitution's sums and
+/// those of the solver's step statistics (one copy when built for size).
+#[cfg_attr(estimator_compact, inline(never))]
+pub(crate) fn dot<T: Real>(x: &[T], y: &[T]) -> T {
+    x.iter().zip(y).fold(T::zero(), |acc, (&p, &q)| acc + p * q)
+}
+
 /// `b ← (L Lᵀ)⁻¹ b` for the factor `l` (column-major `n × n`, lower triangle): forward
 /// substitution `L y = b` by columns (`y_i = b_i / L_ii`, then `b_{i+1..} −= y_i L_{i+1.., i}`),
 /// then back substitution `Lᵀ x = y` by dot products, as nalgebra's `Cholesky::solve_mut`.
@@ -146,19 +160,18 @@ pub(crate) fn substitute<T: Real>(l: &[T], n: usize, b: &mut [T]) {
         let Some(b_i) = b.get_mut(i) else { break };
         let coeff = *b_i / diag;
         *b_i = coeff;
-        for (y, &x) in b.iter_mut().zip(col).skip(i + 1) {
-            *y = x * -coeff + *y;
+        if let (Some(y), Some(x)) = (b.get_mut(i + 1..), col.get(i + 1..)) {
+            axpy(y, x, -coeff);
         }
     }
     for i in (0..n).rev() {
         let Some(col) = l.get(i * n..i * n + n) else {
             continue;
         };
-        let dot = col
-            .iter()
-            .zip(b.iter())
-            .skip(i + 1)
-            .fold(T::zero(), |acc, (&x, &y)| acc + x * y);
+        let dot = match (col.get(i + 1..), b.get(i + 1..)) {
+            (Some(x), Some(y)) => dot(x, y),
+            _ => T::zero(),
+        };
         let diag = col.get(i).copied().unwrap_or_else(T::one);
         if let Some(b_i) = b.get_mut(i) {
             *b_i = (*b_i - dot) / diag;

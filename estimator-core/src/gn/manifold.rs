@@ -76,12 +76,15 @@ impl<A, B, const NA: usize, const NB: usize> Product<A, B, NA, NB> {
     pub fn split<T: Real, const N: usize>(xi: &SVector<T, N>) -> (SVector<T, NA>, SVector<T, NB>) {
         let mut xa = SVector::<T, NA>::zeros();
         let mut xb = SVector::<T, NB>::zeros();
-        // By index (`get` is `None` past the end): no iterator adapter to instantiate.
-        for (k, d) in xa.iter_mut().enumerate() {
-            *d = xi.get(k).copied().unwrap_or_else(T::zero);
+        // Slice copies over the common length (the rest stays zero).
+        let xi = xi.as_slice();
+        for (d, &x) in xa.as_mut_slice().iter_mut().zip(xi) {
+            *d = x;
         }
-        for (k, d) in xb.iter_mut().enumerate() {
-            *d = xi.get(NA + k).copied().unwrap_or_else(T::zero);
+        if let Some(rest) = xi.get(NA..) {
+            for (d, &x) in xb.as_mut_slice().iter_mut().zip(rest) {
+                *d = x;
+            }
         }
         (xa, xb)
     }

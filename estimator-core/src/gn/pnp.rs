@@ -190,7 +190,8 @@ pub fn reprojection_error<T: Real>(
     j.m24 = r1.x;
     j.m25 = r1.y;
     j.m26 = r1.z;
-    Some(((uv - z) * inv_sigma, j))
+    let e = Vector2::new((uv.x - z.x) * inv_sigma, (uv.y - z.y) * inv_sigma);
+    Some((e, j))
 }
 
 /// `R p + t`: a world point in the camera frame (one copy of the code for every caller in a
@@ -229,10 +230,13 @@ impl<T: Real> Problem<T, Se3<T>, 6, 2> for PnpProblem<'_, T> {
         let r = state.rotation().rotation_matrix();
         let t = state.translation();
         for (p, z) in self.world_points.iter().zip(self.pixels) {
-            let (e, j) =
-                reprojection_error(&self.camera, &r, &t, p, z, self.inv_sigma, self.min_depth)
-                    .ok_or(SolveError::PointBehindCamera)?;
-            sink(&e, &j);
+            // Borrowed where it lies (no move out of the `Option`).
+            let block =
+                reprojection_error(&self.camera, &r, &t, p, z, self.inv_sigma, self.min_depth);
+            let Some((e, j)) = &block else {
+                return Err(SolveError::PointBehindCamera);
+            };
+            sink(e, j);
         }
         Ok(())
     }
@@ -311,7 +315,10 @@ fn inlier_mask<T: Real>(
             .camera
             .project(&camera_point(&r, &t, p), problem.min_depth)
             .ok_or(SolveError::PointBehindCamera)?;
-        let e = (uv - z) * problem.inv_sigma;
+        let e = Vector2::new(
+            (uv.x - z.x) * problem.inv_sigma,
+            (uv.y - z.y) * problem.inv_sigma,
+        );
         if e.norm_squared() <= chi2 {
             if let Some(w) = words.get_mut(k / 32) {
                 *w |= 1 << (k % 32);
@@ -349,12 +356,12 @@ fn cauchy_retry<T: Real>(
     };
     // One buffer serves both solves: only the Huber state is kept for the second.
     let mut c = Solution::placeholder(guess);
-    if solve_into(problem, guess, &huber, &mut c).is_err() {
+    if solve_into(problem, &huber, &mut c).is_err() {
         return 0;
     }
     let mut iterations = c.iterations;
-    let start = c.state;
-    if solve_into(problem, &start, options, &mut c).is_ok() {
+    // From the Huber state, in place.
+    if solve_into(problem, options, &mut c).is_ok() {
         iterations += c.iterations;
         if c.final_cost < best.0.final_cost {
             if let Ok(m) = inlier_mask(problem, &c.state, inlier_chi2) {
@@ -444,7 +451,7 @@ pub fn solve_pnp<T: Real>(
         initial_damping: SolverOptions::<T>::default().initial_damping,
     };
     let mut sol = Solution::placeholder(camera_from_world_guess);
-    solve_into(&problem, camera_from_world_guess, &solver_options, &mut sol)?;
+    solve_into(&problem, &solver_options, &mut sol)?;
     let mut inliers = inlier_mask(&problem, &sol.state, options.inlier_chi2)?;
     let mut iterations = sol.iterations;
 

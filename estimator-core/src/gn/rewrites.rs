@@ -162,3 +162,145 @@ fn triad_start_is_the_carried_form() {
     rotation_start::<f32>();
     rotation_start::<f64>();
 }
+
+/// `all_positive` and `all_non_negative` (size form: `x · 0 = 0` as the finiteness test)
+/// against `x > 0 && x.is_finite()` and `x ≥ 0 && x.is_finite()` on every class of number.
+fn sign_checks<T: Real>() {
+    let mut xs = [
+        0.0,
+        -0.0,
+        1e-310,
+        -1e-310,
+        1e-45,
+        -1e-45,
+        1.0,
+        -1.0,
+        3.4e38,
+        -3.4e38,
+        1e300,
+        f64::MAX,
+        -f64::MAX,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+        -f64::NAN,
+    ]
+    .to_vec();
+    let mut rng = Lcg(29);
+    xs.extend((0..200).map(|_| (rng.next() - 0.5) * 10f64.powf(80.0 * rng.next() - 40.0)));
+    for x in xs.into_iter().map(T::lit) {
+        let positive = x > T::zero() && x.is_finite();
+        let non_negative = x >= T::zero() && x.is_finite();
+        assert_eq!(all_positive(&[x]), positive, "{x:?}");
+        assert_eq!(all_non_negative(&[x]), non_negative, "{x:?}");
+        assert_eq!(non_negative_finite(x), non_negative, "{x:?}");
+        assert_eq!(all_positive(&[T::one(), x]), positive, "{x:?}");
+        assert_eq!(all_non_negative(&[x, T::one()]), non_negative, "{x:?}");
+    }
+}
+
+#[test]
+fn sign_checks_are_the_class_tests() {
+    sign_checks::<f32>();
+    sign_checks::<f64>();
+}
+
+/// `unit` (through `normalized`) against its former body: `n = ‖v‖`, `v / n` if `n` is finite
+/// and positive.
+fn unit_cases<T: Real>() {
+    let mut rng = Lcg(41);
+    for i in 0..2000 {
+        let mut d = rng.vector::<T>([1.0, 1e-30, 1e30, 1e38, 1e300, 1e-300][i % 6]);
+        match i % 13 {
+            1 => d.x = T::lit(f64::INFINITY),
+            2 => d.y = T::lit(f64::NAN),
+            3 => d = Vector3::zeros(),
+            4 => d.z = T::lit(-0.0),
+            _ => {}
+        }
+        let n = d.norm();
+        let old = (n.is_finite() && n > T::zero()).then(|| d / n);
+        match (unit(&d), old) {
+            (Some(u), Some(o)) => assert!(same(u.as_slice(), o.as_slice()), "{d:?}"),
+            (u, o) => assert!(u.is_none() && o.is_none(), "{d:?}"),
+        }
+        let (u, m) = super::rotation::normalized(&d);
+        assert!(same(u.as_slice(), (d / d.norm()).as_slice()) && same(&[m], &[n]));
+    }
+}
+
+#[test]
+fn unit_is_the_division_by_the_norm() {
+    unit_cases::<f32>();
+    unit_cases::<f64>();
+}
+
+/// `mul_transpose(w, b)` (TRIAD's `W Bᵀ`) against nalgebra's `w * b.transpose()`: random
+/// entries of every magnitude, signed zeros and infinities.
+fn mul_transpose_cases<T: Real>() {
+    let mut rng = Lcg(17);
+    for i in 0..3000 {
+        let mut m = [nalgebra::Matrix3::<T>::zeros(); 2];
+        for (h, x) in m.iter_mut().flat_map(|m| m.iter_mut()).enumerate() {
+            let scale = [1.0, 1e-30, 1e30, 1e200, 1e-200][(i + h) % 5];
+            *x = T::lit((rng.next() - 0.5) * scale);
+            match (i * 7 + h * 3) % 23 {
+                0 => *x = T::zero(),
+                1 => *x = T::lit(-0.0),
+                2 if i % 5 == 0 => *x = T::lit(f64::INFINITY),
+                3 if i % 7 == 0 => *x = T::lit(f64::NEG_INFINITY),
+                _ => {}
+            }
+        }
+        let [w, b] = m;
+        let got = super::rotation::mul_transpose(&w, &b);
+        let want = w * b.transpose();
+        assert!(same(got.as_slice(), want.as_slice()), "{w:?} {b:?}");
+    }
+}
+
+#[test]
+fn mul_transpose_is_the_nalgebra_product() {
+    mul_transpose_cases::<f32>();
+    mul_transpose_cases::<f64>();
+}
+
+/// `Product::split` (slice copies) against its former body: entry by entry through `get`, zero
+/// past the end of `ξ`, entries beyond `NA + NB` ignored.
+fn split_before<T: Real, const NA: usize, const NB: usize, const N: usize>(
+    xi: &nalgebra::SVector<T, N>,
+) -> (nalgebra::SVector<T, NA>, nalgebra::SVector<T, NB>) {
+    let mut xa = nalgebra::SVector::<T, NA>::zeros();
+    let mut xb = nalgebra::SVector::<T, NB>::zeros();
+    for (k, d) in xa.iter_mut().enumerate() {
+        *d = xi.get(k).copied().unwrap_or_else(T::zero);
+    }
+    for (k, d) in xb.iter_mut().enumerate() {
+        *d = xi.get(NA + k).copied().unwrap_or_else(T::zero);
+    }
+    (xa, xb)
+}
+
+fn split_case<T: Real, const NA: usize, const NB: usize, const N: usize>(rng: &mut Lcg) {
+    let mut xi = nalgebra::SVector::<T, N>::from_fn(|_, _| T::lit(rng.next() - 0.5));
+    if let Some(x) = xi.get_mut(0) {
+        *x = T::lit(-0.0);
+    }
+    let (a, b) = Product::<(), (), NA, NB>::split::<T, N>(&xi);
+    let (a0, b0) = split_before::<T, NA, NB, N>(&xi);
+    assert!(same(a.as_slice(), a0.as_slice()) && same(b.as_slice(), b0.as_slice()));
+}
+
+#[test]
+fn split_is_the_indexed_copy() {
+    let mut rng = Lcg(5);
+    for _ in 0..20 {
+        split_case::<f64, 3, 3, 6>(&mut rng);
+        split_case::<f32, 3, 3, 6>(&mut rng);
+        split_case::<f64, 2, 4, 6>(&mut rng);
+        split_case::<f64, 3, 3, 4>(&mut rng);
+        split_case::<f32, 1, 3, 8>(&mut rng);
+        split_case::<f64, 4, 2, 3>(&mut rng);
+        split_case::<f64, 0, 2, 2>(&mut rng);
+    }
+}

@@ -18,7 +18,7 @@
 use super::solver::{solve_into, Problem, Solution, SolverOptions, Status};
 use super::SolveError;
 use crate::lie::{skew, LieGroup, So3};
-use crate::scalar::all_finite;
+use crate::scalar::{all_finite, positive_finite};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
@@ -62,16 +62,25 @@ pub fn vector_pair_error<T: Real>(
     inv_sigma: T,
 ) -> (Vector3<T>, Matrix3<T>) {
     let pred = world_from_body.inverse().act(world_unit);
-    ((pred - body_unit) * inv_sigma, skew(&pred) * inv_sigma)
+    let e = Vector3::new(
+        (pred.x - body_unit.x) * inv_sigma,
+        (pred.y - body_unit.y) * inv_sigma,
+        (pred.z - body_unit.z) * inv_sigma,
+    );
+    (e, skew(&pred) * inv_sigma)
 }
 
 pub(super) fn unit<T: Real>(v: &Vector3<T>) -> Option<Vector3<T>> {
+    let (u, n) = normalized(v);
+    positive_finite(n).then_some(u)
+}
+
+/// `(v / ‖v‖, ‖v‖)`, whatever the norm (one copy of the code for [`unit`] and the rays of
+/// [`triangulate`](super::triangulate)).
+#[cfg_attr(estimator_compact, inline(never))]
+pub(super) fn normalized<T: Real>(v: &Vector3<T>) -> (Vector3<T>, T) {
     let n = v.norm();
-    if n.is_finite() && n > T::zero() {
-        Some(v / n)
-    } else {
-        None
-    }
+    (Vector3::new(v.x / n, v.y / n, v.z / n), n)
 }
 
 /// The orthonormal triad `(u, u×v/‖u×v‖, u×(u×v)/‖u×v‖)` of the unit vector `u` and a second
@@ -85,7 +94,7 @@ fn triad_frame<T: Real>(u: &Vector3<T>, v: &Vector3<T>) -> Option<Matrix3<T>> {
     if !not_parallel {
         return None;
     }
-    let s = n / nn;
+    let s = Vector3::new(n.x / nn, n.y / nn, n.z / nn);
     Some(Matrix3::from_columns(&[*u, s, u.cross(&s)]))
 }
 
@@ -98,7 +107,28 @@ pub(super) fn triad<T: Real>(
 ) -> Option<So3<T>> {
     let b = triad_frame(b1, b2)?;
     let w = triad_frame(w1, w2)?;
-    So3::from_rotation_matrix(&(w * b.transpose()))
+    So3::from_rotation_matrix(&mul_transpose(&w, &b))
+}
+
+/// `w bᵀ` for 3×3 matrices as the sum of the outer products of their columns,
+/// `Σₖ wₖ bₖᵀ`, entry `(r, c)` = `(w_r0 b_c0 + w_r1 b_c1) + w_r2 b_c2`: nalgebra's product
+/// `w * b.transpose()` sums the same three products as `p₂ + (p₁ + p₀)`, the same bits for
+/// finite entries (addition is commutative), without the transpose and with a short loop.
+pub(super) fn mul_transpose<T: Real>(w: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    let mut out = Matrix3::zeros();
+    let columns = w
+        .as_slice()
+        .chunks_exact(3)
+        .zip(b.as_slice().chunks_exact(3));
+    for (k, (wk, bk)) in columns.enumerate() {
+        for (oc, &bkc) in out.as_mut_slice().chunks_exact_mut(3).zip(bk) {
+            for (o, &wkr) in oc.iter_mut().zip(wk) {
+                // The first product is written, not added to zero (`0 + −0 = +0`).
+                *o = if k == 0 { wkr * bkc } else { *o + wkr * bkc };
+            }
+        }
+    }
+    out
 }
 
 /// [`triad`] of the unit vectors of two pairs; `None` for a zero vector or parallel directions.
@@ -142,10 +172,11 @@ impl<T: Real> Problem<T, So3<T>, 3, 3> for RotProblem<'_, T> {
         F: FnMut(&SVector<T, 3>, &SMatrix<T, 3, 3>),
     {
         for pair in self.pairs {
-            let b = unit(&pair.body).ok_or(SolveError::DegenerateGeometry)?;
-            let w = unit(&pair.world).ok_or(SolveError::DegenerateGeometry)?;
-            let (e, j) = vector_pair_error(state, &b, &w, T::one() / pair.sigma);
-            sink(&e, &j);
+            let (Some(b), Some(w)) = (&unit(&pair.body), &unit(&pair.world)) else {
+                return Err(SolveError::DegenerateGeometry);
+            };
+            let block = vector_pair_error(state, b, w, T::one() / pair.sigma);
+            sink(&block.0, &block.1);
         }
         Ok(())
     }
@@ -189,7 +220,7 @@ pub fn solve_rotation_from_vectors<T: Real>(
         None => start,
     };
     let mut sol = Solution::placeholder(&start);
-    solve_into(&RotProblem { pairs }, &start, options, &mut sol)?;
+    solve_into(&RotProblem { pairs }, options, &mut sol)?;
     let r = sol.state.normalize();
     if !r.is_finite() {
         return Err(SolveError::NonFiniteResidual);

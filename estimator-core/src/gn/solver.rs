@@ -157,16 +157,40 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
     where
         P: Problem<T, S, N, K> + ?Sized,
     {
+        self.accumulate(problem, state, loss)?;
+        finite_sums(
+            self.information.as_slice(),
+            self.gradient.as_slice(),
+            self.cost,
+        )
+    }
+
+    /// [`Self::rebuild`] without the finiteness test (which [`solve_into`] runs in its shared
+    /// part).
+    ///
+    /// # Errors
+    /// The problem's own error.
+    fn accumulate<S, P, const K: usize>(
+        &mut self,
+        problem: &P,
+        state: &S,
+        loss: &Loss<T>,
+    ) -> Result<(), SolveError>
+    where
+        P: Problem<T, S, N, K> + ?Sized,
+    {
         *self = Self::zeros();
-        problem.linearize(state, |e, j| self.add(loss, e, j))?;
-        if self.cost.is_finite()
-            && linalg::all_finite(self.gradient.as_slice())
-            && linalg::all_finite(self.information.as_slice())
-        {
-            Ok(())
-        } else {
-            Err(SolveError::NonFiniteResidual)
-        }
+        problem.linearize(state, |e, j| self.add(loss, e, j))
+    }
+}
+
+/// [`SolveError::NonFiniteResidual`] unless the cost, the gradient and the information of a
+/// linearization are finite.
+fn finite_sums<T: Real>(information: &[T], gradient: &[T], cost: T) -> Result<(), SolveError> {
+    if cost.is_finite() && linalg::all_finite(gradient) && linalg::all_finite(information) {
+        Ok(())
+    } else {
+        Err(SolveError::NonFiniteResidual)
     }
 }
 
@@ -339,7 +363,7 @@ where
     P: Problem<T, S, N, K> + ?Sized,
 {
     let mut out = Solution::placeholder(initial);
-    solve_into(problem, initial, options, &mut out)?;
+    solve_into(problem, options, &mut out)?;
     Ok(out)
 }
 
@@ -358,16 +382,18 @@ impl<T: Real, S: Copy, const N: usize> Solution<T, S, N> {
     }
 }
 
-/// [`solve`] writing its result into `out` (every field, on success) instead of returning it:
-/// callers that keep a solution avoid the by-value copies of the `N × N` covariance through
-/// `Result`, which matters for the stack on embedded targets. On error `out` may hold a partial
-/// result.
+/// [`solve`] from the guess `out.state`, writing its result into `out` (every field, on
+/// success) instead of returning it: callers that keep a solution avoid the by-value copies of
+/// the `N × N` covariance through `Result`, which matters for the stack on embedded targets; the
+/// state is iterated in place. On error `out` may hold a partial result.
+///
+/// Only the storage and the problem-specific steps ([`Candidate`]) are per problem; the rest
+/// ([`drive`]) is compiled once.
 ///
 /// # Errors
 /// As [`solve`].
 pub(crate) fn solve_into<T, S, P, const N: usize, const K: usize>(
     problem: &P,
-    initial: &S,
     options: &SolverOptions<T>,
     out: &mut Solution<T, S, N>,
 ) -> Result<(), SolveError>
@@ -376,37 +402,92 @@ where
     S: Manifold<T, N>,
     P: Problem<T, S, N, K> + ?Sized,
 {
-    if !options.is_valid() {
-        return Err(SolveError::InvalidOptions);
-    }
-    if !initial.all_finite() {
-        return Err(SolveError::NonFiniteGuess);
-    }
+    let Solution {
+        state, covariance, ..
+    } = out;
     let mut run = Run::<T, S, P, N, K> {
         problem,
         loss: options.loss,
-        state: *initial,
-        candidate: *initial,
+        candidate: *state,
+        state,
         ne: NormalEquations::zeros(),
         // The trial linearization, reused across iterations.
         trial: NormalEquations::zeros(),
         step: SVector::zeros(),
     };
-    run.ne.rebuild(problem, &run.state, &run.loss)?;
-    let initial_cost = run.ne.cost;
-    let (iterations, status) = iterate(&mut run, options)?;
-    let state = run.state;
-    let ne = &run.ne;
-    if !state.all_finite() || !ne.cost.is_finite() {
+    let done = drive(&mut run, options, covariance.as_mut_slice())?;
+    out.iterations = done.iterations;
+    out.initial_cost = done.initial_cost;
+    out.final_cost = done.final_cost;
+    out.status = done.status;
+    Ok(())
+}
+
+/// The scalar results of [`drive`].
+struct Done<T> {
+    iterations: usize,
+    initial_cost: T,
+    final_cost: T,
+    status: Status,
+}
+
+/// [`solve_into`] past the allocation of its storage: validation, the linearization at the
+/// guess, [`iterate`], and the covariance `A⁻¹` of the last linearization into `cov`
+/// (column-major). One copy of the code for every problem and dimension.
+///
+/// # Errors
+/// As [`solve`].
+fn drive<T: Real>(
+    run: &mut dyn Candidate<T>,
+    options: &SolverOptions<T>,
+    cov: &mut [T],
+) -> Result<Done<T>, SolveError> {
+    if !options.is_valid() {
+        return Err(SolveError::InvalidOptions);
+    }
+    if !run.finite() {
+        return Err(SolveError::NonFiniteGuess);
+    }
+    // The candidate is the guess: its linearization becomes the current one.
+    linearize(run)?;
+    run.accept(true);
+    let initial_cost = run.parts().cost;
+    let (iterations, status) = iterate(run, options)?;
+    let finite = run.finite();
+    let p = run.parts();
+    if !finite || !p.cost.is_finite() {
         return Err(SolveError::NonFiniteResidual);
     }
-    covariance_into(&ne.information, &mut out.covariance)?;
-    out.state = state;
-    out.iterations = iterations;
-    out.initial_cost = initial_cost;
-    out.final_cost = ne.cost;
-    out.status = status;
-    Ok(())
+    // `Factor::new` then `Factor::inverse_into`, on the trial's information as scratch (a copy
+    // of `A`; the trial linearization is no longer needed).
+    let n = p.step.len();
+    copy(p.scratch, p.information);
+    linalg::cholesky_in_place(p.scratch, n)?;
+    linalg::inverse_in_place(p.scratch, n, cov)?;
+    Ok(Done {
+        iterations,
+        initial_cost,
+        final_cost: p.cost,
+        status,
+    })
+}
+
+/// [`NormalEquations::rebuild`] at the candidate of `run`, into its trial linearization: the
+/// problem-specific accumulation, then the shared finiteness test.
+///
+/// # Errors
+/// As [`NormalEquations::rebuild`].
+fn linearize<T: Real>(run: &mut dyn Candidate<T>) -> Result<(), SolveError> {
+    run.linearize()?;
+    let p = run.parts();
+    finite_sums(p.scratch, p.trial_gradient, p.trial_cost)
+}
+
+/// `dst ← src` entry by entry (the shorter length; no panic on a mismatch).
+fn copy<T: Real>(dst: &mut [T], src: &[T]) {
+    for (d, &s) in dst.iter_mut().zip(src) {
+        *d = s;
+    }
 }
 
 /// What [`iterate`] needs of a step `ξ`: `‖ξ‖`, the model decrease terms `ξᵀAξ` and `ξᵀg`.
@@ -417,21 +498,37 @@ struct StepStats<T> {
     gradient: T,
 }
 
-/// The problem- and dimension-dependent half of an iteration of [`solve_into`], behind `dyn`, so
-/// that the iteration itself ([`iterate`]: damping, gain ratio, acceptance, convergence) is
+/// The storage of a [`Candidate`] as slices over its column-major arrays (`n` the length of
+/// `step`): the current linearization, the trial one's information as scratch, the step.
+struct Parts<'a, T> {
+    /// `A` (`n × n`) of the current linearization.
+    information: &'a [T],
+    /// `g` of the current linearization.
+    gradient: &'a [T],
+    /// `F` of the current linearization.
+    cost: T,
+    /// The trial linearization's `A` (`n × n`), scratch between linearizations.
+    scratch: &'a mut [T],
+    /// `g` of the trial linearization.
+    trial_gradient: &'a [T],
+    /// `F` of the trial linearization.
+    trial_cost: T,
+    /// The step `ξ`.
+    step: &'a mut [T],
+}
+
+/// The problem- and dimension-dependent half of [`solve_into`], behind `dyn`, so that the rest
+/// ([`drive`], [`iterate`]: damping, gain ratio, acceptance, convergence, covariance) is
 /// compiled once, not once per problem or per dimension.
 trait Candidate<T: Real> {
-    /// The cost `F` of the current linearization.
-    fn cost(&self) -> T;
-    /// The cost of the trial linearization.
-    fn trial_cost(&self) -> T;
-    /// Solves for the step `ξ` from the current linearization with damping `λ` (see
-    /// [`damped_step`]) and keeps it.
-    fn solve_step(&mut self, lambda: T, lm: bool) -> Result<StepStats<T>, StepError>;
+    /// The storage, as slices.
+    fn parts(&mut self) -> Parts<'_, T>;
+    /// `true` when the current state is finite.
+    fn finite(&self) -> bool;
     /// Forms the candidate `a ⊕ ξ` (seed eq. 4.5) from the current state and the kept step;
     /// `true` when it is finite.
     fn propose(&mut self) -> bool;
-    /// The normal equations at the candidate, into the trial ([`NormalEquations::rebuild`]).
+    /// The normal equations at the candidate, into the trial, unchecked (see [`linearize`]).
     fn linearize(&mut self) -> Result<(), SolveError>;
     /// The candidate becomes the state; with `adopt_trial` the trial linearization becomes the
     /// current one (the old one is scratch from then on).
@@ -443,7 +540,7 @@ trait Candidate<T: Real> {
 struct Run<'a, T: Real, S, P: ?Sized, const N: usize, const K: usize> {
     problem: &'a P,
     loss: Loss<T>,
-    state: S,
+    state: &'a mut S,
     candidate: S,
     ne: NormalEquations<T, N>,
     trial: NormalEquations<T, N>,
@@ -456,16 +553,20 @@ where
     S: Manifold<T, N>,
     P: Problem<T, S, N, K> + ?Sized,
 {
-    fn cost(&self) -> T {
-        self.ne.cost
+    fn parts(&mut self) -> Parts<'_, T> {
+        Parts {
+            information: self.ne.information.as_slice(),
+            gradient: self.ne.gradient.as_slice(),
+            cost: self.ne.cost,
+            scratch: self.trial.information.as_mut_slice(),
+            trial_gradient: self.trial.gradient.as_slice(),
+            trial_cost: self.trial.cost,
+            step: self.step.as_mut_slice(),
+        }
     }
 
-    fn trial_cost(&self) -> T {
-        self.trial.cost
-    }
-
-    fn solve_step(&mut self, lambda: T, lm: bool) -> Result<StepStats<T>, StepError> {
-        damped_step(&self.ne, lambda, lm, &mut self.step)
+    fn finite(&self) -> bool {
+        self.state.all_finite()
     }
 
     fn propose(&mut self) -> bool {
@@ -475,11 +576,11 @@ where
 
     fn linearize(&mut self) -> Result<(), SolveError> {
         self.trial
-            .rebuild(self.problem, &self.candidate, &self.loss)
+            .accumulate(self.problem, &self.candidate, &self.loss)
     }
 
     fn accept(&mut self, adopt_trial: bool) {
-        self.state = self.candidate;
+        *self.state = self.candidate;
         if adopt_trial {
             core::mem::swap(&mut self.ne, &mut self.trial);
         }
@@ -506,112 +607,92 @@ fn iterate<T: Real>(
 
     while iterations < options.max_iterations {
         iterations += 1;
-        let cost = run.cost();
+        let p = run.parts();
+        let cost = p.cost;
         if cost <= T::zero() {
             status = Status::CostConverged;
             break;
         }
-        let step = match run.solve_step(lambda, lm) {
-            Ok(s) => s,
+        // `None`: the damped information did not factorize (Levenberg-Marquardt only), and the
+        // step is rejected like one that does not lower the cost.
+        let step = match damped_step(p.scratch, p.information, p.gradient, lambda, lm, p.step) {
+            Ok(s) => Some(s),
             Err(StepError::Solve(e)) => return Err(e),
             Err(StepError::Factor(e)) if !lm => return Err(e),
-            Err(StepError::Factor(_)) => {
-                lambda *= nu;
-                nu *= T::lit(2.0);
-                if lambda > T::lit(MAX_DAMPING) {
-                    status = Status::DampingSaturated;
+            Err(StepError::Factor(_)) => None,
+        };
+        if let Some(step) = step {
+            let small_step = step.norm <= options.step_tolerance
+                || step.info <= options.information_step_tolerance;
+            let candidate_finite = run.propose();
+            // A converged step (Gauss-Newton, or Levenberg-Marquardt with little damping) is
+            // taken without another pass over the residuals: it moves the state by at most
+            // `√information_step_tolerance` standard deviations, so the information, cost and
+            // covariance of the current linearization hold to that order.
+            if step.info <= options.information_step_tolerance
+                && (!lm || lambda <= T::one())
+                && candidate_finite
+            {
+                run.accept(false);
+                status = Status::StepConverged;
+                break;
+            }
+            let built = if candidate_finite {
+                linearize(run)
+            } else {
+                Err(SolveError::NonFiniteResidual)
+            };
+            let trial_cost = run.parts().trial_cost;
+            let accepted = match built {
+                Ok(()) => {
+                    if lm {
+                        // Gain ratio of the actual to the predicted decrease of the weighted
+                        // model F(ξ) ≈ F + 2ξᵀg + ξᵀAξ: predicted = −2ξᵀg − ξᵀAξ.
+                        let actual = cost - trial_cost;
+                        let predicted = -(step.gradient * T::lit(2.0)) - step.info;
+                        if actual > T::zero() && predicted > T::zero() {
+                            let r = actual / predicted;
+                            let c = T::lit(2.0) * r - T::one();
+                            lambda *= (T::one() - c * c * c).max(T::lit(1.0 / 3.0));
+                            nu = T::lit(2.0);
+                            true
+                        } else {
+                            false
+                        }
+                    } else {
+                        true
+                    }
+                }
+                Err(e) if !lm => return Err(e),
+                Err(_) => false,
+            };
+            if accepted {
+                let decrease = cost - trial_cost;
+                run.accept(true);
+                if small_step {
+                    status = Status::StepConverged;
+                    break;
+                }
+                if decrease >= T::zero() && decrease <= options.cost_tolerance * cost {
+                    status = Status::CostConverged;
                     break;
                 }
                 continue;
             }
-        };
-        let small_step =
-            step.norm <= options.step_tolerance || step.info <= options.information_step_tolerance;
-        let candidate_finite = run.propose();
-        // A converged step (Gauss-Newton, or Levenberg-Marquardt with little damping) is taken
-        // without another pass over the residuals: it moves the state by at most
-        // `√information_step_tolerance` standard deviations, so the information, cost and
-        // covariance of the current linearization hold to that order.
-        if step.info <= options.information_step_tolerance
-            && (!lm || lambda <= T::one())
-            && candidate_finite
-        {
-            run.accept(false);
-            status = Status::StepConverged;
-            break;
+            if small_step {
+                status = Status::StepConverged;
+                break;
+            }
         }
-        let built = if candidate_finite {
-            run.linearize()
-        } else {
-            Err(SolveError::NonFiniteResidual)
-        };
-        let trial_cost = run.trial_cost();
-        let accepted = match built {
-            Ok(()) => {
-                if lm {
-                    // Gain ratio of the actual to the predicted decrease of the weighted model
-                    // F(ξ) ≈ F + 2ξᵀg + ξᵀAξ: predicted = −2ξᵀg − ξᵀAξ.
-                    let actual = cost - trial_cost;
-                    let predicted = -(step.gradient * T::lit(2.0)) - step.info;
-                    if actual > T::zero() && predicted > T::zero() {
-                        let r = actual / predicted;
-                        let c = T::lit(2.0) * r - T::one();
-                        lambda *= (T::one() - c * c * c).max(T::lit(1.0 / 3.0));
-                        nu = T::lit(2.0);
-                        true
-                    } else {
-                        false
-                    }
-                } else {
-                    true
-                }
-            }
-            Err(e) if !lm => return Err(e),
-            Err(_) => false,
-        };
-        if accepted {
-            let decrease = cost - trial_cost;
-            run.accept(true);
-            if small_step {
-                status = Status::StepConverged;
-                break;
-            }
-            if decrease >= T::zero() && decrease <= options.cost_tolerance * cost {
-                status = Status::CostConverged;
-                break;
-            }
-        } else {
-            if small_step {
-                status = Status::StepConverged;
-                break;
-            }
-            lambda *= nu;
-            nu *= T::lit(2.0);
-            if lambda > T::lit(MAX_DAMPING) {
-                status = Status::DampingSaturated;
-                break;
-            }
+        // Rejected: more damping.
+        lambda *= nu;
+        nu *= T::lit(2.0);
+        if lambda > T::lit(MAX_DAMPING) {
+            status = Status::DampingSaturated;
+            break;
         }
     }
     Ok((iterations, status))
-}
-
-/// The covariance `A⁻¹` of the last linearization, written into `cov`. Out of line (see
-/// [`damped_step`]): the factor's temporaries live in its own frame, not in the iteration's;
-/// per dimension `N`, not per problem.
-///
-/// # Errors
-/// Those of [`Factor::new`](super::Factor::new) and [`Factor::inverse`](super::Factor::inverse)
-/// (then `cov` may hold a partial result).
-#[inline(never)]
-fn covariance_into<T: Real, const N: usize>(
-    information: &SMatrix<T, N, N>,
-    cov: &mut SMatrix<T, N, N>,
-) -> Result<(), SolveError> {
-    // `Factor::new` then `Factor::inverse_into`, on one local copy of `A` (the smallest frame).
-    let mut l = *information;
-    linalg::cholesky_in_place(l.as_mut_slice(), N)?;
-    linalg::inverse_in_place(l.as_slice(), N, cov.as_mut_slice())
 }
 
 /// Why [`damped_step`] produced no step.
@@ -623,33 +704,10 @@ enum StepError {
 }
 
 /// The step `ξ` of one iteration, into `step`: `(A + λ diag A) ξ = −g` (Levenberg-Marquardt,
-/// `lm`) or `A ξ = −g` (Gauss-Newton), with the figures [`iterate`] needs. Kept out of line so
-/// its `N × N` temporary (the damped matrix and its factor) does not share a frame with the
-/// linearization; one copy per dimension `N`.
-#[inline(never)]
-fn damped_step<T: Real, const N: usize>(
-    ne: &NormalEquations<T, N>,
-    lambda: T,
-    lm: bool,
-    step: &mut SVector<T, N>,
-) -> Result<StepStats<T>, StepError> {
-    let mut damped = ne.information;
-    damped_step_shared(
-        damped.as_mut_slice(),
-        ne.information.as_slice(),
-        ne.gradient.as_slice(),
-        lambda,
-        lm,
-        step.as_mut_slice(),
-    )
-}
-
-/// [`damped_step`] on the column-major storage: `damped` holds a copy of the `n × n`
-/// information `a` and is overwritten by the factor, `g` is the gradient and `step` receives
-/// `ξ` (`n` their length). One copy of the code for every dimension.
-#[cfg_attr(estimator_compact, inline(never))]
-#[cfg_attr(not(estimator_compact), inline(always))]
-fn damped_step_shared<T: Real>(
+/// `lm`) or `A ξ = −g` (Gauss-Newton), with the figures [`iterate`] needs, on the column-major
+/// storage: `a` is the `n × n` information, `g` the gradient, `damped` scratch for the damped
+/// matrix and its factor (`n` the length of `step`). One copy of the code for every dimension.
+fn damped_step<T: Real>(
     damped: &mut [T],
     a: &[T],
     g: &[T],
@@ -658,11 +716,12 @@ fn damped_step_shared<T: Real>(
     step: &mut [T],
 ) -> Result<StepStats<T>, StepError> {
     let n = step.len();
+    copy(damped, a);
     if lm {
         damp(damped, n, lambda);
     }
     // Factorized in place (what `Factor::new` and `Factor::solve` do, without a second
-    // `N × N` copy in this frame).
+    // `N × N` copy).
     linalg::cholesky_in_place(damped, n).map_err(StepError::Factor)?;
     for (x, &gk) in step.iter_mut().zip(g) {
         *x = -gk;
@@ -678,7 +737,7 @@ fn damped_step_shared<T: Real>(
 /// one copy of the code for every dimension.
 #[inline(never)]
 fn step_stats<T: Real>(a: &[T], g: &[T], step: &[T]) -> StepStats<T> {
-    let dot = |x: &[T], y: &[T]| x.iter().zip(y).fold(T::zero(), |acc, (&p, &q)| acc + p * q);
+    use linalg::dot;
     let n = step.len();
     // ξᵀAξ = Σ_c ξ_c (A ξ)_c, with (A ξ)_c = Σ_r A_rc ξ_r for the symmetric A (column c of A).
     let info = if n == 0 {

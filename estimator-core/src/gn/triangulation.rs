@@ -4,15 +4,15 @@
 //!
 //! * **Start** (closed form): the point closest to all rays in the least-squares sense. The ray
 //!   of view `i` leaves the centre `cᵢ = −Rᵢᵀ tᵢ` along `dᵢ = Rᵢᵀ K⁻¹[u, v, 1]ᵀ / ‖·‖`; with the
-//!   projector `Pᵢ = I − dᵢdᵢᵀ`, `(Σ Pᵢ) p = Σ Pᵢ cᵢ`, a 3×3 system factorized by [`Factor`]
+//!   projector `Pᵢ = I − dᵢdᵢᵀ`, `(Σ Pᵢ) p = Σ Pᵢ cᵢ`, a 3×3 system factorized by [`Factor`](super::Factor)
 //!   (singular for parallel rays).
 //! * **Refinement**: the residual `eᵢ = (K π(Tᵢ p) − zᵢ)/σ` with Jacobian
 //!   `∂eᵢ/∂p = Jπ(xᵢ) Rᵢ / σ` (seed Theorem 5.1: `∂(T p)/∂p = R`), and `p ⊕ δ = p + δ`.
 //! * **Covariance**: `(Σ wᵢ JᵢᵀJᵢ)⁻¹` at the solution (m²).
 
-use super::pnp::camera_point;
+use super::rotation::normalized;
 use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
-use super::{Factor, Loss, PinholeCamera, SolveError};
+use super::{linalg, reprojection_error, Loss, PinholeCamera, SolveError};
 use crate::lie::{LieGroup, Se3};
 use crate::scalar::all_finite;
 use crate::Real;
@@ -73,11 +73,19 @@ pub fn point_reprojection_error<T: Real>(
     inv_sigma: T,
     min_depth: T,
 ) -> Option<(Vector2<T>, Matrix2x3<T>)> {
-    // `x = R p + t` and `∂x/∂p = R` (what `act_jac` gives, without its pose Jacobian).
+    // `x = R p + t` and `∂x/∂p = R`: the translation block `(Jπ/σ) R` of the pose Jacobian of
+    // [`reprojection_error`] (one copy of the projection code for both).
     let r = camera_from_world.rotation().rotation_matrix();
-    let x = camera_point(&r, &camera_from_world.translation(), p);
-    let (uv, jpi) = camera.project_jac(&x, min_depth)?;
-    Some(((uv - z) * inv_sigma, jpi * r * inv_sigma))
+    let (e, j) = reprojection_error(
+        camera,
+        &r,
+        &camera_from_world.translation(),
+        p,
+        z,
+        inv_sigma,
+        min_depth,
+    )?;
+    Some((e, Matrix2x3::new(j.m11, j.m12, j.m13, j.m21, j.m22, j.m23)))
 }
 
 struct TriProblem<'a, T: Real> {
@@ -94,16 +102,19 @@ impl<T: Real> Problem<T, Vector3<T>, 3, 2> for TriProblem<'_, T> {
         F: FnMut(&SVector<T, 2>, &SMatrix<T, 2, 3>),
     {
         for (pose, z) in self.poses.iter().zip(self.pixels) {
-            let (e, j) = point_reprojection_error(
+            // Borrowed where it lies (no move out of the `Option`).
+            let block = point_reprojection_error(
                 &self.camera,
                 pose,
                 state,
                 z,
                 self.inv_sigma,
                 self.min_depth,
-            )
-            .ok_or(SolveError::PointBehindCamera)?;
-            sink(&e, &j);
+            );
+            let Some((e, j)) = &block else {
+                return Err(SolveError::PointBehindCamera);
+            };
+            sink(e, j);
         }
         Ok(())
     }
@@ -153,7 +164,7 @@ pub fn triangulate<T: Real>(
         let world_from_camera = pose.inverse();
         let c = world_from_camera.translation();
         let d = world_from_camera.rotation().act(&camera.unproject(z));
-        let d = d / d.norm();
+        let (d, _) = normalized(&d);
         // `Pᵢ = I − d dᵀ` is symmetric and `Factor::new` reads only the lower triangle of `m`:
         // its six distinct entries, then `m += Pᵢ` (lower triangle), `b += Pᵢ cᵢ`, each entry
         // with the arithmetic of nalgebra's `identity() − d * dᵀ` and `proj * c`.
@@ -170,9 +181,13 @@ pub fn triangulate<T: Real>(
         b.y += c.x * pxy + c.y * pyy + c.z * pyz;
         b.z += c.x * pxz + c.y * pyz + c.z * pzz;
     }
-    let start = Factor::new(&m)
-        .and_then(|f| f.solve(&b))
-        .map_err(|_| SolveError::DegenerateGeometry)?;
+    // `Factor::new(&m)` and `Factor::solve(&b)` in place (any failure is degenerate geometry).
+    let mut start = b;
+    linalg::cholesky_in_place(m.as_mut_slice(), 3).map_err(|_| SolveError::DegenerateGeometry)?;
+    linalg::substitute(m.as_slice(), 3, start.as_mut_slice());
+    if !all_finite(start.as_slice()) {
+        return Err(SolveError::DegenerateGeometry);
+    }
 
     let inv_sigma = T::one() / options.sigma_px;
     let problem = TriProblem {
@@ -189,7 +204,7 @@ pub fn triangulate<T: Real>(
         ..SolverOptions::default()
     };
     let mut sol = Solution::placeholder(&start);
-    solve_into(&problem, &start, &solver_options, &mut sol)?;
+    solve_into(&problem, &solver_options, &mut sol)?;
     // The solver evaluated every view at its last linearization; the final (converged) step is
     // re-checked here so that a returned point is in front of every camera.
     let in_front = cameras_from_world

@@ -721,3 +721,86 @@ fn so3_conjugate_matrix_is_the_transpose() {
     so3_conjugate_matrix::<f32>();
     so3_conjugate_matrix::<f64>();
 }
+
+/// Special values for the per-component rewrites: signed zeros, infinities, NaN.
+fn specials<T: Real>() -> [T; 7] {
+    let inf = T::lit(f64::INFINITY);
+    [
+        T::zero(),
+        -T::zero(),
+        T::one(),
+        -T::lit(2.5),
+        inf,
+        -inf,
+        T::lit(f64::NAN),
+    ]
+}
+
+/// Quaternions (not necessarily unit) and vectors: random ones and ones made of special values.
+fn for_each_quaternion_and_vector<T: Real>(mut f: impl FnMut(&UnitQuaternion<T>, &Vector3<T>)) {
+    let s = specials::<T>();
+    for_each_quaternion::<T>(|q| {
+        for_each_vector::<T>(47, |p| f(q, p));
+        for (i, &x) in s.iter().enumerate() {
+            let y = s[(i + 3) % s.len()];
+            f(q, &Vector3::new(x, y, -x));
+            let odd = Quaternion::new(x, q.i, y, q.k);
+            f(
+                &UnitQuaternion::new_unchecked(odd),
+                &Vector3::new(y, T::one(), x),
+            );
+        }
+    });
+}
+
+/// SO(3)'s conjugate, rotation, renormalization and exponential written per component, and
+/// SE(3)'s `act`, `compose` and `inverse` through `act_plus`, against the nalgebra expressions
+/// they replace: the same bits (signed zeros and NaN included).
+fn so3_se3_per_component<T: Real>() {
+    use crate::test_support::same_bits;
+    for_each_quaternion_and_vector::<T>(|q, p| {
+        let r = So3::from_unit_quaternion(*q);
+        let qc = r.inverse().quaternion();
+        assert!(same_bits(
+            qc.coords.as_slice(),
+            q.conjugate().coords.as_slice()
+        ));
+        assert!(same_bits(
+            r.act(p).as_slice(),
+            q.transform_vector(p).as_slice()
+        ));
+        let qq = q.quaternion();
+        let scale = (T::lit(3.0) - qq.coords.norm_squared()) * T::lit(0.5);
+        let want = *qq * scale;
+        let got = r.renormalize().quaternion();
+        assert!(same_bits(got.coords.as_slice(), want.coords.as_slice()));
+        let k = AngleCoeffs::of_vector(p);
+        let v = p * k.half_sinc;
+        let e = So3::exp_from(&k, p).quaternion();
+        assert!(same_bits(e.coords.as_slice(), &[v.x, v.y, v.z, k.cos_half]));
+        // SE(3).
+        let t = Vector3::new(p.z, p.x, p.y) * T::lit(1.5);
+        let a = Se3::from_parts(r, t);
+        let b = Se3::from_parts(So3::from_unit_quaternion(q.inverse()), *p);
+        assert!(same_bits(
+            a.act(p).as_slice(),
+            (q.transform_vector(p) + t).as_slice()
+        ));
+        let ab = a.compose(&b);
+        let want_t = q.transform_vector(p) + t;
+        assert!(same_bits(ab.translation().as_slice(), want_t.as_slice()));
+        assert!(same_bits(
+            ab.rotation().quaternion().coords.as_slice(),
+            (*q * q.inverse()).coords.as_slice()
+        ));
+        let ai = a.inverse();
+        let want_i = -q.conjugate().transform_vector(&t);
+        assert!(same_bits(ai.translation().as_slice(), want_i.as_slice()));
+    });
+}
+
+#[test]
+fn so3_se3_per_component_forms_are_bit_identical() {
+    so3_se3_per_component::<f32>();
+    so3_se3_per_component::<f64>();
+}

@@ -277,20 +277,22 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     fn compose(&self, b: &Self) -> Self {
         Self {
             rotation: self.rotation.compose(&b.rotation),
-            translation: self.rotation.act(&b.translation) + self.translation,
+            translation: self.rotation.act_plus(&b.translation, &self.translation),
         }
     }
 
     fn inverse(&self) -> Self {
         let r_inv = self.rotation.inverse();
+        // `−(R⁻¹ t)` entry by entry (no `Neg` loop over a temporary).
+        let u = r_inv.act(&self.translation);
         Self {
             rotation: r_inv,
-            translation: -r_inv.act(&self.translation),
+            translation: Vector3::new(-u.x, -u.y, -u.z),
         }
     }
 
     fn act(&self, p: &Vector3<T>) -> Vector3<T> {
-        self.rotation.act(p) + self.translation
+        self.rotation.act_plus(p, &self.translation)
     }
 
     /// `[[R, [t]×R], [0, R]]`.

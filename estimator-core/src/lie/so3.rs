@@ -166,12 +166,18 @@ impl<T: Real> So3<T> {
         skew_poly(T::one(), T::lit(0.5), k.d(), w)
     }
 
-    /// The unit quaternion `exp(ω)` from precomputed coefficients.
+    /// The unit quaternion `exp(ω)` from precomputed coefficients, `v = h ω` per component (no
+    /// 3-vector temporary at opt-level "s").
     #[inline]
     pub(crate) fn exp_from(k: &AngleCoeffs<T>, w: &Vector3<T>) -> Self {
-        let v = w * k.half_sinc;
+        let h = k.half_sinc;
         Self {
-            q: UnitQuaternion::new_unchecked(Quaternion::new(k.cos_half, v.x, v.y, v.z)),
+            q: UnitQuaternion::new_unchecked(Quaternion::new(
+                k.cos_half,
+                w.x * h,
+                w.y * h,
+                w.z * h,
+            )),
         }
     }
 
@@ -191,12 +197,29 @@ impl<T: Real> So3<T> {
     /// rounding. For `|ε|` above about 0.1 use [`LieGroup::normalize`]. It is the cheap choice
     /// for a filter step at 1 kHz (no `sqrtf`, which is software on a Cortex-M4F).
     #[must_use]
+    #[cfg_attr(estimator_compact, inline(never))]
     pub fn renormalize(&self) -> Self {
         let q = self.q.quaternion();
         let scale = (T::lit(3.0) - q.coords.norm_squared()) * T::lit(0.5);
-        Self {
-            q: UnitQuaternion::new_unchecked(*q * scale),
-        }
+        Self::scaled(q, scale)
+    }
+
+    /// `q p q* + t`: nalgebra's formula for `q p q*` written out per component (the same
+    /// operations in the same order, so the same result; no temporary vectors at opt-level "s"):
+    /// `u = 2 v × p`, `p' = w u + v × u + p`, and `t` added last, as `R p + t` would. One shared
+    /// copy for SO(3)'s `act` (`t = −0`) and SE(3)'s `act`, `compose`.
+    pub(crate) fn act_plus(&self, p: &Vector3<T>, t: &Vector3<T>) -> Vector3<T> {
+        let q = self.q.quaternion();
+        let (w, x, y, z) = (q.w, q.i, q.j, q.k);
+        let two = T::lit(2.0);
+        let tx = (y * p.z - z * p.y) * two;
+        let ty = (z * p.x - x * p.z) * two;
+        let tz = (x * p.y - y * p.x) * two;
+        Vector3::new(
+            tx * w + (y * tz - z * ty) + p.x + t.x,
+            ty * w + (z * tx - x * tz) + p.y + t.y,
+            tz * w + (x * ty - y * tx) + p.z + t.z,
+        )
     }
 
     /// Rotation matrix `R`.
@@ -239,6 +262,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
     /// [`So3::exp_from`]): the same `θ`, `sincos(θ/2)` and `sin(θ/2)/θ`, so the same bits, without
     /// a second inlined copy of them (the kernel's `a`, `b`, `c` are computed and unused).
     #[cfg(estimator_compact)]
+    #[inline(never)]
     fn exp(w: &Vector3<T>) -> Self {
         Self::exp_from(&AngleCoeffs::of_vector(w), w)
     }
@@ -270,27 +294,22 @@ impl<T: Real> LieGroup<T> for So3<T> {
         Self { q: self.q * b.q }
     }
 
+    /// The conjugate, per component (nalgebra's `conjugate` negates the vector part in a loop
+    /// through a temporary at opt-level "s").
+    #[cfg_attr(estimator_compact, inline(never))]
     fn inverse(&self) -> Self {
+        let q = self.q.quaternion();
         Self {
-            q: self.q.conjugate(),
+            q: UnitQuaternion::new_unchecked(Quaternion::new(q.w, -q.i, -q.j, -q.k)),
         }
     }
 
-    /// `q p q*`, nalgebra's formula written out per component (the same operations in the same
-    /// order, so the same result; no temporary vectors at opt-level "s"): `t = 2 v × p`,
-    /// `p' = w t + v × t + p`.
+    /// `q p q*` (see `act_plus`).
+    #[cfg_attr(estimator_compact, inline(never))]
     fn act(&self, p: &Vector3<T>) -> Vector3<T> {
-        let q = self.q.quaternion();
-        let (w, x, y, z) = (q.w, q.i, q.j, q.k);
-        let two = T::lit(2.0);
-        let tx = (y * p.z - z * p.y) * two;
-        let ty = (z * p.x - x * p.z) * two;
-        let tz = (x * p.y - y * p.x) * two;
-        Vector3::new(
-            tx * w + (y * tz - z * ty) + p.x,
-            ty * w + (z * tx - x * tz) + p.y,
-            tz * w + (x * ty - y * tx) + p.z,
-        )
+        // `x + (−0) = x` for every `x` (signed zeros and NaN included): the plain rotation.
+        let z = -T::zero();
+        self.act_plus(p, &Vector3::new(z, z, z))
     }
 
     fn adjoint(&self) -> Matrix3<T> {

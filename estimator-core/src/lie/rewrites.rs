@@ -611,6 +611,22 @@ fn eye_cases<T: Real>() {
         j.as_slice(),
         SMatrix::<T, 6, 6>::identity().as_slice()
     ));
+    // SE(3)'s compose_jac: `I` from `eye`, `Ad_{b⁻¹}`, and the product.
+    let b6 = Se3::exp(&SVector::<T, 6>::new(
+        T::lit(0.1),
+        T::lit(2.0),
+        T::lit(-1.0),
+        T::lit(0.4),
+        T::lit(-2.5),
+        T::lit(0.9),
+    ));
+    let (ab, jb, ji) = a6.compose_jac(&b6);
+    assert!(crate::test_support::same_bits(
+        ji.as_slice(),
+        SMatrix::<T, 6, 6>::identity().as_slice()
+    ));
+    assert!(same(jb.as_slice(), b6.inverse().adjoint().as_slice()));
+    assert!(ab == a6.compose(&b6));
 }
 
 #[test]
@@ -796,6 +812,26 @@ fn so3_se3_per_component<T: Real>() {
         let ai = a.inverse();
         let want_i = -q.conjugate().transform_vector(&t);
         assert!(same_bits(ai.translation().as_slice(), want_i.as_slice()));
+        // try_from_matrix: the blocks entry by entry, as `fixed_view(..).into_owned()` read them.
+        let mut m = a.matrix();
+        m[(0, 1)] += p.x * T::lit(1e-4);
+        let got = Se3::try_from_matrix(&m);
+        let want = So3::try_from_matrix(&m.fixed_view::<3, 3>(0, 0).into_owned())
+            .map(|r| Se3::from_parts(r, Vector3::new(m.m14, m.m24, m.m34)))
+            .filter(Se3::is_finite);
+        assert_eq!(got.is_some(), want.is_some());
+        if let (Some(g), Some(w)) = (got, want) {
+            assert!(same_bits(
+                g.translation().as_slice(),
+                w.translation().as_slice()
+            ));
+            let (gq, wq) = (g.rotation().quaternion(), w.rotation().quaternion());
+            assert!(same_bits(gq.coords.as_slice(), wq.coords.as_slice()));
+        }
+        let m2 = Se2::new(p.x, p.y, p.z).matrix();
+        let got2 = Se2::try_from_matrix(&m2);
+        let want2 = So2::try_from_matrix(&m2.fixed_view::<2, 2>(0, 0).into_owned());
+        assert_eq!(got2.map(|g| g.rotation()), want2.filter(|_| got2.is_some()));
     });
 }
 

@@ -236,7 +236,8 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         if !bottom_ok {
             return None;
         }
-        let r = So2::try_from_matrix(&m.fixed_view::<2, 2>(0, 0).into_owned())?;
+        // The rotation block entry by entry (`fixed_view(..).into_owned()` is a copy loop).
+        let r = So2::try_from_matrix(&Matrix2::new(m.m11, m.m12, m.m21, m.m22))?;
         let t = Vector2::new(m.m13, m.m23);
         if !all_finite(t.as_slice()) {
             return None;

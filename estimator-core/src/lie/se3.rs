@@ -188,15 +188,19 @@ impl<T: Real> Se3<T> {
         upper_block(&(jinv * rho), &mul3(&mul3(&jinv, &q), &jinv))
     }
 
-    /// `J_r(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left Jacobians.
-    #[inline(always)]
+    /// `J_r(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left Jacobians. Out of line
+    /// when built for size (one copy of the split and the kernel call for both).
+    #[cfg_attr(not(estimator_compact), inline(always))]
+    #[cfg_attr(estimator_compact, inline(never))]
     fn jr_at(xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
         let (v, w) = split(xi);
         Self::jr_from(&AngleCoeffs::of_vector(&w), &v, &w, sigma)
     }
 
-    /// `J_r⁻¹(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left inverse Jacobians.
-    #[inline(always)]
+    /// `J_r⁻¹(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left inverse Jacobians
+    /// (out of line when built for size, as [`Self::jr_at`]).
+    #[cfg_attr(not(estimator_compact), inline(always))]
+    #[cfg_attr(estimator_compact, inline(never))]
     fn jr_inv_at(xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
         let (v, w) = split(xi);
         let k = AngleCoeffs::of_vector(&w);
@@ -208,8 +212,12 @@ impl<T: Real> Se3<T> {
     #[cfg_attr(estimator_compact, inline(never))]
     fn signed_adjoint(&self, sigma: T) -> Matrix6<T> {
         let r = self.rotation.rotation_matrix();
-        let tr = mul_skew(&r.transpose(), &(self.translation * -sigma)).transpose();
-        upper_block(&(r * sigma), &tr)
+        // `Rᵀ` as the rotation matrix of the conjugate (the same bits, see `compose_jac` of SO(3))
+        // and `−σt` per component: no transposing copy and no loop over a temporary.
+        let rt = self.rotation.inverse().rotation_matrix();
+        let t = &self.translation;
+        let p = Vector3::new(t.x * -sigma, t.y * -sigma, t.z * -sigma);
+        upper_block(&(r * sigma), &mul_skew(&rt, &p).transpose())
     }
 
     /// `−Ad_T`.
@@ -274,6 +282,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         Vector6::new(m.m14, m.m24, m.m34, m.m32, m.m13, m.m21)
     }
 
+    #[cfg_attr(estimator_compact, inline(never))]
     fn compose(&self, b: &Self) -> Self {
         Self {
             rotation: self.rotation.compose(&b.rotation),
@@ -343,7 +352,10 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         if !bottom_ok {
             return None;
         }
-        let r = So3::try_from_matrix(&m.fixed_view::<3, 3>(0, 0).into_owned())?;
+        // The rotation block entry by entry (`fixed_view(..).into_owned()` is a copy loop).
+        let r = So3::try_from_matrix(&Matrix3::new(
+            m.m11, m.m12, m.m13, m.m21, m.m22, m.m23, m.m31, m.m32, m.m33,
+        ))?;
         let t = Vector3::new(m.m14, m.m24, m.m34);
         if !all_finite(t.as_slice()) {
             return None;
@@ -368,6 +380,11 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         let (xi, k) = self.log_with_coeffs();
         let (v, w) = split(&xi);
         (xi, Self::jr_inv_from(&k, &v, &w, T::one(), T::one()))
+    }
+
+    /// `(a·b, Ad_{b⁻¹}, I)`, the identity from `eye` (not `Ad_e` built from an identity motion).
+    fn compose_jac(&self, b: &Self) -> (Self, Matrix6<T>, Matrix6<T>) {
+        (self.compose(b), b.inverse().adjoint(), eye())
     }
 
     /// `(a⁻¹, −Ad_a)`.

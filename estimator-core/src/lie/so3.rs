@@ -383,17 +383,18 @@ impl<T: Real> LieGroup<T> for So3<T> {
 
     /// `(a⁻¹, −R)`, negated in place (`negate`).
     fn inverse_jac(&self) -> (Self, Matrix3<T>) {
-        let mut j = self.adjoint();
-        negate(&mut j);
-        (self.inverse(), j)
+        // Negated where it is returned (no copy of the Jacobian after the negation).
+        let mut out = (self.inverse(), self.adjoint());
+        negate(&mut out.1);
+        out
     }
 
     /// `(z = a⁻¹·b, −R_{z⁻¹}, I)`, negated in place (`negate`).
     fn between_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
         let z = self.between(b);
-        let mut j = z.inverse().adjoint();
-        negate(&mut j);
-        (z, j, eye())
+        let mut out = (z, z.inverse().adjoint(), eye());
+        negate(&mut out.1);
+        out
     }
 
     fn rminus_jac(&self, b: &Self) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {

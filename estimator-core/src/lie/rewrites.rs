@@ -264,6 +264,19 @@ fn so3_jacobians<T: Real>() {
         let jr_inv = So3::right_jacobian_inv(w);
         assert!(m(&So3::left_jacobian(w), &jr.transpose()));
         assert!(m(&So3::left_jacobian_inv(w), &jr_inv.transpose()));
+        // Through jr_at / jr_inv_at (σ = ±1): the skew_poly forms they replace, to the bit.
+        let k = AngleCoeffs::of_vector(w);
+        let (b, c, d, h) = (k.b, k.c, k.d(), T::lit(0.5));
+        let bits = |a: &Matrix3<T>, b: &Matrix3<T>| {
+            crate::test_support::same_bits(a.as_slice(), b.as_slice())
+        };
+        assert!(bits(&jr, &skew_poly(T::one(), -b, c, w)));
+        assert!(bits(&So3::left_jacobian(w), &skew_poly(T::one(), b, c, w)));
+        assert!(bits(&jr_inv, &skew_poly(T::one(), h, d, w)));
+        assert!(bits(
+            &So3::left_jacobian_inv(w),
+            &skew_poly(T::one(), -h, d, w)
+        ));
         let a = So3::exp(w);
         let b = So3::exp(&(w * T::lit(-0.4)));
         let (tau, jr, jl) = a.rminus_jac(&b);
@@ -611,6 +624,14 @@ fn eye_cases<T: Real>() {
         j.as_slice(),
         SMatrix::<T, 6, 6>::identity().as_slice()
     ));
+    let b2 = Se2::<T>::new(T::lit(-1.5), T::lit(0.25), T::lit(-2.8));
+    let (ab2, jb2, ji2) = a2.compose_jac(&b2);
+    assert!(crate::test_support::same_bits(
+        ji2.as_slice(),
+        Matrix3::<T>::identity().as_slice()
+    ));
+    assert!(same(jb2.as_slice(), b2.inverse().adjoint().as_slice()));
+    assert!(ab2 == a2.compose(&b2));
     // SE(3)'s compose_jac: `I` from `eye`, `Ad_{b⁻¹}`, and the product.
     let b6 = Se3::exp(&SVector::<T, 6>::new(
         T::lit(0.1),

@@ -255,6 +255,11 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         (Self::exp_from(&k, tau), Self::jr_from(&k, tau))
     }
 
+    /// `(a·b, Ad_{b⁻¹}, I)`, the identity from `eye` (not `Ad_e` built from an identity motion).
+    fn compose_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
+        (self.compose(b), b.inverse().adjoint(), eye())
+    }
+
     /// `(a⁻¹, −Ad_a)`, negated in place (`negate`).
     fn inverse_jac(&self) -> (Self, Matrix3<T>) {
         // Negated where it is returned (no copy of the Jacobian after the negation).

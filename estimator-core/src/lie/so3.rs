@@ -166,6 +166,22 @@ impl<T: Real> So3<T> {
         skew_poly(T::one(), T::lit(0.5), k.d(), w)
     }
 
+    /// `J_r(σω) = I − σb[ω]× + c[ω]×²` for `σ = ±1` (`σ = −1`: `J_l(ω)`), with the kernel of `ω`
+    /// (`−b·σ` is `∓b` exactly). Out of line when built for size: one copy for the right and
+    /// left Jacobians.
+    #[cfg_attr(not(estimator_compact), inline(always))]
+    fn jr_at(w: &Vector3<T>, sigma: T) -> Matrix3<T> {
+        let k = AngleCoeffs::of_vector(w);
+        skew_poly(T::one(), -k.b * sigma, k.c, w)
+    }
+
+    /// `J_r⁻¹(σω) = I + ½σ[ω]× + d[ω]×²` for `σ = ±1` (`½·σ` is `±½` exactly).
+    #[inline(always)]
+    fn jr_inv_at(w: &Vector3<T>, sigma: T) -> Matrix3<T> {
+        let k = AngleCoeffs::of_vector(w);
+        skew_poly(T::one(), T::lit(0.5) * sigma, k.d(), w)
+    }
+
     /// The unit quaternion `exp(ω)` from precomputed coefficients, `v = h ω` per component (no
     /// 3-vector temporary at opt-level "s").
     #[inline]
@@ -317,23 +333,21 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn right_jacobian(w: &Vector3<T>) -> Matrix3<T> {
-        Self::jr_from(&AngleCoeffs::of_vector(w), w)
+        Self::jr_at(w, T::one())
     }
 
     fn right_jacobian_inv(w: &Vector3<T>) -> Matrix3<T> {
-        Self::jr_inv_from(&AngleCoeffs::of_vector(w), w)
+        Self::jr_inv_at(w, T::one())
     }
 
     /// `J_r(ω)ᵀ = I + b[ω]× + c[ω]×²`.
     fn left_jacobian(w: &Vector3<T>) -> Matrix3<T> {
-        let k = AngleCoeffs::of_vector(w);
-        skew_poly(T::one(), k.b, k.c, w)
+        Self::jr_at(w, -T::one())
     }
 
     /// `J_r⁻¹(ω)ᵀ = I − ½[ω]× + d[ω]×²`.
     fn left_jacobian_inv(w: &Vector3<T>) -> Matrix3<T> {
-        let k = AngleCoeffs::of_vector(w);
-        skew_poly(T::one(), T::lit(-0.5), k.d(), w)
+        Self::jr_inv_at(w, -T::one())
     }
 
     fn matrix(&self) -> Matrix3<T> {

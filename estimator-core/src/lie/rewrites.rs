@@ -851,8 +851,24 @@ fn so3_se3_per_component<T: Real>() {
         }
         let m2 = Se2::new(p.x, p.y, p.z).matrix();
         let got2 = Se2::try_from_matrix(&m2);
-        let want2 = So2::try_from_matrix(&m2.fixed_view::<2, 2>(0, 0).into_owned());
-        assert_eq!(got2.map(|g| g.rotation()), want2.filter(|_| got2.is_some()));
+        let t2 = [m2.m13, m2.m23];
+        let want2 = So2::try_from_matrix(&m2.fixed_view::<2, 2>(0, 0).into_owned())
+            .filter(|_| all_finite(&t2));
+        assert_eq!(got2.map(|g| g.rotation()), want2);
+        // A non-finite translation entry alone is rejected (the `x·0` term of the bottom sum).
+        for x in specials::<T>() {
+            let mut m =
+                Se3::from_parts(r, Vector3::new(T::one(), T::lit(2.0), T::lit(-3.0))).matrix();
+            m.m24 = x;
+            let rot_ok = So3::try_from_matrix(&r.rotation_matrix()).is_some();
+            assert_eq!(
+                Se3::try_from_matrix(&m).is_some(),
+                all_finite(&[x]) && rot_ok
+            );
+            let mut m2 = Se2::new(T::one(), T::one(), T::lit(0.3)).matrix();
+            m2.m13 = x;
+            assert_eq!(Se2::try_from_matrix(&m2).is_some(), all_finite(&[x]));
+        }
     });
 }
 

@@ -230,7 +230,11 @@ impl<T: Real> LieGroup<T> for Se2<T> {
 
     fn try_from_matrix(m: &Matrix3<T>) -> Option<Self> {
         let tol = T::lit(ORTHOGONALITY_TOLERANCE);
-        let bottom = m.m31.abs() + m.m32.abs() + (m.m33 - T::one()).abs();
+        // `x·0` is `±0` for finite `x` and NaN otherwise (see SE(3)'s `try_from_matrix`): the sum
+        // is NaN exactly when `t` is not finite.
+        let z = T::zero();
+        let finite_t = m.m13 * z + m.m23 * z;
+        let bottom = m.m31.abs() + m.m32.abs() + (m.m33 - T::one()).abs() + finite_t;
         // Written so that NaN (which compares false) is rejected too.
         let bottom_ok = bottom <= tol;
         if !bottom_ok {
@@ -238,11 +242,7 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         }
         // The rotation block entry by entry (`fixed_view(..).into_owned()` is a copy loop).
         let r = So2::try_from_matrix(&Matrix2::new(m.m11, m.m12, m.m21, m.m22))?;
-        let t = Vector2::new(m.m13, m.m23);
-        if !all_finite(t.as_slice()) {
-            return None;
-        }
-        Some(Self::from_parts(r, t))
+        Some(Self::from_parts(r, Vector2::new(m.m13, m.m23)))
     }
 
     fn is_finite(&self) -> bool {

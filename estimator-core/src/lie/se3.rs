@@ -346,7 +346,12 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     fn try_from_matrix(m: &Matrix4<T>) -> Option<Self> {
         let tol = T::lit(ORTHOGONALITY_TOLERANCE);
-        let bottom = m.m41.abs() + m.m42.abs() + m.m43.abs() + (m.m44 - T::one()).abs();
+        // `x·0` is `±0` for finite `x` and NaN otherwise: adding the translation's makes the sum
+        // NaN exactly when `t` is not finite, and leaves it unchanged otherwise (no separate
+        // finiteness check of `t`).
+        let z = T::zero();
+        let finite_t = m.m14 * z + m.m24 * z + m.m34 * z;
+        let bottom = m.m41.abs() + m.m42.abs() + m.m43.abs() + (m.m44 - T::one()).abs() + finite_t;
         // Written so that NaN (which compares false) is rejected too.
         let bottom_ok = bottom <= tol;
         if !bottom_ok {
@@ -356,11 +361,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         let r = So3::try_from_matrix(&Matrix3::new(
             m.m11, m.m12, m.m13, m.m21, m.m22, m.m23, m.m31, m.m32, m.m33,
         ))?;
-        let t = Vector3::new(m.m14, m.m24, m.m34);
-        if !all_finite(t.as_slice()) {
-            return None;
-        }
-        Some(Self::from_parts(r, t))
+        Some(Self::from_parts(r, Vector3::new(m.m14, m.m24, m.m34)))
     }
 
     fn is_finite(&self) -> bool {

@@ -183,9 +183,13 @@ impl<T: Real> Se3<T> {
         sigma: T,
         rho: T,
     ) -> Matrix6<T> {
-        let jinv = skew_poly(T::one(), T::lit(0.5) * sigma, k.d(), w);
+        let (half_sigma, d) = (T::lit(0.5) * sigma, k.d());
+        let jinv = skew_poly(T::one(), half_sigma, d, w);
         let q = q_block(k, v, w, -rho, rho * sigma);
-        upper_block(&(jinv * rho), &mul3(&mul3(&jinv, &q), &jinv))
+        // `ρJ` as `skew_poly(ρ, ½σρ, ρd)`: the same numbers as `J·ρ` up to the sign of zeros
+        // (see `skew_poly`), without a scaled copy of `J`.
+        let diag = skew_poly(rho, half_sigma * rho, d * rho, w);
+        upper_block(&diag, &mul3(&mul3(&jinv, &q), &jinv))
     }
 
     /// `J_r(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left Jacobians. Out of line

@@ -160,32 +160,34 @@ impl<T: Real> Se3<T> {
         self.translation
     }
 
-    fn exp_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Self {
+    /// `exp(ξ)` from the kernel of `ω` (`ξ` split here, as in [`Self::jr_from`]).
+    fn exp_from(k: &AngleCoeffs<T>, xi: &Vector6<T>) -> Self {
+        let (v, w) = split(xi);
         Self {
-            rotation: So3::exp_from(k, w),
-            translation: cross_poly(k.b, k.c, w, v),
+            rotation: So3::exp_from(k, &w),
+            translation: cross_poly(k.b, k.c, &w, &v),
         }
     }
 
     /// `J_r(σξ)` for `σ = ±1` (`σ = −1`: `J_l(ξ)`), from the kernel of `ω`: the SO(3) block of
     /// `σω` and `Q(−σv, −σω)`.
-    fn jr_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>, sigma: T) -> Matrix6<T> {
-        let jr = skew_poly(T::one(), -k.b * sigma, k.c, w);
-        upper_block(&jr, &q_block(k, v, w, T::one(), -sigma))
+    ///
+    /// Takes `ξ` whole and splits it here: one copy of `v`, `ω` for every caller.
+    fn jr_from(k: &AngleCoeffs<T>, xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
+        let (v, w) = split(xi);
+        let jr = skew_poly(T::one(), -k.b * sigma, k.c, &w);
+        upper_block(&jr, &q_block(k, &v, &w, T::one(), -sigma))
     }
 
     /// `ρ·J_r⁻¹(σξ)` for `σ, ρ = ±1`: `[[ρJ, −ρ J Q(−σv, −σω) J], [0, ρJ]]` with `J = J_r⁻¹(σω)`
     /// of SO(3); the signs go into `Q` (see [`q_block`]) and `J`, exactly.
-    fn jr_inv_from(
-        k: &AngleCoeffs<T>,
-        v: &Vector3<T>,
-        w: &Vector3<T>,
-        sigma: T,
-        rho: T,
-    ) -> Matrix6<T> {
+    /// `ξ` is split here, as in [`Self::jr_from`].
+    fn jr_inv_from(k: &AngleCoeffs<T>, xi: &Vector6<T>, sigma: T, rho: T) -> Matrix6<T> {
+        let (v, w) = split(xi);
+        let w = &w;
         let (half_sigma, d) = (T::lit(0.5) * sigma, k.d());
         let jinv = skew_poly(T::one(), half_sigma, d, w);
-        let q = q_block(k, v, w, -rho, rho * sigma);
+        let q = q_block(k, &v, w, -rho, rho * sigma);
         // `ρJ` as `skew_poly(ρ, ½σρ, ρd)`: the same numbers as `J·ρ` up to the sign of zeros
         // (see `skew_poly`), without a scaled copy of `J`.
         let diag = skew_poly(rho, half_sigma * rho, d * rho, w);
@@ -197,8 +199,7 @@ impl<T: Real> Se3<T> {
     #[cfg_attr(not(estimator_compact), inline(always))]
     #[cfg_attr(estimator_compact, inline(never))]
     fn jr_at(xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
-        let (v, w) = split(xi);
-        Self::jr_from(&AngleCoeffs::of_vector(&w), &v, &w, sigma)
+        Self::jr_from(&AngleCoeffs::of_components(xi.w, xi.a, xi.b), xi, sigma)
     }
 
     /// `J_r⁻¹(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left inverse Jacobians
@@ -206,9 +207,8 @@ impl<T: Real> Se3<T> {
     #[cfg_attr(not(estimator_compact), inline(always))]
     #[cfg_attr(estimator_compact, inline(never))]
     fn jr_inv_at(xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
-        let (v, w) = split(xi);
-        let k = AngleCoeffs::of_vector(&w);
-        Self::jr_inv_from(&k, &v, &w, sigma, T::one())
+        let k = AngleCoeffs::of_components(xi.w, xi.a, xi.b);
+        Self::jr_inv_from(&k, xi, sigma, T::one())
     }
 
     /// `σ·Ad_T = [[σR, [σt]×R], [0, σR]]` for `σ = ±1`: the adjoint, and `−Ad_T` built negated
@@ -260,10 +260,10 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     }
 
     fn exp(xi: &Vector6<T>) -> Self {
-        let (v, w) = split(xi);
         // Not `of_vector`: where SE(3)'s exponential is the only user of the kernel (the PnP
         // firmware) the squared norm inlines with it, and a call to a shared copy costs 80 bytes.
-        Self::exp_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), &v, &w)
+        let (_, w) = split(xi);
+        Self::exp_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), xi)
     }
 
     fn log(&self) -> Vector6<T> {
@@ -373,18 +373,13 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     }
 
     fn exp_jac(xi: &Vector6<T>) -> (Self, Matrix6<T>) {
-        let (v, w) = split(xi);
-        let k = AngleCoeffs::of_vector(&w);
-        (
-            Self::exp_from(&k, &v, &w),
-            Self::jr_from(&k, &v, &w, T::one()),
-        )
+        let k = AngleCoeffs::of_components(xi.w, xi.a, xi.b);
+        (Self::exp_from(&k, xi), Self::jr_from(&k, xi, T::one()))
     }
 
     fn log_jac(&self) -> (Vector6<T>, Matrix6<T>) {
         let (xi, k) = self.log_with_coeffs();
-        let (v, w) = split(&xi);
-        (xi, Self::jr_inv_from(&k, &v, &w, T::one(), T::one()))
+        (xi, Self::jr_inv_from(&k, &xi, T::one(), T::one()))
     }
 
     /// `(a·b, Ad_{b⁻¹}, I)`, the identity from `eye` (not `Ad_e` built from an identity motion).
@@ -407,11 +402,11 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     /// inverse Jacobians (`J_l⁻¹(τ) = J_r⁻¹(−τ)`, same angle).
     fn rminus_jac(&self, b: &Self) -> (Vector6<T>, Matrix6<T>, Matrix6<T>) {
         let (tau, k) = b.between(self).log_with_coeffs();
-        let (v, w) = split(&tau);
+
         (
             tau,
-            Self::jr_inv_from(&k, &v, &w, T::one(), T::one()),
-            Self::jr_inv_from(&k, &v, &w, -T::one(), -T::one()),
+            Self::jr_inv_from(&k, &tau, T::one(), T::one()),
+            Self::jr_inv_from(&k, &tau, -T::one(), -T::one()),
         )
     }
 

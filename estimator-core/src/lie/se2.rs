@@ -213,7 +213,9 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         Self::right_jacobian(&Vector3::new(-tau.x, -tau.y, -tau.z))
     }
 
-    /// `J_r⁻¹(−τ)`, `−τ` entry by entry.
+    /// `J_r⁻¹(−τ)`, `−τ` entry by entry. Out of line when built for size (`rminus_jac` calls it
+    /// too).
+    #[cfg_attr(estimator_compact, inline(never))]
     fn left_jacobian_inv(tau: &Vector3<T>) -> Matrix3<T> {
         Self::right_jacobian_inv(&Vector3::new(-tau.x, -tau.y, -tau.z))
     }

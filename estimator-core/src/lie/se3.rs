@@ -71,13 +71,10 @@ fn upper_block<T: Real>(diag: &Matrix3<T>, upper: &Matrix3<T>) -> Matrix6<T> {
 /// part, so `Q(−v, −ω)` is `sym = 1, skew = −1`, and `−Q(−v, −ω)` is `sym = −1, skew = 1` (the
 /// signs are exact, so each is bit for bit the negated-argument or negated-result form).
 /// Written entry by entry (no 3-vector temporaries at opt-level "s").
-fn q_block<T: Real>(
-    k: &AngleCoeffs<T>,
-    v: &Vector3<T>,
-    w: &Vector3<T>,
-    sym: T,
-    skew: T,
-) -> Matrix3<T> {
+fn q_block<T: Real>(k: &AngleCoeffs<T>, xi: &Vector6<T>, sym: T, skew: T) -> Matrix3<T> {
+    // `ξ = [v; ω]` read in place (the callers' `ω` copy is for `skew_poly` only).
+    let (v, w) = split(xi);
+    let (v, w) = (&v, &w);
     let se = k.se();
     let dot = w.dot(v);
     let sc = dot * (k.c + se.e + se.e);
@@ -174,20 +171,19 @@ impl<T: Real> Se3<T> {
     ///
     /// Takes `ξ` whole and splits it here: one copy of `v`, `ω` for every caller.
     fn jr_from(k: &AngleCoeffs<T>, xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
-        let (v, w) = split(xi);
+        let w = Vector3::new(xi.w, xi.a, xi.b);
         let jr = skew_poly(T::one(), -k.b * sigma, k.c, &w);
-        upper_block(&jr, &q_block(k, &v, &w, T::one(), -sigma))
+        upper_block(&jr, &q_block(k, xi, T::one(), -sigma))
     }
 
     /// `ρ·J_r⁻¹(σξ)` for `σ, ρ = ±1`: `[[ρJ, −ρ J Q(−σv, −σω) J], [0, ρJ]]` with `J = J_r⁻¹(σω)`
     /// of SO(3); the signs go into `Q` (see [`q_block`]) and `J`, exactly.
     /// `ξ` is split here, as in [`Self::jr_from`].
     fn jr_inv_from(k: &AngleCoeffs<T>, xi: &Vector6<T>, sigma: T, rho: T) -> Matrix6<T> {
-        let (v, w) = split(xi);
-        let w = &w;
+        let w = &Vector3::new(xi.w, xi.a, xi.b);
         let (half_sigma, d) = (T::lit(0.5) * sigma, k.d());
         let jinv = skew_poly(T::one(), half_sigma, d, w);
-        let q = q_block(k, &v, w, -rho, rho * sigma);
+        let q = q_block(k, xi, -rho, rho * sigma);
         // `ρJ` as `skew_poly(ρ, ½σρ, ρd)`: the same numbers as `J·ρ` up to the sign of zeros
         // (see `skew_poly`), without a scaled copy of `J`.
         let diag = skew_poly(rho, half_sigma * rho, d * rho, w);

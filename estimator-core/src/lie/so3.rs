@@ -105,24 +105,32 @@ impl<T: Real> So3<T> {
             m.m13 + m.m31,
             m.m23 + m.m32,
         ];
-        // `from` lists the components in nalgebra's storage order `[x, y, z, w]`.
-        let (radicand, from): (T, [u8; 4]) = if trace > T::zero() {
-            (trace + one, [0, 1, 2, SELF])
+        // `from` lists the components in nalgebra's storage order `[x, y, z, w]`, one byte each
+        // of a little-endian word (one constant per case instead of four byte stores).
+        let (radicand, from): (T, u32) = if trace > T::zero() {
+            (trace + one, u32::from_le_bytes([0, 1, 2, SELF]))
         } else if m.m11 > m.m22 && m.m11 > m.m33 {
-            (one + m.m11 - m.m22 - m.m33, [SELF, 3, 4, 0])
+            (
+                one + m.m11 - m.m22 - m.m33,
+                u32::from_le_bytes([SELF, 3, 4, 0]),
+            )
         } else if m.m22 > m.m33 {
-            (one + m.m22 - m.m11 - m.m33, [3, SELF, 5, 1])
+            (
+                one + m.m22 - m.m11 - m.m33,
+                u32::from_le_bytes([3, SELF, 5, 1]),
+            )
         } else {
-            (one + m.m33 - m.m11 - m.m22, [4, 5, SELF, 2])
+            (
+                one + m.m33 - m.m11 - m.m22,
+                u32::from_le_bytes([4, 5, SELF, 2]),
+            )
         };
+        let from = from.to_le_bytes();
         let s = radicand.sqrt() * T::lit(2.0);
-        let mut q = [T::zero(); 4];
-        for (qi, &j) in q.iter_mut().zip(from.iter()) {
-            *qi = match pairs.get(usize::from(j)) {
-                Some(p) => *p / s,
-                None => T::lit(0.25) * s,
-            };
-        }
+        let q = from.map(|j| match pairs.get(usize::from(j)) {
+            Some(p) => *p / s,
+            None => T::lit(0.25) * s,
+        });
         Self::from_quaternion(&Quaternion::from(Vector4::from(q)))
     }
 

@@ -227,10 +227,11 @@ impl<T: Real> Se3<T> {
 
     /// `log` and the kernel of its rotation angle.
     fn log_with_coeffs(&self) -> (Vector6<T>, AngleCoeffs<T>) {
-        let (w, k) = self.rotation.log_with_coeffs();
+        let lk = self.rotation.log_with_coeffs();
+        let w = &lk.0;
         // J_l⁻¹(ω) t = t − ½ ω×t + d ω×(ω×t).
-        let v = cross_poly(T::lit(-0.5), k.d(), &w, &self.translation);
-        (join(&v, &w), k)
+        let v = cross_poly(T::lit(-0.5), lk.1.d(), w, &self.translation);
+        (join(&v, w), lk.1)
     }
 }
 
@@ -374,8 +375,9 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     }
 
     fn log_jac(&self) -> (Vector6<T>, Matrix6<T>) {
-        let (xi, k) = self.log_with_coeffs();
-        (xi, Self::jr_inv_from(&k, &xi, T::one(), T::one()))
+        // Not destructured: the kernel is read where `log_with_coeffs` put it (no copy).
+        let lk = self.log_with_coeffs();
+        (lk.0, Self::jr_inv_from(&lk.1, &lk.0, T::one(), T::one()))
     }
 
     /// `(a·b, Ad_{b⁻¹}, I)`, the identity from `eye` (not `Ad_e` built from an identity motion).
@@ -397,12 +399,12 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))` with one trigonometric kernel for the log and both
     /// inverse Jacobians (`J_l⁻¹(τ) = J_r⁻¹(−τ)`, same angle).
     fn rminus_jac(&self, b: &Self) -> (Vector6<T>, Matrix6<T>, Matrix6<T>) {
-        let (tau, k) = b.between(self).log_with_coeffs();
-
+        let lk = b.between(self).log_with_coeffs();
+        let (tau, k) = (&lk.0, &lk.1);
         (
-            tau,
-            Self::jr_inv_from(&k, &tau, T::one(), T::one()),
-            Self::jr_inv_from(&k, &tau, -T::one(), -T::one()),
+            *tau,
+            Self::jr_inv_from(k, tau, T::one(), T::one()),
+            Self::jr_inv_from(k, tau, -T::one(), -T::one()),
         )
     }
 
@@ -410,11 +412,13 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     ///
     /// SO(3)'s `act_jac` gives `R p`, `−R[p]×` and `R`; the 3×6 block is their columns side by side.
     fn act_jac(&self, p: &Vector3<T>) -> (Vector3<T>, Matrix3x6<T>, Matrix3<T>) {
-        let (rp, h, r) = self.rotation.act_jac(p);
+        // Not destructured: the blocks are read where SO(3)'s `act_jac` put them.
+        let a = self.rotation.act_jac(p);
+        let (rp, h, r) = (&a.0, &a.1, &a.2);
         let [r0, r1, r2] = r.data.0;
         let [h0, h1, h2] = h.data.0;
         let j = Matrix3x6::from_array_storage(ArrayStorage([r0, r1, r2, h0, h1, h2]));
         let t = &self.translation;
-        (Vector3::new(rp.x + t.x, rp.y + t.y, rp.z + t.z), j, r)
+        (Vector3::new(rp.x + t.x, rp.y + t.y, rp.z + t.z), j, *r)
     }
 }

@@ -393,8 +393,9 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn log_jac(&self) -> (Vector3<T>, Matrix3<T>) {
-        let (w, k) = self.log_with_coeffs();
-        (w, Self::jr_inv_from(&k, &w))
+        // Not destructured: the kernel is read where `log_with_coeffs` put it (no copy).
+        let lk = self.log_with_coeffs();
+        (lk.0, Self::jr_inv_from(&lk.1, &lk.0))
     }
 
     fn compose_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
@@ -420,8 +421,8 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn rminus_jac(&self, b: &Self) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {
-        let (tau, k) = b.between(self).log_with_coeffs();
-        let d = k.d();
+        let lk = b.between(self).log_with_coeffs();
+        let (tau, d) = (lk.0, lk.1.d());
         // −J_l⁻¹(τ) = −J_r⁻¹(τ)ᵀ = −I + ½[τ]× − d[τ]×², built negated.
         (
             tau,

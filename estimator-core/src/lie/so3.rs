@@ -210,9 +210,10 @@ impl<T: Real> So3<T> {
     #[cfg_attr(not(estimator_compact), inline)]
     #[cfg_attr(estimator_compact, inline(never))]
     pub(crate) fn log_with_coeffs(&self) -> (Vector3<T>, AngleCoeffs<T>) {
-        let (omega, theta, sin_half, cos_half) = self.log_parts();
-        let k = AngleCoeffs::from_half_angle(theta * theta, theta, sin_half, cos_half);
-        (omega, k)
+        // Not destructured (read in place, see `log_jac`).
+        let p = self.log_parts();
+        let k = AngleCoeffs::from_half_angle(p.1 * p.1, p.1, p.2, p.3);
+        (p.0, k)
     }
 
     /// Re-projects a quaternion already near unit norm without a square root: one Newton step

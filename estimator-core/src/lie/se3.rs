@@ -21,7 +21,7 @@
 use super::so3::So3;
 use super::trig::AngleCoeffs;
 use super::{all_finite, eye, mul_skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
-use nalgebra::{ArrayStorage, Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
 
 /// A rigid motion `T = (R, t) ∈ SE(3)`; `a_from_b` maps `b` coordinates into `a`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -415,9 +415,12 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         // Not destructured: the blocks are read where SO(3)'s `act_jac` put them.
         let a = self.rotation.act_jac(p);
         let (rp, h, r) = (&a.0, &a.1, &a.2);
-        let [r0, r1, r2] = r.data.0;
-        let [h0, h1, h2] = h.data.0;
-        let j = Matrix3x6::from_array_storage(ArrayStorage([r0, r1, r2, h0, h1, h2]));
+        // The two 3×3 blocks copied whole into the column-major 3×6 (two block copies instead of
+        // six column copies through a temporary).
+        let mut j = Matrix3x6::zeros();
+        let (jr, jh) = j.as_mut_slice().split_at_mut(9);
+        jr.copy_from_slice(r.as_slice());
+        jh.copy_from_slice(h.as_slice());
         let t = &self.translation;
         (Vector3::new(rp.x + t.x, rp.y + t.y, rp.z + t.z), j, *r)
     }

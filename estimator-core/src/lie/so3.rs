@@ -183,8 +183,10 @@ impl<T: Real> So3<T> {
         skew_poly(T::one(), -k.b * sigma, k.c, w)
     }
 
-    /// `J_r⁻¹(σω) = I + ½σ[ω]× + d[ω]×²` for `σ = ±1` (`½·σ` is `±½` exactly).
-    #[inline(always)]
+    /// `J_r⁻¹(σω) = I + ½σ[ω]× + d[ω]×²` for `σ = ±1` (`½·σ` is `±½` exactly), out of line
+    /// when built for size as `jr_at`.
+    #[cfg_attr(not(estimator_compact), inline(always))]
+    #[cfg_attr(estimator_compact, inline(never))]
     fn jr_inv_at(w: &Vector3<T>, sigma: T) -> Matrix3<T> {
         let k = AngleCoeffs::of_vector(w);
         skew_poly(T::one(), T::lit(0.5) * sigma, k.d(), w)

@@ -169,6 +169,7 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         Vector3::new(m.m13, m.m23, m.m21)
     }
 
+    #[cfg_attr(estimator_compact, inline(never))]
     fn compose(&self, b: &Self) -> Self {
         Self {
             rotation: self.rotation.compose(&b.rotation),

@@ -417,8 +417,9 @@ impl<T: Real> LieGroup<T> for So3<T> {
 
     /// `(z = a⁻¹·b, −R_{z⁻¹}, I)`, negated in place (`negate`).
     fn between_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
-        let z = self.between(b);
-        let mut out = (z, z.inverse().adjoint(), eye());
+        // `z` written where it is returned and read there (no copy of it into the tuple).
+        let mut out = (self.between(b), eye(), eye());
+        out.1 = out.0.inverse().adjoint();
         negate(&mut out.1);
         out
     }

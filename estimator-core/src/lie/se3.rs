@@ -392,8 +392,10 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     /// `(z = a⁻¹·b, −Ad_{z⁻¹}, I)`.
     fn between_jac(&self, b: &Self) -> (Self, Matrix6<T>, Matrix6<T>) {
-        let z = self.between(b);
-        (z, z.inverse().neg_adjoint(), eye())
+        // `z` written where it is returned and read there (no copy of it into the tuple).
+        let mut out = (self.between(b), eye(), eye());
+        out.1 = out.0.inverse().neg_adjoint();
+        out
     }
 
     /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))` with one trigonometric kernel for the log and both

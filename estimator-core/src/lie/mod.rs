@@ -230,8 +230,9 @@ pub trait LieGroup<T: Real>: Copy + core::fmt::Debug + PartialEq + Sized {
     /// `(a ⊕ τ, Ad_{exp(τ)}⁻¹, J_r(τ))`.
     #[must_use]
     fn rplus_jac(&self, tau: &Self::Tangent) -> (Self, Self::Jacobian, Self::Jacobian) {
-        let (step, jr) = Self::exp_jac(tau);
-        (self.compose(&step), step.inverse().adjoint(), jr)
+        // Not destructured: `exp_jac`'s pair is read where it was returned (no copy of it).
+        let sj = Self::exp_jac(tau);
+        (self.compose(&sj.0), sj.0.inverse().adjoint(), sj.1)
     }
 
     /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))`.

@@ -264,6 +264,19 @@ fn so3_jacobians<T: Real>() {
         let jr_inv = So3::right_jacobian_inv(w);
         assert!(m(&So3::left_jacobian(w), &jr.transpose()));
         assert!(m(&So3::left_jacobian_inv(w), &jr_inv.transpose()));
+        // Through jr_at / jr_inv_at (σ = ±1): the skew_poly forms they replace, to the bit.
+        let k = AngleCoeffs::of_vector(w);
+        let (b, c, d, h) = (k.b, k.c, k.d(), T::lit(0.5));
+        let bits = |a: &Matrix3<T>, b: &Matrix3<T>| {
+            crate::test_support::same_bits(a.as_slice(), b.as_slice())
+        };
+        assert!(bits(&jr, &skew_poly(T::one(), -b, c, w)));
+        assert!(bits(&So3::left_jacobian(w), &skew_poly(T::one(), b, c, w)));
+        assert!(bits(&jr_inv, &skew_poly(T::one(), h, d, w)));
+        assert!(bits(
+            &So3::left_jacobian_inv(w),
+            &skew_poly(T::one(), -h, d, w)
+        ));
         let a = So3::exp(w);
         let b = So3::exp(&(w * T::lit(-0.4)));
         let (tau, jr, jl) = a.rminus_jac(&b);
@@ -611,6 +624,30 @@ fn eye_cases<T: Real>() {
         j.as_slice(),
         SMatrix::<T, 6, 6>::identity().as_slice()
     ));
+    let b2 = Se2::<T>::new(T::lit(-1.5), T::lit(0.25), T::lit(-2.8));
+    let (ab2, jb2, ji2) = a2.compose_jac(&b2);
+    assert!(crate::test_support::same_bits(
+        ji2.as_slice(),
+        Matrix3::<T>::identity().as_slice()
+    ));
+    assert!(same(jb2.as_slice(), b2.inverse().adjoint().as_slice()));
+    assert!(ab2 == a2.compose(&b2));
+    // SE(3)'s compose_jac: `I` from `eye`, `Ad_{b⁻¹}`, and the product.
+    let b6 = Se3::exp(&SVector::<T, 6>::new(
+        T::lit(0.1),
+        T::lit(2.0),
+        T::lit(-1.0),
+        T::lit(0.4),
+        T::lit(-2.5),
+        T::lit(0.9),
+    ));
+    let (ab, jb, ji) = a6.compose_jac(&b6);
+    assert!(crate::test_support::same_bits(
+        ji.as_slice(),
+        SMatrix::<T, 6, 6>::identity().as_slice()
+    ));
+    assert!(same(jb.as_slice(), b6.inverse().adjoint().as_slice()));
+    assert!(ab == a6.compose(&b6));
 }
 
 #[test]
@@ -720,4 +757,123 @@ fn so3_conjugate_matrix<T: Real>() {
 fn so3_conjugate_matrix_is_the_transpose() {
     so3_conjugate_matrix::<f32>();
     so3_conjugate_matrix::<f64>();
+}
+
+/// Special values for the per-component rewrites: signed zeros, infinities, NaN.
+fn specials<T: Real>() -> [T; 7] {
+    let inf = T::lit(f64::INFINITY);
+    [
+        T::zero(),
+        -T::zero(),
+        T::one(),
+        -T::lit(2.5),
+        inf,
+        -inf,
+        T::lit(f64::NAN),
+    ]
+}
+
+/// Quaternions (not necessarily unit) and vectors: random ones and ones made of special values.
+fn for_each_quaternion_and_vector<T: Real>(mut f: impl FnMut(&UnitQuaternion<T>, &Vector3<T>)) {
+    let s = specials::<T>();
+    for_each_quaternion::<T>(|q| {
+        for_each_vector::<T>(47, |p| f(q, p));
+        for (i, &x) in s.iter().enumerate() {
+            let y = s[(i + 3) % s.len()];
+            f(q, &Vector3::new(x, y, -x));
+            let odd = Quaternion::new(x, q.i, y, q.k);
+            f(
+                &UnitQuaternion::new_unchecked(odd),
+                &Vector3::new(y, T::one(), x),
+            );
+        }
+    });
+}
+
+/// SO(3)'s conjugate, rotation, renormalization and exponential written per component, and
+/// SE(3)'s `act`, `compose` and `inverse` through `act_plus`, against the nalgebra expressions
+/// they replace: the same bits (signed zeros and NaN included).
+fn so3_se3_per_component<T: Real>() {
+    use crate::test_support::same_bits;
+    for_each_quaternion_and_vector::<T>(|q, p| {
+        let r = So3::from_unit_quaternion(*q);
+        let qc = r.inverse().quaternion();
+        assert!(same_bits(
+            qc.coords.as_slice(),
+            q.conjugate().coords.as_slice()
+        ));
+        assert!(same_bits(
+            r.act(p).as_slice(),
+            q.transform_vector(p).as_slice()
+        ));
+        let qq = q.quaternion();
+        let scale = (T::lit(3.0) - qq.coords.norm_squared()) * T::lit(0.5);
+        let want = *qq * scale;
+        let got = r.renormalize().quaternion();
+        assert!(same_bits(got.coords.as_slice(), want.coords.as_slice()));
+        let k = AngleCoeffs::of_vector(p);
+        let v = p * k.half_sinc;
+        let e = So3::exp_from(&k, p).quaternion();
+        assert!(same_bits(e.coords.as_slice(), &[v.x, v.y, v.z, k.cos_half]));
+        // SE(3).
+        let t = Vector3::new(p.z, p.x, p.y) * T::lit(1.5);
+        let a = Se3::from_parts(r, t);
+        let b = Se3::from_parts(So3::from_unit_quaternion(q.inverse()), *p);
+        assert!(same_bits(
+            a.act(p).as_slice(),
+            (q.transform_vector(p) + t).as_slice()
+        ));
+        let ab = a.compose(&b);
+        let want_t = q.transform_vector(p) + t;
+        assert!(same_bits(ab.translation().as_slice(), want_t.as_slice()));
+        assert!(same_bits(
+            ab.rotation().quaternion().coords.as_slice(),
+            (*q * q.inverse()).coords.as_slice()
+        ));
+        let ai = a.inverse();
+        let want_i = -q.conjugate().transform_vector(&t);
+        assert!(same_bits(ai.translation().as_slice(), want_i.as_slice()));
+        // try_from_matrix: the blocks entry by entry, as `fixed_view(..).into_owned()` read them.
+        let mut m = a.matrix();
+        m[(0, 1)] += p.x * T::lit(1e-4);
+        let got = Se3::try_from_matrix(&m);
+        let want = So3::try_from_matrix(&m.fixed_view::<3, 3>(0, 0).into_owned())
+            .map(|r| Se3::from_parts(r, Vector3::new(m.m14, m.m24, m.m34)))
+            .filter(Se3::is_finite);
+        assert_eq!(got.is_some(), want.is_some());
+        if let (Some(g), Some(w)) = (got, want) {
+            assert!(same_bits(
+                g.translation().as_slice(),
+                w.translation().as_slice()
+            ));
+            let (gq, wq) = (g.rotation().quaternion(), w.rotation().quaternion());
+            assert!(same_bits(gq.coords.as_slice(), wq.coords.as_slice()));
+        }
+        let m2 = Se2::new(p.x, p.y, p.z).matrix();
+        let got2 = Se2::try_from_matrix(&m2);
+        let t2 = [m2.m13, m2.m23];
+        let want2 = So2::try_from_matrix(&m2.fixed_view::<2, 2>(0, 0).into_owned())
+            .filter(|_| all_finite(&t2));
+        assert_eq!(got2.map(|g| g.rotation()), want2);
+        // A non-finite translation entry alone is rejected (the `x·0` term of the bottom sum).
+        for x in specials::<T>() {
+            let mut m =
+                Se3::from_parts(r, Vector3::new(T::one(), T::lit(2.0), T::lit(-3.0))).matrix();
+            m.m24 = x;
+            let rot_ok = So3::try_from_matrix(&r.rotation_matrix()).is_some();
+            assert_eq!(
+                Se3::try_from_matrix(&m).is_some(),
+                all_finite(&[x]) && rot_ok
+            );
+            let mut m2 = Se2::new(T::one(), T::one(), T::lit(0.3)).matrix();
+            m2.m13 = x;
+            assert_eq!(Se2::try_from_matrix(&m2).is_some(), all_finite(&[x]));
+        }
+    });
+}
+
+#[test]
+fn so3_se3_per_component_forms_are_bit_identical() {
+    so3_se3_per_component::<f32>();
+    so3_se3_per_component::<f64>();
 }

@@ -169,6 +169,7 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         Vector3::new(m.m13, m.m23, m.m21)
     }
 
+    #[cfg_attr(estimator_compact, inline(never))]
     fn compose(&self, b: &Self) -> Self {
         Self {
             rotation: self.rotation.compose(&b.rotation),
@@ -213,7 +214,9 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         Self::right_jacobian(&Vector3::new(-tau.x, -tau.y, -tau.z))
     }
 
-    /// `J_r⁻¹(−τ)`, `−τ` entry by entry.
+    /// `J_r⁻¹(−τ)`, `−τ` entry by entry. Out of line when built for size (`rminus_jac` calls it
+    /// too).
+    #[cfg_attr(estimator_compact, inline(never))]
     fn left_jacobian_inv(tau: &Vector3<T>) -> Matrix3<T> {
         Self::right_jacobian_inv(&Vector3::new(-tau.x, -tau.y, -tau.z))
     }
@@ -230,18 +233,19 @@ impl<T: Real> LieGroup<T> for Se2<T> {
 
     fn try_from_matrix(m: &Matrix3<T>) -> Option<Self> {
         let tol = T::lit(ORTHOGONALITY_TOLERANCE);
-        let bottom = m.m31.abs() + m.m32.abs() + (m.m33 - T::one()).abs();
+        // `x·0` is `±0` for finite `x` and NaN otherwise (see SE(3)'s `try_from_matrix`): the sum
+        // is NaN exactly when `t` is not finite.
+        let z = T::zero();
+        let finite_t = m.m13 * z + m.m23 * z;
+        let bottom = m.m31.abs() + m.m32.abs() + (m.m33 - T::one()).abs() + finite_t;
         // Written so that NaN (which compares false) is rejected too.
         let bottom_ok = bottom <= tol;
         if !bottom_ok {
             return None;
         }
-        let r = So2::try_from_matrix(&m.fixed_view::<2, 2>(0, 0).into_owned())?;
-        let t = Vector2::new(m.m13, m.m23);
-        if !all_finite(t.as_slice()) {
-            return None;
-        }
-        Some(Self::from_parts(r, t))
+        // The rotation block entry by entry (`fixed_view(..).into_owned()` is a copy loop).
+        let r = So2::try_from_matrix(&Matrix2::new(m.m11, m.m12, m.m21, m.m22))?;
+        Some(Self::from_parts(r, Vector2::new(m.m13, m.m23)))
     }
 
     fn is_finite(&self) -> bool {
@@ -254,19 +258,26 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         (Self::exp_from(&k, tau), Self::jr_from(&k, tau))
     }
 
+    /// `(a·b, Ad_{b⁻¹}, I)`, the identity from `eye` (not `Ad_e` built from an identity motion).
+    fn compose_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
+        (self.compose(b), b.inverse().adjoint(), eye())
+    }
+
     /// `(a⁻¹, −Ad_a)`, negated in place (`negate`).
     fn inverse_jac(&self) -> (Self, Matrix3<T>) {
-        let mut j = self.adjoint();
-        negate(&mut j);
-        (self.inverse(), j)
+        // Negated where it is returned (no copy of the Jacobian after the negation).
+        let mut out = (self.inverse(), self.adjoint());
+        negate(&mut out.1);
+        out
     }
 
     /// `(z = a⁻¹·b, −Ad_{z⁻¹}, I)`, negated in place (`negate`).
     fn between_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
-        let z = self.between(b);
-        let mut j = z.inverse().adjoint();
-        negate(&mut j);
-        (z, j, eye())
+        // `z` written where it is returned and read there (no copy of it into the tuple).
+        let mut out = (self.between(b), eye(), eye());
+        out.1 = out.0.inverse().adjoint();
+        negate(&mut out.1);
+        out
     }
 
     /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))`, the last negated in place (`negate`).

@@ -21,7 +21,7 @@
 use super::so3::So3;
 use super::trig::AngleCoeffs;
 use super::{all_finite, eye, mul_skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
-use nalgebra::{ArrayStorage, Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
 
 /// A rigid motion `T = (R, t) ∈ SE(3)`; `a_from_b` maps `b` coordinates into `a`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -71,13 +71,10 @@ fn upper_block<T: Real>(diag: &Matrix3<T>, upper: &Matrix3<T>) -> Matrix6<T> {
 /// part, so `Q(−v, −ω)` is `sym = 1, skew = −1`, and `−Q(−v, −ω)` is `sym = −1, skew = 1` (the
 /// signs are exact, so each is bit for bit the negated-argument or negated-result form).
 /// Written entry by entry (no 3-vector temporaries at opt-level "s").
-fn q_block<T: Real>(
-    k: &AngleCoeffs<T>,
-    v: &Vector3<T>,
-    w: &Vector3<T>,
-    sym: T,
-    skew: T,
-) -> Matrix3<T> {
+fn q_block<T: Real>(k: &AngleCoeffs<T>, xi: &Vector6<T>, sym: T, skew: T) -> Matrix3<T> {
+    // `ξ = [v; ω]` read in place (the callers' `ω` copy is for `skew_poly` only).
+    let (v, w) = split(xi);
+    let (v, w) = (&v, &w);
     let se = k.se();
     let dot = w.dot(v);
     let sc = dot * (k.c + se.e + se.e);
@@ -160,47 +157,54 @@ impl<T: Real> Se3<T> {
         self.translation
     }
 
-    fn exp_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Self {
+    /// `exp(ξ)` from the kernel of `ω` (`ξ` split here, as in [`Self::jr_from`]).
+    fn exp_from(k: &AngleCoeffs<T>, xi: &Vector6<T>) -> Self {
+        let (v, w) = split(xi);
         Self {
-            rotation: So3::exp_from(k, w),
-            translation: cross_poly(k.b, k.c, w, v),
+            rotation: So3::exp_from(k, &w),
+            translation: cross_poly(k.b, k.c, &w, &v),
         }
     }
 
     /// `J_r(σξ)` for `σ = ±1` (`σ = −1`: `J_l(ξ)`), from the kernel of `ω`: the SO(3) block of
     /// `σω` and `Q(−σv, −σω)`.
-    fn jr_from(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>, sigma: T) -> Matrix6<T> {
-        let jr = skew_poly(T::one(), -k.b * sigma, k.c, w);
-        upper_block(&jr, &q_block(k, v, w, T::one(), -sigma))
+    ///
+    /// Takes `ξ` whole and splits it here: one copy of `v`, `ω` for every caller.
+    fn jr_from(k: &AngleCoeffs<T>, xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
+        let w = Vector3::new(xi.w, xi.a, xi.b);
+        let jr = skew_poly(T::one(), -k.b * sigma, k.c, &w);
+        upper_block(&jr, &q_block(k, xi, T::one(), -sigma))
     }
 
     /// `ρ·J_r⁻¹(σξ)` for `σ, ρ = ±1`: `[[ρJ, −ρ J Q(−σv, −σω) J], [0, ρJ]]` with `J = J_r⁻¹(σω)`
     /// of SO(3); the signs go into `Q` (see [`q_block`]) and `J`, exactly.
-    fn jr_inv_from(
-        k: &AngleCoeffs<T>,
-        v: &Vector3<T>,
-        w: &Vector3<T>,
-        sigma: T,
-        rho: T,
-    ) -> Matrix6<T> {
-        let jinv = skew_poly(T::one(), T::lit(0.5) * sigma, k.d(), w);
-        let q = q_block(k, v, w, -rho, rho * sigma);
-        upper_block(&(jinv * rho), &mul3(&mul3(&jinv, &q), &jinv))
+    /// `ξ` is split here, as in [`Self::jr_from`].
+    fn jr_inv_from(k: &AngleCoeffs<T>, xi: &Vector6<T>, sigma: T, rho: T) -> Matrix6<T> {
+        let w = &Vector3::new(xi.w, xi.a, xi.b);
+        let (half_sigma, d) = (T::lit(0.5) * sigma, k.d());
+        let jinv = skew_poly(T::one(), half_sigma, d, w);
+        let q = q_block(k, xi, -rho, rho * sigma);
+        // `ρJ` as `skew_poly(ρ, ½σρ, ρd)`: the same numbers as `J·ρ` up to the sign of zeros
+        // (see `skew_poly`), without a scaled copy of `J`.
+        let diag = skew_poly(rho, half_sigma * rho, d * rho, w);
+        upper_block(&diag, &mul3(&mul3(&jinv, &q), &jinv))
     }
 
-    /// `J_r(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left Jacobians.
-    #[inline(always)]
+    /// `J_r(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left Jacobians. Out of line
+    /// when built for size (one copy of the split and the kernel call for both).
+    #[cfg_attr(not(estimator_compact), inline(always))]
+    #[cfg_attr(estimator_compact, inline(never))]
     fn jr_at(xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
-        let (v, w) = split(xi);
-        Self::jr_from(&AngleCoeffs::of_vector(&w), &v, &w, sigma)
+        Self::jr_from(&AngleCoeffs::of_components(xi.w, xi.a, xi.b), xi, sigma)
     }
 
-    /// `J_r⁻¹(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left inverse Jacobians.
-    #[inline(always)]
+    /// `J_r⁻¹(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left inverse Jacobians
+    /// (out of line when built for size, as [`Self::jr_at`]).
+    #[cfg_attr(not(estimator_compact), inline(always))]
+    #[cfg_attr(estimator_compact, inline(never))]
     fn jr_inv_at(xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
-        let (v, w) = split(xi);
-        let k = AngleCoeffs::of_vector(&w);
-        Self::jr_inv_from(&k, &v, &w, sigma, T::one())
+        let k = AngleCoeffs::of_components(xi.w, xi.a, xi.b);
+        Self::jr_inv_from(&k, xi, sigma, T::one())
     }
 
     /// `σ·Ad_T = [[σR, [σt]×R], [0, σR]]` for `σ = ±1`: the adjoint, and `−Ad_T` built negated
@@ -208,8 +212,12 @@ impl<T: Real> Se3<T> {
     #[cfg_attr(estimator_compact, inline(never))]
     fn signed_adjoint(&self, sigma: T) -> Matrix6<T> {
         let r = self.rotation.rotation_matrix();
-        let tr = mul_skew(&r.transpose(), &(self.translation * -sigma)).transpose();
-        upper_block(&(r * sigma), &tr)
+        // `Rᵀ` as the rotation matrix of the conjugate (the same bits, see `compose_jac` of SO(3))
+        // and `−σt` per component: no transposing copy and no loop over a temporary.
+        let rt = self.rotation.inverse().rotation_matrix();
+        let t = &self.translation;
+        let p = Vector3::new(t.x * -sigma, t.y * -sigma, t.z * -sigma);
+        upper_block(&(r * sigma), &mul_skew(&rt, &p).transpose())
     }
 
     /// `−Ad_T`.
@@ -219,10 +227,11 @@ impl<T: Real> Se3<T> {
 
     /// `log` and the kernel of its rotation angle.
     fn log_with_coeffs(&self) -> (Vector6<T>, AngleCoeffs<T>) {
-        let (w, k) = self.rotation.log_with_coeffs();
+        let lk = self.rotation.log_with_coeffs();
+        let w = &lk.0;
         // J_l⁻¹(ω) t = t − ½ ω×t + d ω×(ω×t).
-        let v = cross_poly(T::lit(-0.5), k.d(), &w, &self.translation);
-        (join(&v, &w), k)
+        let v = cross_poly(T::lit(-0.5), lk.1.d(), w, &self.translation);
+        (join(&v, w), lk.1)
     }
 }
 
@@ -248,10 +257,10 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     }
 
     fn exp(xi: &Vector6<T>) -> Self {
-        let (v, w) = split(xi);
         // Not `of_vector`: where SE(3)'s exponential is the only user of the kernel (the PnP
         // firmware) the squared norm inlines with it, and a call to a shared copy costs 80 bytes.
-        Self::exp_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), &v, &w)
+        let (_, w) = split(xi);
+        Self::exp_from(&AngleCoeffs::from_theta_sq(w.norm_squared()), xi)
     }
 
     fn log(&self) -> Vector6<T> {
@@ -274,23 +283,26 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         Vector6::new(m.m14, m.m24, m.m34, m.m32, m.m13, m.m21)
     }
 
+    #[cfg_attr(estimator_compact, inline(never))]
     fn compose(&self, b: &Self) -> Self {
         Self {
             rotation: self.rotation.compose(&b.rotation),
-            translation: self.rotation.act(&b.translation) + self.translation,
+            translation: self.rotation.act_plus(&b.translation, &self.translation),
         }
     }
 
     fn inverse(&self) -> Self {
         let r_inv = self.rotation.inverse();
+        // `−(R⁻¹ t)` entry by entry (no `Neg` loop over a temporary).
+        let u = r_inv.act(&self.translation);
         Self {
             rotation: r_inv,
-            translation: -r_inv.act(&self.translation),
+            translation: Vector3::new(-u.x, -u.y, -u.z),
         }
     }
 
     fn act(&self, p: &Vector3<T>) -> Vector3<T> {
-        self.rotation.act(p) + self.translation
+        self.rotation.act_plus(p, &self.translation)
     }
 
     /// `[[R, [t]×R], [0, R]]`.
@@ -335,18 +347,22 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     fn try_from_matrix(m: &Matrix4<T>) -> Option<Self> {
         let tol = T::lit(ORTHOGONALITY_TOLERANCE);
-        let bottom = m.m41.abs() + m.m42.abs() + m.m43.abs() + (m.m44 - T::one()).abs();
+        // `x·0` is `±0` for finite `x` and NaN otherwise: adding the translation's makes the sum
+        // NaN exactly when `t` is not finite, and leaves it unchanged otherwise (no separate
+        // finiteness check of `t`).
+        let z = T::zero();
+        let finite_t = m.m14 * z + m.m24 * z + m.m34 * z;
+        let bottom = m.m41.abs() + m.m42.abs() + m.m43.abs() + (m.m44 - T::one()).abs() + finite_t;
         // Written so that NaN (which compares false) is rejected too.
         let bottom_ok = bottom <= tol;
         if !bottom_ok {
             return None;
         }
-        let r = So3::try_from_matrix(&m.fixed_view::<3, 3>(0, 0).into_owned())?;
-        let t = Vector3::new(m.m14, m.m24, m.m34);
-        if !all_finite(t.as_slice()) {
-            return None;
-        }
-        Some(Self::from_parts(r, t))
+        // The rotation block entry by entry (`fixed_view(..).into_owned()` is a copy loop).
+        let r = So3::try_from_matrix(&Matrix3::new(
+            m.m11, m.m12, m.m13, m.m21, m.m22, m.m23, m.m31, m.m32, m.m33,
+        ))?;
+        Some(Self::from_parts(r, Vector3::new(m.m14, m.m24, m.m34)))
     }
 
     fn is_finite(&self) -> bool {
@@ -354,18 +370,19 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     }
 
     fn exp_jac(xi: &Vector6<T>) -> (Self, Matrix6<T>) {
-        let (v, w) = split(xi);
-        let k = AngleCoeffs::of_vector(&w);
-        (
-            Self::exp_from(&k, &v, &w),
-            Self::jr_from(&k, &v, &w, T::one()),
-        )
+        let k = AngleCoeffs::of_components(xi.w, xi.a, xi.b);
+        (Self::exp_from(&k, xi), Self::jr_from(&k, xi, T::one()))
     }
 
     fn log_jac(&self) -> (Vector6<T>, Matrix6<T>) {
-        let (xi, k) = self.log_with_coeffs();
-        let (v, w) = split(&xi);
-        (xi, Self::jr_inv_from(&k, &v, &w, T::one(), T::one()))
+        // Not destructured: the kernel is read where `log_with_coeffs` put it (no copy).
+        let lk = self.log_with_coeffs();
+        (lk.0, Self::jr_inv_from(&lk.1, &lk.0, T::one(), T::one()))
+    }
+
+    /// `(a·b, Ad_{b⁻¹}, I)`, the identity from `eye` (not `Ad_e` built from an identity motion).
+    fn compose_jac(&self, b: &Self) -> (Self, Matrix6<T>, Matrix6<T>) {
+        (self.compose(b), b.inverse().adjoint(), eye())
     }
 
     /// `(a⁻¹, −Ad_a)`.
@@ -375,19 +392,21 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     /// `(z = a⁻¹·b, −Ad_{z⁻¹}, I)`.
     fn between_jac(&self, b: &Self) -> (Self, Matrix6<T>, Matrix6<T>) {
-        let z = self.between(b);
-        (z, z.inverse().neg_adjoint(), eye())
+        // `z` written where it is returned and read there (no copy of it into the tuple).
+        let mut out = (self.between(b), eye(), eye());
+        out.1 = out.0.inverse().neg_adjoint();
+        out
     }
 
     /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))` with one trigonometric kernel for the log and both
     /// inverse Jacobians (`J_l⁻¹(τ) = J_r⁻¹(−τ)`, same angle).
     fn rminus_jac(&self, b: &Self) -> (Vector6<T>, Matrix6<T>, Matrix6<T>) {
-        let (tau, k) = b.between(self).log_with_coeffs();
-        let (v, w) = split(&tau);
+        let lk = b.between(self).log_with_coeffs();
+        let (tau, k) = (&lk.0, &lk.1);
         (
-            tau,
-            Self::jr_inv_from(&k, &v, &w, T::one(), T::one()),
-            Self::jr_inv_from(&k, &v, &w, -T::one(), -T::one()),
+            *tau,
+            Self::jr_inv_from(k, tau, T::one(), T::one()),
+            Self::jr_inv_from(k, tau, -T::one(), -T::one()),
         )
     }
 
@@ -395,11 +414,16 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     ///
     /// SO(3)'s `act_jac` gives `R p`, `−R[p]×` and `R`; the 3×6 block is their columns side by side.
     fn act_jac(&self, p: &Vector3<T>) -> (Vector3<T>, Matrix3x6<T>, Matrix3<T>) {
-        let (rp, h, r) = self.rotation.act_jac(p);
-        let [r0, r1, r2] = r.data.0;
-        let [h0, h1, h2] = h.data.0;
-        let j = Matrix3x6::from_array_storage(ArrayStorage([r0, r1, r2, h0, h1, h2]));
+        // Not destructured: the blocks are read where SO(3)'s `act_jac` put them.
+        let a = self.rotation.act_jac(p);
+        let (rp, h, r) = (&a.0, &a.1, &a.2);
+        // The two 3×3 blocks copied whole into the column-major 3×6 (two block copies instead of
+        // six column copies through a temporary).
+        let mut j = Matrix3x6::zeros();
+        let (jr, jh) = j.as_mut_slice().split_at_mut(9);
+        jr.copy_from_slice(r.as_slice());
+        jh.copy_from_slice(h.as_slice());
         let t = &self.translation;
-        (Vector3::new(rp.x + t.x, rp.y + t.y, rp.z + t.z), j, r)
+        (Vector3::new(rp.x + t.x, rp.y + t.y, rp.z + t.z), j, *r)
     }
 }

@@ -105,24 +105,32 @@ impl<T: Real> So3<T> {
             m.m13 + m.m31,
             m.m23 + m.m32,
         ];
-        // `from` lists the components in nalgebra's storage order `[x, y, z, w]`.
-        let (radicand, from): (T, [u8; 4]) = if trace > T::zero() {
-            (trace + one, [0, 1, 2, SELF])
+        // `from` lists the components in nalgebra's storage order `[x, y, z, w]`, one byte each
+        // of a little-endian word (one constant per case instead of four byte stores).
+        let (radicand, from): (T, u32) = if trace > T::zero() {
+            (trace + one, u32::from_le_bytes([0, 1, 2, SELF]))
         } else if m.m11 > m.m22 && m.m11 > m.m33 {
-            (one + m.m11 - m.m22 - m.m33, [SELF, 3, 4, 0])
+            (
+                one + m.m11 - m.m22 - m.m33,
+                u32::from_le_bytes([SELF, 3, 4, 0]),
+            )
         } else if m.m22 > m.m33 {
-            (one + m.m22 - m.m11 - m.m33, [3, SELF, 5, 1])
+            (
+                one + m.m22 - m.m11 - m.m33,
+                u32::from_le_bytes([3, SELF, 5, 1]),
+            )
         } else {
-            (one + m.m33 - m.m11 - m.m22, [4, 5, SELF, 2])
+            (
+                one + m.m33 - m.m11 - m.m22,
+                u32::from_le_bytes([4, 5, SELF, 2]),
+            )
         };
+        let from = from.to_le_bytes();
         let s = radicand.sqrt() * T::lit(2.0);
-        let mut q = [T::zero(); 4];
-        for (qi, &j) in q.iter_mut().zip(from.iter()) {
-            *qi = match pairs.get(usize::from(j)) {
-                Some(p) => *p / s,
-                None => T::lit(0.25) * s,
-            };
-        }
+        let q = from.map(|j| match pairs.get(usize::from(j)) {
+            Some(p) => *p / s,
+            None => T::lit(0.25) * s,
+        });
         Self::from_quaternion(&Quaternion::from(Vector4::from(q)))
     }
 
@@ -166,12 +174,36 @@ impl<T: Real> So3<T> {
         skew_poly(T::one(), T::lit(0.5), k.d(), w)
     }
 
-    /// The unit quaternion `exp(ω)` from precomputed coefficients.
+    /// `J_r(σω) = I − σb[ω]× + c[ω]×²` for `σ = ±1` (`σ = −1`: `J_l(ω)`), with the kernel of `ω`
+    /// (`−b·σ` is `∓b` exactly). Out of line when built for size: one copy for the right and
+    /// left Jacobians.
+    #[cfg_attr(not(estimator_compact), inline(always))]
+    fn jr_at(w: &Vector3<T>, sigma: T) -> Matrix3<T> {
+        let k = AngleCoeffs::of_vector(w);
+        skew_poly(T::one(), -k.b * sigma, k.c, w)
+    }
+
+    /// `J_r⁻¹(σω) = I + ½σ[ω]× + d[ω]×²` for `σ = ±1` (`½·σ` is `±½` exactly), out of line
+    /// when built for size as `jr_at`.
+    #[cfg_attr(not(estimator_compact), inline(always))]
+    #[cfg_attr(estimator_compact, inline(never))]
+    fn jr_inv_at(w: &Vector3<T>, sigma: T) -> Matrix3<T> {
+        let k = AngleCoeffs::of_vector(w);
+        skew_poly(T::one(), T::lit(0.5) * sigma, k.d(), w)
+    }
+
+    /// The unit quaternion `exp(ω)` from precomputed coefficients, `v = h ω` per component (no
+    /// 3-vector temporary at opt-level "s").
     #[inline]
     pub(crate) fn exp_from(k: &AngleCoeffs<T>, w: &Vector3<T>) -> Self {
-        let v = w * k.half_sinc;
+        let h = k.half_sinc;
         Self {
-            q: UnitQuaternion::new_unchecked(Quaternion::new(k.cos_half, v.x, v.y, v.z)),
+            q: UnitQuaternion::new_unchecked(Quaternion::new(
+                k.cos_half,
+                w.x * h,
+                w.y * h,
+                w.z * h,
+            )),
         }
     }
 
@@ -180,9 +212,10 @@ impl<T: Real> So3<T> {
     #[cfg_attr(not(estimator_compact), inline)]
     #[cfg_attr(estimator_compact, inline(never))]
     pub(crate) fn log_with_coeffs(&self) -> (Vector3<T>, AngleCoeffs<T>) {
-        let (omega, theta, sin_half, cos_half) = self.log_parts();
-        let k = AngleCoeffs::from_half_angle(theta * theta, theta, sin_half, cos_half);
-        (omega, k)
+        // Not destructured (read in place, see `log_jac`).
+        let p = self.log_parts();
+        let k = AngleCoeffs::from_half_angle(p.1 * p.1, p.1, p.2, p.3);
+        (p.0, k)
     }
 
     /// Re-projects a quaternion already near unit norm without a square root: one Newton step
@@ -191,12 +224,29 @@ impl<T: Real> So3<T> {
     /// rounding. For `|ε|` above about 0.1 use [`LieGroup::normalize`]. It is the cheap choice
     /// for a filter step at 1 kHz (no `sqrtf`, which is software on a Cortex-M4F).
     #[must_use]
+    #[cfg_attr(estimator_compact, inline(never))]
     pub fn renormalize(&self) -> Self {
         let q = self.q.quaternion();
         let scale = (T::lit(3.0) - q.coords.norm_squared()) * T::lit(0.5);
-        Self {
-            q: UnitQuaternion::new_unchecked(*q * scale),
-        }
+        Self::scaled(q, scale)
+    }
+
+    /// `q p q* + t`: nalgebra's formula for `q p q*` written out per component (the same
+    /// operations in the same order, so the same result; no temporary vectors at opt-level "s"):
+    /// `u = 2 v × p`, `p' = w u + v × u + p`, and `t` added last, as `R p + t` would. One shared
+    /// copy for SO(3)'s `act` (`t = −0`) and SE(3)'s `act`, `compose`.
+    pub(crate) fn act_plus(&self, p: &Vector3<T>, t: &Vector3<T>) -> Vector3<T> {
+        let q = self.q.quaternion();
+        let (w, x, y, z) = (q.w, q.i, q.j, q.k);
+        let two = T::lit(2.0);
+        let tx = (y * p.z - z * p.y) * two;
+        let ty = (z * p.x - x * p.z) * two;
+        let tz = (x * p.y - y * p.x) * two;
+        Vector3::new(
+            tx * w + (y * tz - z * ty) + p.x + t.x,
+            ty * w + (z * tx - x * tz) + p.y + t.y,
+            tz * w + (x * ty - y * tx) + p.z + t.z,
+        )
     }
 
     /// Rotation matrix `R`.
@@ -239,6 +289,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
     /// [`So3::exp_from`]): the same `θ`, `sincos(θ/2)` and `sin(θ/2)/θ`, so the same bits, without
     /// a second inlined copy of them (the kernel's `a`, `b`, `c` are computed and unused).
     #[cfg(estimator_compact)]
+    #[inline(never)]
     fn exp(w: &Vector3<T>) -> Self {
         Self::exp_from(&AngleCoeffs::of_vector(w), w)
     }
@@ -270,27 +321,22 @@ impl<T: Real> LieGroup<T> for So3<T> {
         Self { q: self.q * b.q }
     }
 
+    /// The conjugate, per component (nalgebra's `conjugate` negates the vector part in a loop
+    /// through a temporary at opt-level "s").
+    #[cfg_attr(estimator_compact, inline(never))]
     fn inverse(&self) -> Self {
+        let q = self.q.quaternion();
         Self {
-            q: self.q.conjugate(),
+            q: UnitQuaternion::new_unchecked(Quaternion::new(q.w, -q.i, -q.j, -q.k)),
         }
     }
 
-    /// `q p q*`, nalgebra's formula written out per component (the same operations in the same
-    /// order, so the same result; no temporary vectors at opt-level "s"): `t = 2 v × p`,
-    /// `p' = w t + v × t + p`.
+    /// `q p q*` (see `act_plus`).
+    #[cfg_attr(estimator_compact, inline(never))]
     fn act(&self, p: &Vector3<T>) -> Vector3<T> {
-        let q = self.q.quaternion();
-        let (w, x, y, z) = (q.w, q.i, q.j, q.k);
-        let two = T::lit(2.0);
-        let tx = (y * p.z - z * p.y) * two;
-        let ty = (z * p.x - x * p.z) * two;
-        let tz = (x * p.y - y * p.x) * two;
-        Vector3::new(
-            tx * w + (y * tz - z * ty) + p.x,
-            ty * w + (z * tx - x * tz) + p.y,
-            tz * w + (x * ty - y * tx) + p.z,
-        )
+        // `x + (−0) = x` for every `x` (signed zeros and NaN included): the plain rotation.
+        let z = -T::zero();
+        self.act_plus(p, &Vector3::new(z, z, z))
     }
 
     fn adjoint(&self) -> Matrix3<T> {
@@ -298,23 +344,21 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn right_jacobian(w: &Vector3<T>) -> Matrix3<T> {
-        Self::jr_from(&AngleCoeffs::of_vector(w), w)
+        Self::jr_at(w, T::one())
     }
 
     fn right_jacobian_inv(w: &Vector3<T>) -> Matrix3<T> {
-        Self::jr_inv_from(&AngleCoeffs::of_vector(w), w)
+        Self::jr_inv_at(w, T::one())
     }
 
     /// `J_r(ω)ᵀ = I + b[ω]× + c[ω]×²`.
     fn left_jacobian(w: &Vector3<T>) -> Matrix3<T> {
-        let k = AngleCoeffs::of_vector(w);
-        skew_poly(T::one(), k.b, k.c, w)
+        Self::jr_at(w, -T::one())
     }
 
     /// `J_r⁻¹(ω)ᵀ = I − ½[ω]× + d[ω]×²`.
     fn left_jacobian_inv(w: &Vector3<T>) -> Matrix3<T> {
-        let k = AngleCoeffs::of_vector(w);
-        skew_poly(T::one(), T::lit(-0.5), k.d(), w)
+        Self::jr_inv_at(w, -T::one())
     }
 
     fn matrix(&self) -> Matrix3<T> {
@@ -352,8 +396,9 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn log_jac(&self) -> (Vector3<T>, Matrix3<T>) {
-        let (w, k) = self.log_with_coeffs();
-        (w, Self::jr_inv_from(&k, &w))
+        // Not destructured: the kernel is read where `log_with_coeffs` put it (no copy).
+        let lk = self.log_with_coeffs();
+        (lk.0, Self::jr_inv_from(&lk.1, &lk.0))
     }
 
     fn compose_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
@@ -364,22 +409,24 @@ impl<T: Real> LieGroup<T> for So3<T> {
 
     /// `(a⁻¹, −R)`, negated in place (`negate`).
     fn inverse_jac(&self) -> (Self, Matrix3<T>) {
-        let mut j = self.adjoint();
-        negate(&mut j);
-        (self.inverse(), j)
+        // Negated where it is returned (no copy of the Jacobian after the negation).
+        let mut out = (self.inverse(), self.adjoint());
+        negate(&mut out.1);
+        out
     }
 
     /// `(z = a⁻¹·b, −R_{z⁻¹}, I)`, negated in place (`negate`).
     fn between_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
-        let z = self.between(b);
-        let mut j = z.inverse().adjoint();
-        negate(&mut j);
-        (z, j, eye())
+        // `z` written where it is returned and read there (no copy of it into the tuple).
+        let mut out = (self.between(b), eye(), eye());
+        out.1 = out.0.inverse().adjoint();
+        negate(&mut out.1);
+        out
     }
 
     fn rminus_jac(&self, b: &Self) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {
-        let (tau, k) = b.between(self).log_with_coeffs();
-        let d = k.d();
+        let lk = b.between(self).log_with_coeffs();
+        let (tau, d) = (lk.0, lk.1.d());
         // −J_l⁻¹(τ) = −J_r⁻¹(τ)ᵀ = −I + ½[τ]× − d[τ]×², built negated.
         (
             tau,

@@ -120,7 +120,7 @@ impl<T: Real> AngleCoeffs<T> {
     /// of the squared norm for every SO(3) and SE(3) kernel.
     #[cfg_attr(not(estimator_compact), inline)]
     #[cfg_attr(estimator_compact, inline(never))]
-    fn of_components(x: T, y: T, z: T) -> Self {
+    pub(crate) fn of_components(x: T, y: T, z: T) -> Self {
         Self::from_theta_sq(Vector3::new(x, y, z).norm_squared())
     }
 

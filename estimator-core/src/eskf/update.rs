@@ -8,7 +8,7 @@ use super::state::ErrorState;
 use crate::lie::{LieGroup, So3};
 use crate::scalar::positive_finite;
 use crate::Real;
-use nalgebra::{Cholesky, Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 /// A measurement linearized at a state: the residual `r = z ⊖ h(x)` (for a vector measurement
 /// `z − h(x)`; angles wrapped) and `H = ∂h(x ⊕ δx)/∂δx` at `δx = 0` (seed eq. 4.3 / Def. 4.6).
@@ -90,58 +90,50 @@ pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
     Ok(())
 }
 
-/// Checks that `A` is finite, symmetric (to `1e-6` of its largest entry) and positive definite,
-/// by an in-place Cholesky factorization of one packed copy (no other `N × N` temporary).
+/// Checks that `A` is finite, symmetric (to `1e-6` of its largest entry) and positive definite:
+/// the symmetry test, then the Cholesky factorization ([`factor_lower`]) of a copy.
 pub(crate) fn check_spd<T: Real, const M: usize>(r: &SMatrix<T, M, M>) -> bool {
-    if M <= PACKED_MAX_DIM {
-        spd_packed(r.as_slice(), M)
-    } else {
-        finite_symmetric(r.as_slice(), M) && Cholesky::new(*r).is_some()
-    }
+    let mut l = *r;
+    finite_symmetric(r.as_slice(), M) && factor_lower(l.as_mut_slice(), M)
 }
 
 /// The largest error state (`Ins`, 15): the size of the fixed buffers of the shared update
 /// steps ([`commit_shared`]).
 const MAX_STATE: usize = 15;
 
-/// Largest dimension whose Cholesky test uses the packed lower triangle: every covariance of
-/// a filter.
-const PACKED_MAX_DIM: usize = MAX_STATE;
-
-/// [`check_spd`] on the column-major storage `a` of an `n × n` matrix (`n ≤ 15`): the
-/// symmetry test, then the Cholesky recurrence `L_ij = (A_ij − Σ_k<j L_ik L_jk) / L_jj`,
-/// `L_jj = √(A_jj − Σ_k<j L_jk²) > 0`, storing only the lower triangle of `L` (packed row by
-/// row: `(i, j) ↦ i(i+1)/2 + j`), 480 bytes for `f32` instead of a full copy. Not generic over
-/// the size: one copy of this code serves every matrix.
+/// `A = L Lᵀ` in place on the column-major storage `l` of an `n × n` matrix, operation for
+/// operation as `nalgebra::Cholesky::new` (the same bits, failing exactly when it fails): column
+/// by column, `a_ij ← (−l_jk) l_ik + a_ij` for `k < j ≤ i`, then `l_jj = √a_jj`, refused unless
+/// `a_jj > 0` (zero, negative or NaN), and `l_ij = a_ij / l_jj` (`i > j`). Only the lower
+/// triangle is read or written. Not generic over the size: one copy of this code serves the
+/// covariance and noise checks and the innovation's inverse.
 #[inline(never)]
-pub(crate) fn spd_packed<T: Real>(a: &[T], n: usize) -> bool {
-    if !finite_symmetric(a, n) {
-        return false;
-    }
-    let mut l = [T::zero(); PACKED_MAX_DIM * (PACKED_MAX_DIM + 1) / 2];
-    for i in 0..n {
-        let ri = i * (i + 1) / 2;
-        for j in 0..=i {
-            let rj = j * (j + 1) / 2;
-            let mut s = at(a, j * n + i);
-            // Σ_k<j L_ik L_jk over the packed rows i and j, k ascending.
-            if let (Some(li), Some(lj)) = (l.get(ri..ri + j), l.get(rj..rj + j)) {
-                for (x, y) in li.iter().zip(lj) {
-                    s -= *x * *y;
-                }
+pub(crate) fn factor_lower<T: Real>(l: &mut [T], n: usize) -> bool {
+    for j in 0..n {
+        // The columns before j, and rows j.. of column j (`col_j[0]` is the diagonal entry).
+        let Some((before, rest)) = l.split_at_mut_checked(j * n) else {
+            return false;
+        };
+        let Some(col_j) = rest.get_mut(j..n) else {
+            return false;
+        };
+        for col_k in before.chunks_exact(n) {
+            let col_k = col_k.get(j..).unwrap_or_default();
+            let f = -at(col_k, 0);
+            for (e, x) in col_j.iter_mut().zip(col_k) {
+                *e = f * *x + *e;
             }
-            let v = if i == j {
-                if !greater(s, T::zero()) {
-                    return false;
-                }
-                s.sqrt()
-            } else {
-                s / at(&l, rj + j)
-            };
-            match l.get_mut(ri + j) {
-                Some(e) => *e = v,
-                None => return false,
-            }
+        }
+        let Some((diagonal, below)) = col_j.split_first_mut() else {
+            return false;
+        };
+        if !greater(*diagonal, T::zero()) {
+            return false;
+        }
+        let d = diagonal.sqrt();
+        *diagonal = d;
+        for e in below {
+            *e /= d;
         }
     }
     true
@@ -533,7 +525,7 @@ fn gain_shared<T: Real, const C: usize>(
     }
     #[cfg(not(estimator_compact))]
     {
-        *s_inv_out = Cholesky::new(*s)
+        *s_inv_out = nalgebra::Cholesky::new(*s)
             .ok_or(EskfError::SingularInnovation)?
             .inverse();
     }
@@ -567,65 +559,23 @@ pub(crate) fn symmetrize<T: Real, const C: usize>(s: &mut SMatrix<T, C, C>) {
 }
 
 /// `A⁻¹` by `nalgebra::Cholesky::new(A)?.inverse()`, operation for operation (the same bits;
-/// `None` exactly when nalgebra's factorization fails), in plain loops over the column arrays
-/// instead of nalgebra's run-time-sized views: nalgebra's order of operations is the factor
-/// column by column, `a_ij ← (−l_jk) l_ik + a_ij` for `k < j ≤ i`, then `l_jj = √a_jj` (failing
-/// for a zero, negative or NaN `a_jj`) and `l_ij = a_ij / l_jj` (`i > j`; the strict upper
-/// triangle keeps `A`); then, per column `b` of the identity, the forward solve
-/// `b_i ← b_i / l_ii`, `b_k ← (−b_i) l_ki + b_k` (`k > i`) and the backward solve
-/// `b_i ← (b_i − (0 + Σ_{k>i} l_ki b_k)) / l_ii` (`i` descending).
+/// `None` exactly when nalgebra's factorization fails), over the column arrays instead of
+/// nalgebra's run-time-sized views: the factor by [`factor_lower`], then, per column `b` of the
+/// identity, the forward solve `b_i ← b_i / l_ii`, `b_k ← (−b_i) l_ki + b_k` (`k > i`) and the
+/// backward solve `b_i ← (b_i − (0 + Σ_{k>i} l_ki b_k)) / l_ii` (`i` descending): the
+/// substitution the solver's factor uses (`gn::linalg::substitute`), one copy for both.
 #[cfg_attr(estimator_compact, inline(never))]
 #[cfg_attr(not(estimator_compact), allow(dead_code))] // tests only, unless built for size
 pub(crate) fn cholesky_inverse<T: Real, const C: usize>(
     a: &SMatrix<T, C, C>,
 ) -> Option<SMatrix<T, C, C>> {
     let mut l = *a;
-    let l = l.as_mut_slice();
-    for j in 0..C {
-        for k in 0..j {
-            let f = -at(l, k * C + j);
-            for i in j..C {
-                let x = at(l, k * C + i);
-                if let Some(e) = l.get_mut(j * C + i) {
-                    *e = f * x + *e;
-                }
-            }
-        }
-        let d = at(l, j * C + j);
-        if d == T::zero() {
-            return None;
-        }
-        let d = d.try_sqrt()?;
-        for i in j..C {
-            if let Some(e) = l.get_mut(j * C + i) {
-                *e = if i == j { d } else { *e / d };
-            }
-        }
+    if !factor_lower(l.as_mut_slice(), C) {
+        return None;
     }
-    let l: &[T] = l;
     let mut inv = SMatrix::<T, C, C>::identity();
     for b in inv.as_mut_slice().chunks_exact_mut(C.max(1)) {
-        for i in 0..C {
-            let coeff = at(b, i) / at(l, i * C + i);
-            if let Some(e) = b.get_mut(i) {
-                *e = coeff;
-            }
-            for k in i + 1..C {
-                let x = at(l, i * C + k);
-                if let Some(e) = b.get_mut(k) {
-                    *e = -coeff * x + *e;
-                }
-            }
-        }
-        for i in (0..C).rev() {
-            let mut dot = T::zero();
-            for k in i + 1..C {
-                dot += at(l, i * C + k) * at(b, k);
-            }
-            if let Some(e) = b.get_mut(i) {
-                *e = (*e - dot) / at(l, i * C + i);
-            }
-        }
+        crate::gn::linalg::substitute(l.as_slice(), C, b);
     }
     Some(inv)
 }

@@ -183,12 +183,13 @@ pub(crate) const CORE_ROWS: usize = 3;
 /// The core takes `&dyn Rows<T, S, N, C>`, so it is compiled once per `(T, S, N, C)`, not once per
 /// model; only [`Padded::linearize_rows`] (the model's own `linearize` and a copy) is per model.
 trait Rows<T: Real, S, const N: usize, const C: usize> {
-    /// Linearizes at `x` into `ht = Hᵀ` (`N × C`; column `c` is row `c` of `H`, so that each row
-    /// of `H` is contiguous) and `r`; the columns and rows past `M` are zero.
+    /// Linearizes at `x` into `ht = Hᵀ` (`N × C`, column-major in the first `N·C` entries of the
+    /// storage; column `c` is row `c` of `H`, so that each row of `H` is contiguous) and `r`;
+    /// the columns and rows past `M` are zero, and so is the rest of the storage.
     fn linearize_rows(
         &self,
         x: &S,
-        ht: &mut SMatrix<T, N, C>,
+        ht: &mut SMatrix<T, MAX_STATE, C>,
         r: &mut SVector<T, C>,
     ) -> Result<(), EskfError>;
 }
@@ -205,7 +206,7 @@ where
     fn linearize_rows(
         &self,
         x: &S,
-        ht: &mut SMatrix<T, N, C>,
+        ht: &mut SMatrix<T, MAX_STATE, C>,
         r: &mut SVector<T, C>,
     ) -> Result<(), EskfError> {
         // Borrowed inside the `Result`, not moved out of it: one copy of the linearization on
@@ -269,25 +270,44 @@ fn pad_into<T: Real>(src: &[T], m: usize, dst: &mut [T], c: usize) {
 
 /// The working set of one update, kept in one place on the caller's stack and filled in place
 /// by the phases below (each phase is a separate, non-inlined function, so their frames do not
-/// add up: the peak stack stays small on a Cortex-M). Columns (of `N × C` matrices) and rows
-/// past `m` are zero.
-struct Work<T: Real, const N: usize, const C: usize> {
+/// add up: the peak stack stays small on a Cortex-M). Its type does not depend on the filter:
+/// an `n × C` matrix (`n` the error-state dimension, 15 or 6) is stored column-major in the
+/// first `n·C` entries of a `MAX_STATE × C` array (column `c` at `c·n .. c·n + n`), the rest
+/// zero, so that the steps that do not touch the state are one compiled copy for both filters.
+/// Columns and rows past `m` are zero.
+struct Work<T: Real, const C: usize> {
     /// `H̃ᵀ` at the current iterate.
-    ht: SMatrix<T, N, C>,
+    ht: SMatrix<T, MAX_STATE, C>,
     /// Residual `r = z ⊖ h(x̂ ⊕ δx)` at the current iterate.
     r: SVector<T, C>,
     /// `U = P H̃ᵀ`.
-    u: SMatrix<T, N, C>,
+    u: SMatrix<T, MAX_STATE, C>,
     /// `S = H̃ P H̃ᵀ + R` (identity past `m`).
     s: SMatrix<T, C, C>,
     /// `K = U S⁻¹`.
-    k: SMatrix<T, N, C>,
+    k: SMatrix<T, MAX_STATE, C>,
     /// `S⁻¹` (for the NIS at the prior).
     s_inv: SMatrix<T, C, C>,
-    /// The current correction `δx`.
-    dx: SVector<T, N>,
+    /// The current correction `δx` (the first `n` entries; the rest zero).
+    dx: SVector<T, MAX_STATE>,
     /// The number of active rows, `M`.
     m: usize,
+}
+
+/// The first `len` entries of `s` (all of `s` if shorter; no caller asks for more).
+#[inline(always)]
+fn head<T>(s: &[T], len: usize) -> &[T] {
+    s.get(..len).unwrap_or(s)
+}
+
+/// The first `N` entries of `s` as the state's error vector (zero past the end of `s`).
+#[inline(always)]
+fn error_vector<T: Real, const N: usize>(s: &[T]) -> SVector<T, N> {
+    let mut v = SVector::<T, N>::zeros();
+    for (d, e) in v.as_mut_slice().iter_mut().zip(s) {
+        *d = *e;
+    }
+    v
 }
 
 /// The generic update on `(x, P)`; `x` and `P` are written only when the result is `Accepted`.
@@ -327,7 +347,10 @@ where
     }
 }
 
-/// Steps 1–4 for a model seen through `C` rows, `m` of them active (see [`update`]).
+/// Steps 1–4 for a model seen through `C` rows, `m` of them active (see [`update`]). Only the
+/// parts that touch the state (`h`, `⊕`) are here, per filter; the rest are the shared steps
+/// ([`start`], [`gate_step`], [`step_shared`], [`commit_shared`]), built for size one copy for
+/// both filters (at opt-level 2 or 3 inlined, where `n = N` is a constant).
 #[inline(never)]
 fn update_core<T, S, const N: usize, const C: usize>(
     x: &mut S,
@@ -341,17 +364,7 @@ where
     T: Real,
     S: ErrorState<T, N>,
 {
-    if opts.max_iterations == 0 || !opts.step_tolerance.is_finite() {
-        return Err(EskfError::InvalidOption);
-    }
-    if let Gate::Threshold(t) = opts.gate {
-        if !(t.is_finite() || t > T::zero()) {
-            return Err(EskfError::InvalidOption);
-        }
-    }
-    if !check_spd(r_noise) {
-        return Err(EskfError::NoiseNotPositiveDefinite);
-    }
+    start(opts, r_noise)?;
     let mut w = Work {
         ht: SMatrix::zeros(),
         r: SVector::zeros(),
@@ -363,7 +376,47 @@ where
         m,
     };
     linearize_into(model, x, &mut w, true)?;
-    gain_into(p, r_noise, &mut w)?;
+    let nis = match gate_step(p.as_slice(), N, m, r_noise, opts, &mut w)? {
+        UpdateOutcome::Accepted { nis, .. } => nis,
+        rejected => return Ok(rejected),
+    };
+    let iterations = iterate(x, p, model, opts, r_noise, &mut w);
+    commit(x, p, &mut w)?;
+    Ok(UpdateOutcome::Accepted { nis, iterations })
+}
+
+/// The checks before any work: the options, and `R` symmetric positive definite.
+fn start<T: Real, const C: usize>(
+    opts: &UpdateOptions<T>,
+    r_noise: &SMatrix<T, C, C>,
+) -> Result<(), EskfError> {
+    if opts.max_iterations == 0 || !opts.step_tolerance.is_finite() {
+        return Err(EskfError::InvalidOption);
+    }
+    if let Gate::Threshold(t) = opts.gate {
+        if !(t.is_finite() || t > T::zero()) {
+            return Err(EskfError::InvalidOption);
+        }
+    }
+    if !check_spd(r_noise) {
+        return Err(EskfError::NoiseNotPositiveDefinite);
+    }
+    Ok(())
+}
+
+/// The gain at the prior, the NIS and the gate (`m` = `w.m`, the argument lets the compiler
+/// see its range), then `δx₁ = K₀ r₀` into `w.dx`. Returns
+/// `Rejected`, or `Accepted` with the NIS (its iteration count is set by the caller).
+#[cfg_attr(not(estimator_compact), inline(always))]
+fn gate_step<T: Real, const C: usize>(
+    p: &[T],
+    n: usize,
+    m: usize,
+    r_noise: &SMatrix<T, C, C>,
+    opts: &UpdateOptions<T>,
+    w: &mut Work<T, C>,
+) -> Result<UpdateOutcome<T>, EskfError> {
+    gain_into(p, n, r_noise, w)?;
     let nis = nis(&w.s_inv, &w.r);
     if !nis.is_finite() {
         return Err(EskfError::SingularInnovation);
@@ -372,10 +425,12 @@ where
     if nis > threshold {
         return Ok(UpdateOutcome::Rejected { nis, threshold });
     }
-    mat_vec(w.k.as_slice(), w.r.as_slice(), w.dx.as_mut_slice());
-    let iterations = iterate(x, p, model, opts, r_noise, &mut w);
-    commit(x, p, &mut w)?;
-    Ok(UpdateOutcome::Accepted { nis, iterations })
+    mat_vec(
+        w.k.as_slice(),
+        w.r.as_slice(),
+        w.dx.as_mut_slice().get_mut(..n).unwrap_or_default(),
+    );
+    Ok(UpdateOutcome::Accepted { nis, iterations: 1 })
 }
 
 /// `NIS = rᵀ S⁻¹ r` with the `S⁻¹` already formed for `K`, and an explicit sum:
@@ -411,7 +466,7 @@ pub(crate) fn mat_vec<T: Real>(a: &[T], x: &[T], out: &mut [T]) {
 fn linearize_into<T, S, const N: usize, const C: usize>(
     model: &dyn Rows<T, S, N, C>,
     x: &S,
-    w: &mut Work<T, N, C>,
+    w: &mut Work<T, C>,
     first: bool,
 ) -> Result<(), EskfError>
 where
@@ -421,13 +476,29 @@ where
     if first {
         model.linearize_rows(x, &mut w.ht, &mut w.r)?;
     } else {
-        model.linearize_rows(&x.oplus(&w.dx), &mut w.ht, &mut w.r)?;
+        let dx = error_vector::<T, N>(w.dx.as_slice());
+        model.linearize_rows(&x.oplus(&dx), &mut w.ht, &mut w.r)?;
     }
+    check_rows(N, w, first)
+}
+
+/// The rows just linearized: finite (else `NonFinite`), and after the first linearization
+/// turned into the chart Jacobian ([`chart_jacobian`]).
+#[cfg_attr(not(estimator_compact), inline(always))]
+fn check_rows<T: Real, const C: usize>(
+    n: usize,
+    w: &mut Work<T, C>,
+    first: bool,
+) -> Result<(), EskfError> {
     if !(finite_vec(&w.r) && finite_vec(&w.ht)) {
         return Err(EskfError::NonFinite);
     }
     if !first {
-        chart_jacobian(w.dx.as_slice(), w.ht.as_mut_slice());
+        let ht = w.ht.as_mut_slice();
+        chart_jacobian(
+            head(w.dx.as_slice(), n),
+            ht.get_mut(..n * C).unwrap_or_default(),
+        );
     }
     Ok(())
 }
@@ -452,18 +523,18 @@ pub(crate) fn chart_jacobian<T: Real>(dx: &[T], ht: &mut [T]) {
     }
 }
 
-/// `U = P H̃ᵀ`, `S = H̃ U + R`, `S⁻¹`, `K = U S⁻¹` into `w`. The per-size entry of
-/// [`gain_shared`] (see [`commit`] for the two builds).
-#[cfg_attr(estimator_compact, inline(always))]
-#[cfg_attr(not(estimator_compact), inline(never))]
-fn gain_into<T: Real, const N: usize, const C: usize>(
-    p: &SMatrix<T, N, N>,
+/// `U = P H̃ᵀ`, `S = H̃ U + R`, `S⁻¹`, `K = U S⁻¹` into `w`, for the `n × n` covariance `p`
+/// (column-major).
+#[inline(always)]
+fn gain_into<T: Real, const C: usize>(
+    p: &[T],
+    n: usize,
     r_noise: &SMatrix<T, C, C>,
-    w: &mut Work<T, N, C>,
+    w: &mut Work<T, C>,
 ) -> Result<(), EskfError> {
     gain_shared(
-        p.as_slice(),
-        N,
+        p,
+        n,
         w.m,
         r_noise,
         w.ht.as_slice(),
@@ -643,7 +714,7 @@ fn iterate<T, S, const N: usize, const C: usize>(
     model: &dyn Rows<T, S, N, C>,
     opts: &UpdateOptions<T>,
     r_noise: &SMatrix<T, C, C>,
-    w: &mut Work<T, N, C>,
+    w: &mut Work<T, C>,
 ) -> u8
 where
     T: Real,
@@ -651,32 +722,53 @@ where
 {
     let mut iterations: u8 = 1;
     while iterations < opts.max_iterations {
-        let (u, s, k, prev) = (w.u, w.s, w.k, w.dx);
-        let ok = linearize_into(model, x, w, false).is_ok() && gain_into(p, r_noise, w).is_ok();
-        // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
-        let mut next = SVector::<T, N>::zeros();
-        gauss_newton_step(
-            w.ht.as_slice(),
-            w.k.as_slice(),
-            &w.r,
-            w.m,
-            prev.as_slice(),
-            next.as_mut_slice(),
-        );
-        if !(ok && finite_vec(&next)) {
-            w.u = u;
-            w.s = s;
-            w.k = k;
-            w.dx = prev;
+        let linearized = linearize_into(model, x, w, false).is_ok();
+        let Some(converged) = step_shared(p.as_slice(), N, r_noise, opts, w, linearized) else {
             break;
-        }
-        w.dx = next;
+        };
         iterations += 1;
-        if distance(next.as_slice(), prev.as_slice()) < opts.step_tolerance {
+        if converged {
             break;
         }
     }
     iterations
+}
+
+/// One Gauss-Newton step after a re-linearization (`linearized` tells whether it succeeded):
+/// the gain there, then `δx_{k+1} = K_k (r_k + H̃_k δx_k)` into `w.dx`; `None` (with `U`, `S`,
+/// `K` and `δx` as they were) when the linearization, the gain or the step failed, else whether
+/// `‖δx_{k+1} − δx_k‖ < tol`. For the `n × n` covariance `p` (column-major).
+#[cfg_attr(not(estimator_compact), inline(always))]
+fn step_shared<T: Real, const C: usize>(
+    p: &[T],
+    n: usize,
+    r_noise: &SMatrix<T, C, C>,
+    opts: &UpdateOptions<T>,
+    w: &mut Work<T, C>,
+    linearized: bool,
+) -> Option<bool> {
+    if !linearized {
+        return None;
+    }
+    // The linearization wrote `H̃` and `r` only; the gain overwrites these.
+    let (u, s, k) = (w.u, w.s, w.k);
+    let ok = gain_into(p, n, r_noise, w).is_ok();
+    // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
+    let mut next = SVector::<T, MAX_STATE>::zeros();
+    let next = next.as_mut_slice().get_mut(..n).unwrap_or_default();
+    let prev = head(w.dx.as_slice(), n);
+    gauss_newton_step(w.ht.as_slice(), w.k.as_slice(), &w.r, w.m, prev, next);
+    if !(ok && sum_times_zero_is_zero(next)) {
+        w.u = u;
+        w.s = s;
+        w.k = k;
+        return None;
+    }
+    let converged = distance(next, prev) < opts.step_tolerance;
+    for (d, e) in w.dx.as_mut_slice().iter_mut().zip(next.iter()) {
+        *d = *e;
+    }
+    Some(converged)
 }
 
 /// Steps 3–4: Joseph-form covariance, injection and reset; writes `x` and `P` only when every
@@ -692,13 +784,14 @@ where
 fn commit<T, S, const N: usize, const C: usize>(
     x: &mut S,
     p: &mut SMatrix<T, N, N>,
-    w: &mut Work<T, N, C>,
+    w: &mut Work<T, C>,
 ) -> Result<(), EskfError>
 where
     T: Real,
     S: ErrorState<T, N>,
 {
-    let new_x = x.oplus(&w.dx);
+    let dx = head(w.dx.as_slice(), N);
+    let new_x = x.oplus(&error_vector(dx));
     commit_shared(
         p.as_mut_slice(),
         N,
@@ -706,7 +799,7 @@ where
         w.u.as_mut_slice(),
         w.k.as_slice(),
         &w.s,
-        w.dx.as_slice(),
+        dx,
         new_x.is_finite(),
     )?;
     *x = new_x;

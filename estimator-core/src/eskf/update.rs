@@ -248,14 +248,6 @@ pub(crate) fn rows_into<T: Real>(h: &[T], r_in: &[T], ht: &mut [T], r: &mut [T])
     }
 }
 
-/// `R` (`M × M`) padded to `C × C` with the identity.
-#[cfg_attr(estimator_compact, inline(never))]
-fn pad_noise<T: Real, const M: usize, const C: usize>(r: &SMatrix<T, M, M>) -> SMatrix<T, C, C> {
-    let mut out = SMatrix::<T, C, C>::identity();
-    pad_into(r.as_slice(), M, out.as_mut_slice(), C);
-    out
-}
-
 /// Copies the column-major `m × m` matrix `src` into the top-left of the column-major `c × c`
 /// matrix `dst` (one copy of this code for every size).
 fn pad_into<T: Real>(src: &[T], m: usize, dst: &mut [T], c: usize) {
@@ -290,6 +282,8 @@ struct Work<T: Real, const C: usize> {
     s_inv: SMatrix<T, C, C>,
     /// The current correction `δx` (the first `n` entries; the rest zero).
     dx: SVector<T, MAX_STATE>,
+    /// `R` padded to `C × C` with the identity.
+    noise: SMatrix<T, C, C>,
     /// The number of active rows, `M`.
     m: usize,
 }
@@ -325,8 +319,8 @@ fn error_vector<T: Real, const N: usize>(s: &[T]) -> SVector<T, N> {
 /// 4. Inject `x⁺ = x̂ ⊕ δx` (seed eq. 4.5) and reset `P ← G P Gᵀ`,
 ///    `G = blockdiag(J_r(δθ), I)` (the new error `e⁺ = log(exp(δθ)⁻¹ exp(e)) ≈ J_r(δθ)(e − δθ)`).
 ///
-/// This wrapper is the only per-model code: it pads the model to the core's row capacity
-/// ([`CORE_ROWS`]) and calls the shared core.
+/// This wrapper is the only per-model code: it picks the core's row capacity ([`CORE_ROWS`])
+/// and calls the core, which pads the model's rows and noise to it.
 pub(crate) fn update<T, S, Mo, const N: usize, const M: usize>(
     x: &mut S,
     p: &mut SMatrix<T, N, N>,
@@ -339,11 +333,11 @@ where
     Mo: Measurement<T, S, N, M>,
 {
     let rows = Padded::<Mo, M>(model);
+    let noise = model.noise();
     if M <= CORE_ROWS {
-        let noise = pad_noise::<T, M, CORE_ROWS>(&model.noise());
-        update_core::<T, S, N, CORE_ROWS>(x, p, &rows, &noise, M, opts)
+        update_core::<T, S, N, CORE_ROWS>(x, p, &rows, noise.as_slice(), M, opts)
     } else {
-        update_core::<T, S, N, M>(x, p, &rows, &model.noise(), M, opts)
+        update_core::<T, S, N, M>(x, p, &rows, noise.as_slice(), M, opts)
     }
 }
 
@@ -356,7 +350,7 @@ fn update_core<T, S, const N: usize, const C: usize>(
     x: &mut S,
     p: &mut SMatrix<T, N, N>,
     model: &dyn Rows<T, S, N, C>,
-    r_noise: &SMatrix<T, C, C>,
+    noise: &[T],
     m: usize,
     opts: &UpdateOptions<T>,
 ) -> Result<UpdateOutcome<T>, EskfError>
@@ -364,7 +358,6 @@ where
     T: Real,
     S: ErrorState<T, N>,
 {
-    start(opts, r_noise)?;
     let mut w = Work {
         ht: SMatrix::zeros(),
         r: SVector::zeros(),
@@ -373,22 +366,26 @@ where
         k: SMatrix::zeros(),
         s_inv: SMatrix::zeros(),
         dx: SVector::zeros(),
+        noise: SMatrix::identity(),
         m,
     };
+    start(opts, noise, &mut w)?;
     linearize_into(model, x, &mut w, true)?;
-    let nis = match gate_step(p.as_slice(), N, m, r_noise, opts, &mut w)? {
+    let nis = match gate_step(p.as_slice(), N, m, opts, &mut w)? {
         UpdateOutcome::Accepted { nis, .. } => nis,
         rejected => return Ok(rejected),
     };
-    let iterations = iterate(x, p, model, opts, r_noise, &mut w);
+    let iterations = iterate(x, p, model, opts, &mut w);
     commit(x, p, &mut w)?;
     Ok(UpdateOutcome::Accepted { nis, iterations })
 }
 
-/// The checks before any work: the options, and `R` symmetric positive definite.
+/// The checks before any work: the options, and `R` (`noise`, `m × m` column-major, padded
+/// into `w.noise`) symmetric positive definite.
 fn start<T: Real, const C: usize>(
     opts: &UpdateOptions<T>,
-    r_noise: &SMatrix<T, C, C>,
+    noise: &[T],
+    w: &mut Work<T, C>,
 ) -> Result<(), EskfError> {
     if opts.max_iterations == 0 || !opts.step_tolerance.is_finite() {
         return Err(EskfError::InvalidOption);
@@ -398,7 +395,8 @@ fn start<T: Real, const C: usize>(
             return Err(EskfError::InvalidOption);
         }
     }
-    if !check_spd(r_noise) {
+    pad_into(noise, w.m, w.noise.as_mut_slice(), C);
+    if !check_spd(&w.noise) {
         return Err(EskfError::NoiseNotPositiveDefinite);
     }
     Ok(())
@@ -412,11 +410,10 @@ fn gate_step<T: Real, const C: usize>(
     p: &[T],
     n: usize,
     m: usize,
-    r_noise: &SMatrix<T, C, C>,
     opts: &UpdateOptions<T>,
     w: &mut Work<T, C>,
 ) -> Result<UpdateOutcome<T>, EskfError> {
-    gain_into(p, n, r_noise, w)?;
+    gain_into(p, n, w)?;
     let nis = nis(&w.s_inv, &w.r);
     if !nis.is_finite() {
         return Err(EskfError::SingularInnovation);
@@ -529,14 +526,13 @@ pub(crate) fn chart_jacobian<T: Real>(dx: &[T], ht: &mut [T]) {
 fn gain_into<T: Real, const C: usize>(
     p: &[T],
     n: usize,
-    r_noise: &SMatrix<T, C, C>,
     w: &mut Work<T, C>,
 ) -> Result<(), EskfError> {
     gain_shared(
         p,
         n,
         w.m,
-        r_noise,
+        &w.noise,
         w.ht.as_slice(),
         w.u.as_mut_slice(),
         &mut w.s,
@@ -713,7 +709,6 @@ fn iterate<T, S, const N: usize, const C: usize>(
     p: &SMatrix<T, N, N>,
     model: &dyn Rows<T, S, N, C>,
     opts: &UpdateOptions<T>,
-    r_noise: &SMatrix<T, C, C>,
     w: &mut Work<T, C>,
 ) -> u8
 where
@@ -723,7 +718,7 @@ where
     let mut iterations: u8 = 1;
     while iterations < opts.max_iterations {
         let linearized = linearize_into(model, x, w, false).is_ok();
-        let Some(converged) = step_shared(p.as_slice(), N, r_noise, opts, w, linearized) else {
+        let Some(converged) = step_shared(p.as_slice(), N, opts, w, linearized) else {
             break;
         };
         iterations += 1;
@@ -742,7 +737,6 @@ where
 fn step_shared<T: Real, const C: usize>(
     p: &[T],
     n: usize,
-    r_noise: &SMatrix<T, C, C>,
     opts: &UpdateOptions<T>,
     w: &mut Work<T, C>,
     linearized: bool,
@@ -752,7 +746,7 @@ fn step_shared<T: Real, const C: usize>(
     }
     // The linearization wrote `H̃` and `r` only; the gain overwrites these.
     let (u, s, k) = (w.u, w.s, w.k);
-    let ok = gain_into(p, n, r_noise, w).is_ok();
+    let ok = gain_into(p, n, w).is_ok();
     // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
     let mut next = SVector::<T, MAX_STATE>::zeros();
     let next = next.as_mut_slice().get_mut(..n).unwrap_or_default();

@@ -521,43 +521,32 @@ pub(crate) fn chart_jacobian<T: Real>(dx: &[T], ht: &mut [T]) {
 }
 
 /// `U = P H̃ᵀ`, `S = H̃ U + R`, `S⁻¹`, `K = U S⁻¹` into `w`, for the `n × n` covariance `p`
-/// (column-major).
+/// (column-major), over the `n × C` matrices of the working set (column `c` is entries
+/// `c·n .. c·n + n`), for the `m` active columns only.
 #[inline(always)]
 fn gain_into<T: Real, const C: usize>(
     p: &[T],
     n: usize,
     w: &mut Work<T, C>,
 ) -> Result<(), EskfError> {
-    gain_shared(
-        p,
-        n,
-        w.m,
-        &w.noise,
-        w.ht.as_slice(),
+    gain_shared(p, n, w)
+}
+
+/// The body of [`gain_into`]: one out-of-line copy built for size, inlined at opt-level 2 or 3.
+#[cfg_attr(estimator_compact, inline(never))]
+#[cfg_attr(not(estimator_compact), inline(always))]
+fn gain_shared<T: Real, const C: usize>(
+    p: &[T],
+    n: usize,
+    w: &mut Work<T, C>,
+) -> Result<(), EskfError> {
+    let (m, r_noise, ht) = (w.m, &w.noise, w.ht.as_slice());
+    let (u, s, s_inv_out, k) = (
         w.u.as_mut_slice(),
         &mut w.s,
         &mut w.s_inv,
         w.k.as_mut_slice(),
-    )
-}
-
-/// [`gain_into`] on the column-major storage of an `n × n` covariance `p` and of the `n × C`
-/// matrices `ht`, `u`, `k` (column `c` is entries `c·n .. c·n + n`), for the `m` active
-/// columns only.
-#[cfg_attr(estimator_compact, inline(never))]
-#[cfg_attr(not(estimator_compact), inline(always))]
-#[allow(clippy::too_many_arguments)] // the working set, lent field by field
-fn gain_shared<T: Real, const C: usize>(
-    p: &[T],
-    n: usize,
-    m: usize,
-    r_noise: &SMatrix<T, C, C>,
-    ht: &[T],
-    u: &mut [T],
-    s: &mut SMatrix<T, C, C>,
-    s_inv_out: &mut SMatrix<T, C, C>,
-    k: &mut [T],
-) -> Result<(), EskfError> {
+    );
     // Column c of U = Σ_j P e_j H_cj over the nonzero entries of row c of H only (most models
     // touch 3–6 of the 15 error components).
     u.fill(T::zero());
@@ -786,39 +775,27 @@ where
 {
     let dx = head(w.dx.as_slice(), N);
     let new_x = x.oplus(&error_vector(dx));
-    commit_shared(
-        p.as_mut_slice(),
-        N,
-        w.m,
-        w.u.as_mut_slice(),
-        w.k.as_slice(),
-        &w.s,
-        dx,
-        new_x.is_finite(),
-    )?;
+    commit_shared(p.as_mut_slice(), N, w, new_x.is_finite())?;
     *x = new_x;
     Ok(())
 }
 
-/// The covariance of steps 3–4 on the column-major storage of the `n × n` covariance `p` and
-/// the `n × C` matrices `u` (`U`, overwritten by `V`), `k` (`K`); `s` is `S`, `dx` the
-/// correction. Writes `p` only when `state_ok` and every check passes.
+/// The covariance of steps 3–4 on the column-major storage of the `n × n` covariance `p`,
+/// from the working set: the `n × C` matrices `U` (overwritten by `V`) and `K`, `S` and the
+/// correction `δx`. Writes `p` only when `state_ok` and every check passes.
 #[cfg_attr(estimator_compact, inline(never))]
 #[cfg_attr(not(estimator_compact), inline(always))]
-#[allow(clippy::too_many_arguments)] // the working set, lent field by field
 fn commit_shared<T: Real, const C: usize>(
     p: &mut [T],
     n: usize,
-    m: usize,
-    u: &mut [T],
-    k: &[T],
-    s: &SMatrix<T, C, C>,
-    dx: &[T],
+    w: &mut Work<T, C>,
     state_ok: bool,
 ) -> Result<(), EskfError> {
     if !(3..=MAX_STATE).contains(&n) {
         return Err(EskfError::NumericalFailure); // no filter has such a state
     }
+    let (m, u, k, s) = (w.m, w.u.as_mut_slice(), w.k.as_slice(), &w.s);
+    let dx = head(w.dx.as_slice(), n);
     // Joseph form, expanded and written as m symmetric rank-2 corrections:
     //   P⁺ = P − K Uᵀ − U Kᵀ + K S Kᵀ = P + V Kᵀ + K Vᵀ = P + Σ_c (v_c k_cᵀ + k_c v_cᵀ),
     //   V = ½ K S − U (columns v_c, k_c of V and K): exactly symmetric, computed in place

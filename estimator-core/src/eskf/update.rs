@@ -433,7 +433,6 @@ fn gate_step<T: Real, const C: usize>(
 /// `NIS = rᵀ S⁻¹ r` with the `S⁻¹` already formed for `K`, and an explicit sum:
 /// `Cholesky::solve` (dynamic-range `dot`s) and `dot` keep shape asserts, panic paths at
 /// opt-level "s". Generic over the row capacity only: one copy for both filters.
-#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn nis<T: Real, const C: usize>(s_inv: &SMatrix<T, C, C>, r: &SVector<T, C>) -> T {
     let mut y = SVector::<T, C>::zeros();
     mat_vec(s_inv.as_slice(), r.as_slice(), y.as_mut_slice());
@@ -447,7 +446,6 @@ pub(crate) fn nis<T: Real, const C: usize>(s_inv: &SMatrix<T, C, C>, r: &SVector
 /// nalgebra's product (`gemv`): `out_i = a_i0 x_0`, then `out_i = a_ij x_j + out_i` for
 /// `j = 1, 2, …` (no leading zero term). Not generic over the sizes: one copy for `K r` in
 /// both filters and for the NIS.
-#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn mat_vec<T: Real>(a: &[T], x: &[T], out: &mut [T]) {
     for (j, (col, xj)) in a.chunks_exact(out.len().max(1)).zip(x).enumerate() {
         for (o, e) in out.iter_mut().zip(col) {
@@ -505,7 +503,6 @@ fn check_rows<T: Real, const C: usize>(
 /// `J_rᵀ h` ([`mv`](super::imu::mv), the sums of nalgebra's `J_rᵀ · Hᵀ[0..3, ..]`), over every
 /// column (the zero padding too, as that product did). Not generic over the sizes: one copy
 /// for both filters.
-#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn chart_jacobian<T: Real>(dx: &[T], ht: &mut [T]) {
     let dth = Vector3::new(at(dx, 0), at(dx, 1), at(dx, 2));
     let jrt = super::imu::tr33(&So3::right_jacobian(&dth));
@@ -640,7 +637,6 @@ pub(crate) fn cholesky_inverse<T: Real, const C: usize>(
 /// storage of the `n × C` matrices `ht` (`H̃ᵀ`) and `k` (`K`), `n = prev.len()`: `y = r`,
 /// `y_c += (row c of H̃)·prev`, then `next = Σ_c y_c k_c` from zero. Generic over the row
 /// capacity only: one copy for both filters.
-#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn gauss_newton_step<T: Real, const C: usize>(
     ht: &[T],
     k: &[T],
@@ -671,7 +667,6 @@ fn axpy<T: Real>(y: &mut [T], a: T, x: &[T]) {
 
 /// `‖a − b‖` over two equally long slices: `√(a − b)·(a − b)`, the differences then [`dot`]'s
 /// sum. Not generic over the length: one copy for both filters.
-#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn distance<T: Real>(a: &[T], b: &[T]) -> T {
     a.iter()
         .zip(b)

@@ -165,19 +165,27 @@ pub(crate) fn blk_rc<T: Real, const R: usize, const C: usize>(
 
 /// Writes block `(i, j)` of an `R × C` matrix, column piece by column piece (nothing outside
 /// the matrix).
-#[cfg_attr(estimator_compact, inline(never))]
+#[inline(always)]
 pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
     m: &mut SMatrix<T, R, C>,
     i: usize,
     j: usize,
     v: &Matrix3<T>,
 ) {
-    if 3 * i + 3 > R {
+    set_blk_rows(m.as_mut_slice(), R, i, j, v);
+}
+
+/// [`set_blk_rc`] on the column-major storage `m` of a matrix with `rows` rows. Not generic
+/// over the shape: built for size, one copy for every matrix.
+#[cfg_attr(estimator_compact, inline(never))]
+#[cfg_attr(not(estimator_compact), inline(always))]
+fn set_blk_rows<T: Real>(m: &mut [T], rows: usize, i: usize, j: usize, v: &Matrix3<T>) {
+    if 3 * i + 3 > rows {
         return;
     }
     for (c, src) in v.as_slice().chunks_exact(3).enumerate() {
-        let s = R * (3 * j + c) + 3 * i;
-        if let Some(dst) = m.as_mut_slice().get_mut(s..s + 3) {
+        let s = rows * (3 * j + c) + 3 * i;
+        if let Some(dst) = m.get_mut(s..s + 3) {
             for (d, x) in dst.iter_mut().zip(src) {
                 *d = *x;
             }

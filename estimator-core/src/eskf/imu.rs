@@ -164,7 +164,9 @@ pub(crate) fn blk_rc<T: Real, const R: usize, const C: usize>(
 }
 
 /// Writes block `(i, j)` of an `R × C` matrix, column piece by column piece (nothing outside
-/// the matrix).
+/// the matrix). Built for size, through one out-of-line copy over the storage
+/// ([`set_blk_rows`]) for every shape.
+#[cfg(estimator_compact)]
 #[inline(always)]
 pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
     m: &mut SMatrix<T, R, C>,
@@ -175,10 +177,32 @@ pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
     set_blk_rows(m.as_mut_slice(), R, i, j, v);
 }
 
-/// [`set_blk_rc`] on the column-major storage `m` of a matrix with `rows` rows. Not generic
-/// over the shape: built for size, one copy for every matrix.
-#[cfg_attr(estimator_compact, inline(never))]
-#[cfg_attr(not(estimator_compact), inline(always))]
+/// Writes block `(i, j)` of an `R × C` matrix (see the build for size above); at opt-level 2
+/// or 3 specialised for each shape, with which the prediction's instruction counts are budgeted.
+#[cfg(not(estimator_compact))]
+pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
+    m: &mut SMatrix<T, R, C>,
+    i: usize,
+    j: usize,
+    v: &Matrix3<T>,
+) {
+    if 3 * i + 3 > R {
+        return;
+    }
+    for (c, src) in v.as_slice().chunks_exact(3).enumerate() {
+        let s = R * (3 * j + c) + 3 * i;
+        if let Some(dst) = m.as_mut_slice().get_mut(s..s + 3) {
+            for (d, x) in dst.iter_mut().zip(src) {
+                *d = *x;
+            }
+        }
+    }
+}
+
+/// [`set_blk_rc`] on the column-major storage `m` of a matrix with `rows` rows (the same
+/// stores).
+#[cfg(estimator_compact)]
+#[inline(never)]
 fn set_blk_rows<T: Real>(m: &mut [T], rows: usize, i: usize, j: usize, v: &Matrix3<T>) {
     if 3 * i + 3 > rows {
         return;

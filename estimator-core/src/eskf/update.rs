@@ -261,8 +261,8 @@ fn pad_into<T: Real>(src: &[T], m: usize, dst: &mut [T], c: usize) {
 }
 
 /// The working set of one update, kept in one place on the caller's stack and filled in place
-/// by the phases below (each phase is a separate, non-inlined function, so their frames do not
-/// add up: the peak stack stays small on a Cortex-M). Its type does not depend on the filter:
+/// by the phases below (the phases with large temporaries are separate, non-inlined functions,
+/// so their frames do not add up: the peak stack stays small on a Cortex-M). Its type does not depend on the filter:
 /// an `n × C` matrix (`n` the error-state dimension, 15 or 6) is stored column-major in the
 /// first `n·C` entries of a `MAX_STATE × C` array (column `c` at `c·n .. c·n + n`), the rest
 /// zero, so that the steps that do not touch the state are one compiled copy for both filters.
@@ -457,7 +457,11 @@ pub(crate) fn mat_vec<T: Real>(a: &[T], x: &[T], out: &mut [T]) {
 /// Linearizes at `x̂ ⊕ δx` (`δx` = `w.dx`) into `w.ht`, `w.r`, with the chart Jacobian
 /// `H̃ = H · blockdiag(J_r(δθ), I)` (the Jacobian of `h(x̂ ⊕ δx)` in `δx`, so that the iterated
 /// update is Gauss-Newton in the chart at the prior `x̂`; `J_r(0) = I`).
-#[inline(never)]
+///
+/// Built for size, inlined into [`update_core`] (as is [`iterate`]): one function per filter
+/// instead of three, and this frame is on the update's deepest path either way.
+#[cfg_attr(estimator_compact, inline(always))]
+#[cfg_attr(not(estimator_compact), inline(never))]
 fn linearize_into<T, S, const N: usize, const C: usize>(
     model: &dyn Rows<T, S, N, C>,
     x: &S,
@@ -687,7 +691,8 @@ fn dot<T: Real>(a: &[T], b: &[T]) -> T {
 /// The Gauss-Newton iterations (step 2 after the first): at `x̂ ⊕ δx_k`,
 /// `δx_{k+1} = K_k (r_k + H̃_k δx_k)`. A failure to re-linearize stops at the last good iterate
 /// (whose `K`, `U`, `S` are restored). Returns the number of linearizations used.
-#[inline(never)]
+#[cfg_attr(estimator_compact, inline(always))]
+#[cfg_attr(not(estimator_compact), inline(never))]
 fn iterate<T, S, const N: usize, const C: usize>(
     x: &S,
     p: &SMatrix<T, N, N>,

@@ -621,7 +621,6 @@ pub(crate) fn symmetrize<T: Real, const C: usize>(s: &mut SMatrix<T, C, C>) {
 /// identity, the forward solve `b_i ← b_i / l_ii`, `b_k ← (−b_i) l_ki + b_k` (`k > i`) and the
 /// backward solve `b_i ← (b_i − (0 + Σ_{k>i} l_ki b_k)) / l_ii` (`i` descending): the
 /// substitution the solver's factor uses (`gn::linalg::substitute`), one copy for both.
-#[cfg_attr(estimator_compact, inline(never))]
 #[cfg_attr(not(estimator_compact), allow(dead_code))] // tests only, unless built for size
 pub(crate) fn cholesky_inverse<T: Real, const C: usize>(
     a: &SMatrix<T, C, C>,

@@ -164,8 +164,22 @@ pub(crate) fn blk_rc<T: Real, const R: usize, const C: usize>(
 }
 
 /// Writes block `(i, j)` of an `R × C` matrix, column piece by column piece (nothing outside
-/// the matrix).
-#[cfg_attr(estimator_compact, inline(never))]
+/// the matrix). Built for size, through one out-of-line copy over the storage
+/// ([`set_blk_rows`]) for every shape.
+#[cfg(estimator_compact)]
+#[inline(always)]
+pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
+    m: &mut SMatrix<T, R, C>,
+    i: usize,
+    j: usize,
+    v: &Matrix3<T>,
+) {
+    set_blk_rows(m.as_mut_slice(), R, i, j, v);
+}
+
+/// Writes block `(i, j)` of an `R × C` matrix (see the build for size above); at opt-level 2
+/// or 3 specialised for each shape, with which the prediction's instruction counts are budgeted.
+#[cfg(not(estimator_compact))]
 pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
     m: &mut SMatrix<T, R, C>,
     i: usize,
@@ -178,6 +192,24 @@ pub(crate) fn set_blk_rc<T: Real, const R: usize, const C: usize>(
     for (c, src) in v.as_slice().chunks_exact(3).enumerate() {
         let s = R * (3 * j + c) + 3 * i;
         if let Some(dst) = m.as_mut_slice().get_mut(s..s + 3) {
+            for (d, x) in dst.iter_mut().zip(src) {
+                *d = *x;
+            }
+        }
+    }
+}
+
+/// [`set_blk_rc`] on the column-major storage `m` of a matrix with `rows` rows (the same
+/// stores).
+#[cfg(estimator_compact)]
+#[inline(never)]
+fn set_blk_rows<T: Real>(m: &mut [T], rows: usize, i: usize, j: usize, v: &Matrix3<T>) {
+    if 3 * i + 3 > rows {
+        return;
+    }
+    for (c, src) in v.as_slice().chunks_exact(3).enumerate() {
+        let s = rows * (3 * j + c) + 3 * i;
+        if let Some(dst) = m.get_mut(s..s + 3) {
             for (d, x) in dst.iter_mut().zip(src) {
                 *d = *x;
             }

@@ -97,13 +97,14 @@
 //!
 //! `size_of::<Ins<f32>>()` is 996 bytes (state 64, `P` as a full 15 × 15 `f32` 900, configuration
 //! 32); `Ahrs<f32>` is 204 bytes. No scratch space is stored. Each update runs in non-inlined
-//! phases (linearize, gain, iterate, commit) sharing one small working set, so no `N × N`
-//! temporary exists during an update. The update is compiled once per scalar type and filter,
-//! not once per measurement model: every model with up to three rows goes through one shared
-//! core (`&dyn`, padded to three rows; see `update.rs`), so adding models costs only their own
-//! `linearize`. Measured on a Cortex-M4F (f32, opt-level 3, painted stack): 976 bytes for the
-//! 15-state predict, 1,516 bytes for a GNSS or magnetometer update, 1,112 for an AHRS update
-//! (`firmware/README.md`).
+//! phases (linearize, gain, iterate, commit) sharing one small working set (sized for 15
+//! states in both filters), so no `N × N` temporary exists during an update. The update is
+//! compiled once per scalar type and filter, not once per measurement model: every model with up
+//! to three rows goes through one shared core (`&dyn`, padded to three rows; see `update.rs`),
+//! so adding models costs only their own `linearize`; built for size, the steps that do not
+//! touch the state (gain, gate, Gauss-Newton step, covariance) are one copy for both filters.
+//! Peak stack measured on a Cortex-M4F (f32, opt-level 3, painted): 984 bytes for the 15-state
+//! predict, 1,608 bytes for a GNSS or magnetometer update, 1,700 for an AHRS update.
 //!
 //! # Edges
 //!

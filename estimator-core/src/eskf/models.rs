@@ -38,6 +38,19 @@ fn jacobian<T: Real, const M: usize, const N: usize>(
     h
 }
 
+/// The linearization of a three-row model that sees only the attitude, from its residual and
+/// attitude block: one copy per filter shared by the direction models ([`Magnetometer`],
+/// [`GravityDirection`]).
+fn attitude_only<T: Real, const N: usize>(
+    parts: Result<(Vector3<T>, Matrix3<T>), EskfError>,
+) -> Result<Linearization<T, N, 3>, EskfError> {
+    let (residual, h_att) = parts?;
+    Ok(Linearization {
+        residual,
+        jacobian: jacobian(&[(0, h_att)]),
+    })
+}
+
 /// Sets the identity block in columns `col..col + 3` of `h` (the models that observe a vector
 /// state directly).
 fn set_identity<T: Real, const N: usize>(h: &mut SMatrix<T, 3, N>, col: usize) {
@@ -290,11 +303,7 @@ impl<T: Real> Magnetometer<T> {
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for Magnetometer<T> {
     #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
-        let (residual, h_att) = self.attitude_parts(x.attitude())?;
-        Ok(Linearization {
-            residual,
-            jacobian: jacobian(&[(0, h_att)]),
-        })
+        attitude_only(self.attitude_parts(x.attitude()))
     }
     fn noise(&self) -> Matrix3<T> {
         self.noise
@@ -348,11 +357,7 @@ impl<T: Real> GravityDirection<T> {
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for GravityDirection<T> {
     #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
-        let (residual, h_att) = self.attitude_parts(x.attitude())?;
-        Ok(Linearization {
-            residual,
-            jacobian: jacobian(&[(0, h_att)]),
-        })
+        attitude_only(self.attitude_parts(x.attitude()))
     }
     fn noise(&self) -> Matrix3<T> {
         self.noise

@@ -472,11 +472,11 @@ fn symmetrize_is_nalgebras() {
     symmetrize_case::<f64, 4>(191);
 }
 
-/// `spd_packed` (the packed rows as slices) against the former indexing of the packed lower
-/// triangle, on symmetric positive definite, indefinite, nearly singular, asymmetric and
-/// non-finite `n × n` matrices.
-fn spd_packed_case<T: Real, const N: usize>(seed: u64) {
-    use super::update::spd_packed;
+/// `check_spd` (the symmetry test, then `factor_lower` on a full copy) against the former
+/// recurrence on the packed lower triangle, on symmetric positive definite, indefinite, nearly
+/// singular, asymmetric and non-finite `n × n` matrices.
+fn check_spd_case<T: Real, const N: usize>(seed: u64) {
+    use super::update::check_spd;
     use nalgebra::SMatrix;
     fn old<T: Real>(a: &[T], n: usize) -> bool {
         let get = |s: &[T], idx: usize| s.get(idx).copied().unwrap_or_else(T::zero);
@@ -528,7 +528,7 @@ fn spd_packed_case<T: Real, const N: usize>(seed: u64) {
                 *e = -*e;
             }
         }
-        let new = spd_packed(a.as_slice(), N);
+        let new = check_spd(&a);
         assert_eq!(new, old(a.as_slice(), N));
         accepted += usize::from(new);
     }
@@ -536,12 +536,12 @@ fn spd_packed_case<T: Real, const N: usize>(seed: u64) {
 }
 
 #[test]
-fn spd_packed_is_the_former_recurrence() {
-    spd_packed_case::<f32, 3>(193);
-    spd_packed_case::<f32, 6>(197);
-    spd_packed_case::<f32, 15>(199);
-    spd_packed_case::<f64, 15>(211);
-    spd_packed_case::<f64, 1>(223);
+fn check_spd_is_the_former_recurrence() {
+    check_spd_case::<f32, 3>(193);
+    check_spd_case::<f32, 6>(197);
+    check_spd_case::<f32, 15>(199);
+    check_spd_case::<f64, 15>(211);
+    check_spd_case::<f64, 1>(223);
 }
 
 /// `imu::sigmas` against `diagonal().map(|d| d.max(0).sqrt())`, the former `sigmas()` body.

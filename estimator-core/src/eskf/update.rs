@@ -8,7 +8,7 @@ use super::state::ErrorState;
 use crate::lie::{LieGroup, So3};
 use crate::scalar::positive_finite;
 use crate::Real;
-use nalgebra::{Cholesky, Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 /// A measurement linearized at a state: the residual `r = z ⊖ h(x)` (for a vector measurement
 /// `z − h(x)`; angles wrapped) and `H = ∂h(x ⊕ δx)/∂δx` at `δx = 0` (seed eq. 4.3 / Def. 4.6).
@@ -90,58 +90,50 @@ pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
     Ok(())
 }
 
-/// Checks that `A` is finite, symmetric (to `1e-6` of its largest entry) and positive definite,
-/// by an in-place Cholesky factorization of one packed copy (no other `N × N` temporary).
+/// Checks that `A` is finite, symmetric (to `1e-6` of its largest entry) and positive definite:
+/// the symmetry test, then the Cholesky factorization ([`factor_lower`]) of a copy.
 pub(crate) fn check_spd<T: Real, const M: usize>(r: &SMatrix<T, M, M>) -> bool {
-    if M <= PACKED_MAX_DIM {
-        spd_packed(r.as_slice(), M)
-    } else {
-        finite_symmetric(r.as_slice(), M) && Cholesky::new(*r).is_some()
-    }
+    let mut l = *r;
+    finite_symmetric(r.as_slice(), M) && factor_lower(l.as_mut_slice(), M)
 }
 
 /// The largest error state (`Ins`, 15): the size of the fixed buffers of the shared update
 /// steps ([`commit_shared`]).
 const MAX_STATE: usize = 15;
 
-/// Largest dimension whose Cholesky test uses the packed lower triangle: every covariance of
-/// a filter.
-const PACKED_MAX_DIM: usize = MAX_STATE;
-
-/// [`check_spd`] on the column-major storage `a` of an `n × n` matrix (`n ≤ 15`): the
-/// symmetry test, then the Cholesky recurrence `L_ij = (A_ij − Σ_k<j L_ik L_jk) / L_jj`,
-/// `L_jj = √(A_jj − Σ_k<j L_jk²) > 0`, storing only the lower triangle of `L` (packed row by
-/// row: `(i, j) ↦ i(i+1)/2 + j`), 480 bytes for `f32` instead of a full copy. Not generic over
-/// the size: one copy of this code serves every matrix.
+/// `A = L Lᵀ` in place on the column-major storage `l` of an `n × n` matrix, operation for
+/// operation as `nalgebra::Cholesky::new` (the same bits, failing exactly when it fails): column
+/// by column, `a_ij ← (−l_jk) l_ik + a_ij` for `k < j ≤ i`, then `l_jj = √a_jj`, refused unless
+/// `a_jj > 0` (zero, negative or NaN), and `l_ij = a_ij / l_jj` (`i > j`). Only the lower
+/// triangle is read or written. Not generic over the size: one copy of this code serves the
+/// covariance and noise checks and the innovation's inverse.
 #[inline(never)]
-pub(crate) fn spd_packed<T: Real>(a: &[T], n: usize) -> bool {
-    if !finite_symmetric(a, n) {
-        return false;
-    }
-    let mut l = [T::zero(); PACKED_MAX_DIM * (PACKED_MAX_DIM + 1) / 2];
-    for i in 0..n {
-        let ri = i * (i + 1) / 2;
-        for j in 0..=i {
-            let rj = j * (j + 1) / 2;
-            let mut s = at(a, j * n + i);
-            // Σ_k<j L_ik L_jk over the packed rows i and j, k ascending.
-            if let (Some(li), Some(lj)) = (l.get(ri..ri + j), l.get(rj..rj + j)) {
-                for (x, y) in li.iter().zip(lj) {
-                    s -= *x * *y;
-                }
+pub(crate) fn factor_lower<T: Real>(l: &mut [T], n: usize) -> bool {
+    for j in 0..n {
+        // The columns before j, and rows j.. of column j (`col_j[0]` is the diagonal entry).
+        let Some((before, rest)) = l.split_at_mut_checked(j * n) else {
+            return false;
+        };
+        let Some(col_j) = rest.get_mut(j..n) else {
+            return false;
+        };
+        for col_k in before.chunks_exact(n) {
+            let col_k = col_k.get(j..).unwrap_or_default();
+            let f = -at(col_k, 0);
+            for (e, x) in col_j.iter_mut().zip(col_k) {
+                *e = f * *x + *e;
             }
-            let v = if i == j {
-                if !greater(s, T::zero()) {
-                    return false;
-                }
-                s.sqrt()
-            } else {
-                s / at(&l, rj + j)
-            };
-            match l.get_mut(ri + j) {
-                Some(e) => *e = v,
-                None => return false,
-            }
+        }
+        let Some((diagonal, below)) = col_j.split_first_mut() else {
+            return false;
+        };
+        if !greater(*diagonal, T::zero()) {
+            return false;
+        }
+        let d = diagonal.sqrt();
+        *diagonal = d;
+        for e in below {
+            *e /= d;
         }
     }
     true
@@ -191,12 +183,13 @@ pub(crate) const CORE_ROWS: usize = 3;
 /// The core takes `&dyn Rows<T, S, N, C>`, so it is compiled once per `(T, S, N, C)`, not once per
 /// model; only [`Padded::linearize_rows`] (the model's own `linearize` and a copy) is per model.
 trait Rows<T: Real, S, const N: usize, const C: usize> {
-    /// Linearizes at `x` into `ht = Hᵀ` (`N × C`; column `c` is row `c` of `H`, so that each row
-    /// of `H` is contiguous) and `r`; the columns and rows past `M` are zero.
+    /// Linearizes at `x` into `ht = Hᵀ` (`N × C`, column-major in the first `N·C` entries of the
+    /// storage; column `c` is row `c` of `H`, so that each row of `H` is contiguous) and `r`;
+    /// the columns and rows past `M` are zero, and so is the rest of the storage.
     fn linearize_rows(
         &self,
         x: &S,
-        ht: &mut SMatrix<T, N, C>,
+        ht: &mut SMatrix<T, MAX_STATE, C>,
         r: &mut SVector<T, C>,
     ) -> Result<(), EskfError>;
 }
@@ -213,7 +206,7 @@ where
     fn linearize_rows(
         &self,
         x: &S,
-        ht: &mut SMatrix<T, N, C>,
+        ht: &mut SMatrix<T, MAX_STATE, C>,
         r: &mut SVector<T, C>,
     ) -> Result<(), EskfError> {
         // Borrowed inside the `Result`, not moved out of it: one copy of the linearization on
@@ -255,14 +248,6 @@ pub(crate) fn rows_into<T: Real>(h: &[T], r_in: &[T], ht: &mut [T], r: &mut [T])
     }
 }
 
-/// `R` (`M × M`) padded to `C × C` with the identity.
-#[cfg_attr(estimator_compact, inline(never))]
-fn pad_noise<T: Real, const M: usize, const C: usize>(r: &SMatrix<T, M, M>) -> SMatrix<T, C, C> {
-    let mut out = SMatrix::<T, C, C>::identity();
-    pad_into(r.as_slice(), M, out.as_mut_slice(), C);
-    out
-}
-
 /// Copies the column-major `m × m` matrix `src` into the top-left of the column-major `c × c`
 /// matrix `dst` (one copy of this code for every size).
 fn pad_into<T: Real>(src: &[T], m: usize, dst: &mut [T], c: usize) {
@@ -276,26 +261,47 @@ fn pad_into<T: Real>(src: &[T], m: usize, dst: &mut [T], c: usize) {
 }
 
 /// The working set of one update, kept in one place on the caller's stack and filled in place
-/// by the phases below (each phase is a separate, non-inlined function, so their frames do not
-/// add up: the peak stack stays small on a Cortex-M). Columns (of `N × C` matrices) and rows
-/// past `m` are zero.
-struct Work<T: Real, const N: usize, const C: usize> {
+/// by the phases below (the phases with large temporaries are separate, non-inlined functions,
+/// so their frames do not add up: the peak stack stays small on a Cortex-M). Its type does not depend on the filter:
+/// an `n × C` matrix (`n` the error-state dimension, 15 or 6) is stored column-major in the
+/// first `n·C` entries of a `MAX_STATE × C` array (column `c` at `c·n .. c·n + n`), the rest
+/// zero, so that the steps that do not touch the state are one compiled copy for both filters.
+/// Columns and rows past `m` are zero.
+struct Work<T: Real, const C: usize> {
     /// `H̃ᵀ` at the current iterate.
-    ht: SMatrix<T, N, C>,
+    ht: SMatrix<T, MAX_STATE, C>,
     /// Residual `r = z ⊖ h(x̂ ⊕ δx)` at the current iterate.
     r: SVector<T, C>,
     /// `U = P H̃ᵀ`.
-    u: SMatrix<T, N, C>,
+    u: SMatrix<T, MAX_STATE, C>,
     /// `S = H̃ P H̃ᵀ + R` (identity past `m`).
     s: SMatrix<T, C, C>,
     /// `K = U S⁻¹`.
-    k: SMatrix<T, N, C>,
+    k: SMatrix<T, MAX_STATE, C>,
     /// `S⁻¹` (for the NIS at the prior).
     s_inv: SMatrix<T, C, C>,
-    /// The current correction `δx`.
-    dx: SVector<T, N>,
+    /// The current correction `δx` (the first `n` entries; the rest zero).
+    dx: SVector<T, MAX_STATE>,
+    /// `R` padded to `C × C` with the identity.
+    noise: SMatrix<T, C, C>,
     /// The number of active rows, `M`.
     m: usize,
+}
+
+/// The first `len` entries of `s` (all of `s` if shorter; no caller asks for more).
+#[inline(always)]
+fn head<T>(s: &[T], len: usize) -> &[T] {
+    s.get(..len).unwrap_or(s)
+}
+
+/// The first `N` entries of `s` as the state's error vector (zero past the end of `s`).
+#[inline(always)]
+fn error_vector<T: Real, const N: usize>(s: &[T]) -> SVector<T, N> {
+    let mut v = SVector::<T, N>::zeros();
+    for (d, e) in v.as_mut_slice().iter_mut().zip(s) {
+        *d = *e;
+    }
+    v
 }
 
 /// The generic update on `(x, P)`; `x` and `P` are written only when the result is `Accepted`.
@@ -313,8 +319,8 @@ struct Work<T: Real, const N: usize, const C: usize> {
 /// 4. Inject `x⁺ = x̂ ⊕ δx` (seed eq. 4.5) and reset `P ← G P Gᵀ`,
 ///    `G = blockdiag(J_r(δθ), I)` (the new error `e⁺ = log(exp(δθ)⁻¹ exp(e)) ≈ J_r(δθ)(e − δθ)`).
 ///
-/// This wrapper is the only per-model code: it pads the model to the core's row capacity
-/// ([`CORE_ROWS`]) and calls the shared core.
+/// This wrapper is the only per-model code: it picks the core's row capacity ([`CORE_ROWS`])
+/// and calls the core, which pads the model's rows and noise to it.
 pub(crate) fn update<T, S, Mo, const N: usize, const M: usize>(
     x: &mut S,
     p: &mut SMatrix<T, N, N>,
@@ -327,21 +333,24 @@ where
     Mo: Measurement<T, S, N, M>,
 {
     let rows = Padded::<Mo, M>(model);
+    let noise = model.noise();
     if M <= CORE_ROWS {
-        let noise = pad_noise::<T, M, CORE_ROWS>(&model.noise());
-        update_core::<T, S, N, CORE_ROWS>(x, p, &rows, &noise, M, opts)
+        update_core::<T, S, N, CORE_ROWS>(x, p, &rows, noise.as_slice(), M, opts)
     } else {
-        update_core::<T, S, N, M>(x, p, &rows, &model.noise(), M, opts)
+        update_core::<T, S, N, M>(x, p, &rows, noise.as_slice(), M, opts)
     }
 }
 
-/// Steps 1–4 for a model seen through `C` rows, `m` of them active (see [`update`]).
+/// Steps 1–4 for a model seen through `C` rows, `m` of them active (see [`update`]). Only the
+/// parts that touch the state (`h`, `⊕`) are here, per filter; the rest are the shared steps
+/// ([`start`], [`gate_step`], [`step_shared`], [`commit_shared`]), built for size one copy for
+/// both filters (at opt-level 2 or 3 inlined, where `n = N` is a constant).
 #[inline(never)]
 fn update_core<T, S, const N: usize, const C: usize>(
     x: &mut S,
     p: &mut SMatrix<T, N, N>,
     model: &dyn Rows<T, S, N, C>,
-    r_noise: &SMatrix<T, C, C>,
+    noise: &[T],
     m: usize,
     opts: &UpdateOptions<T>,
 ) -> Result<UpdateOutcome<T>, EskfError>
@@ -349,17 +358,6 @@ where
     T: Real,
     S: ErrorState<T, N>,
 {
-    if opts.max_iterations == 0 || !opts.step_tolerance.is_finite() {
-        return Err(EskfError::InvalidOption);
-    }
-    if let Gate::Threshold(t) = opts.gate {
-        if !(t.is_finite() || t > T::zero()) {
-            return Err(EskfError::InvalidOption);
-        }
-    }
-    if !check_spd(r_noise) {
-        return Err(EskfError::NoiseNotPositiveDefinite);
-    }
     let mut w = Work {
         ht: SMatrix::zeros(),
         r: SVector::zeros(),
@@ -368,10 +366,54 @@ where
         k: SMatrix::zeros(),
         s_inv: SMatrix::zeros(),
         dx: SVector::zeros(),
+        noise: SMatrix::identity(),
         m,
     };
+    start(opts, noise, &mut w)?;
     linearize_into(model, x, &mut w, true)?;
-    gain_into(p, r_noise, &mut w)?;
+    let nis = match gate_step(p.as_slice(), N, m, opts, &mut w)? {
+        UpdateOutcome::Accepted { nis, .. } => nis,
+        rejected => return Ok(rejected),
+    };
+    let iterations = iterate(x, p, model, opts, &mut w);
+    commit(x, p, &mut w)?;
+    Ok(UpdateOutcome::Accepted { nis, iterations })
+}
+
+/// The checks before any work: the options, and `R` (`noise`, `m × m` column-major, padded
+/// into `w.noise`) symmetric positive definite.
+fn start<T: Real, const C: usize>(
+    opts: &UpdateOptions<T>,
+    noise: &[T],
+    w: &mut Work<T, C>,
+) -> Result<(), EskfError> {
+    if opts.max_iterations == 0 || !opts.step_tolerance.is_finite() {
+        return Err(EskfError::InvalidOption);
+    }
+    if let Gate::Threshold(t) = opts.gate {
+        if !(t.is_finite() || t > T::zero()) {
+            return Err(EskfError::InvalidOption);
+        }
+    }
+    pad_into(noise, w.m, w.noise.as_mut_slice(), C);
+    if !check_spd(&w.noise) {
+        return Err(EskfError::NoiseNotPositiveDefinite);
+    }
+    Ok(())
+}
+
+/// The gain at the prior, the NIS and the gate (`m` = `w.m`, the argument lets the compiler
+/// see its range), then `δx₁ = K₀ r₀` into `w.dx`. Returns
+/// `Rejected`, or `Accepted` with the NIS (its iteration count is set by the caller).
+#[cfg_attr(not(estimator_compact), inline(always))]
+fn gate_step<T: Real, const C: usize>(
+    p: &[T],
+    n: usize,
+    m: usize,
+    opts: &UpdateOptions<T>,
+    w: &mut Work<T, C>,
+) -> Result<UpdateOutcome<T>, EskfError> {
+    gain_into(p, n, w)?;
     let nis = nis(&w.s_inv, &w.r);
     if !nis.is_finite() {
         return Err(EskfError::SingularInnovation);
@@ -380,16 +422,17 @@ where
     if nis > threshold {
         return Ok(UpdateOutcome::Rejected { nis, threshold });
     }
-    mat_vec(w.k.as_slice(), w.r.as_slice(), w.dx.as_mut_slice());
-    let iterations = iterate(x, p, model, opts, r_noise, &mut w);
-    commit(x, p, &mut w)?;
-    Ok(UpdateOutcome::Accepted { nis, iterations })
+    mat_vec(
+        w.k.as_slice(),
+        w.r.as_slice(),
+        w.dx.as_mut_slice().get_mut(..n).unwrap_or_default(),
+    );
+    Ok(UpdateOutcome::Accepted { nis, iterations: 1 })
 }
 
 /// `NIS = rᵀ S⁻¹ r` with the `S⁻¹` already formed for `K`, and an explicit sum:
 /// `Cholesky::solve` (dynamic-range `dot`s) and `dot` keep shape asserts, panic paths at
 /// opt-level "s". Generic over the row capacity only: one copy for both filters.
-#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn nis<T: Real, const C: usize>(s_inv: &SMatrix<T, C, C>, r: &SVector<T, C>) -> T {
     let mut y = SVector::<T, C>::zeros();
     mat_vec(s_inv.as_slice(), r.as_slice(), y.as_mut_slice());
@@ -403,7 +446,6 @@ pub(crate) fn nis<T: Real, const C: usize>(s_inv: &SMatrix<T, C, C>, r: &SVector
 /// nalgebra's product (`gemv`): `out_i = a_i0 x_0`, then `out_i = a_ij x_j + out_i` for
 /// `j = 1, 2, …` (no leading zero term). Not generic over the sizes: one copy for `K r` in
 /// both filters and for the NIS.
-#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn mat_vec<T: Real>(a: &[T], x: &[T], out: &mut [T]) {
     for (j, (col, xj)) in a.chunks_exact(out.len().max(1)).zip(x).enumerate() {
         for (o, e) in out.iter_mut().zip(col) {
@@ -415,11 +457,15 @@ pub(crate) fn mat_vec<T: Real>(a: &[T], x: &[T], out: &mut [T]) {
 /// Linearizes at `x̂ ⊕ δx` (`δx` = `w.dx`) into `w.ht`, `w.r`, with the chart Jacobian
 /// `H̃ = H · blockdiag(J_r(δθ), I)` (the Jacobian of `h(x̂ ⊕ δx)` in `δx`, so that the iterated
 /// update is Gauss-Newton in the chart at the prior `x̂`; `J_r(0) = I`).
-#[inline(never)]
+///
+/// Built for size, inlined into [`update_core`] (as is [`iterate`]): one function per filter
+/// instead of three, and this frame is on the update's deepest path either way.
+#[cfg_attr(estimator_compact, inline(always))]
+#[cfg_attr(not(estimator_compact), inline(never))]
 fn linearize_into<T, S, const N: usize, const C: usize>(
     model: &dyn Rows<T, S, N, C>,
     x: &S,
-    w: &mut Work<T, N, C>,
+    w: &mut Work<T, C>,
     first: bool,
 ) -> Result<(), EskfError>
 where
@@ -429,13 +475,29 @@ where
     if first {
         model.linearize_rows(x, &mut w.ht, &mut w.r)?;
     } else {
-        model.linearize_rows(&x.oplus(&w.dx), &mut w.ht, &mut w.r)?;
+        let dx = error_vector::<T, N>(w.dx.as_slice());
+        model.linearize_rows(&x.oplus(&dx), &mut w.ht, &mut w.r)?;
     }
+    check_rows(N, w, first)
+}
+
+/// The rows just linearized: finite (else `NonFinite`), and after the first linearization
+/// turned into the chart Jacobian ([`chart_jacobian`]).
+#[cfg_attr(not(estimator_compact), inline(always))]
+fn check_rows<T: Real, const C: usize>(
+    n: usize,
+    w: &mut Work<T, C>,
+    first: bool,
+) -> Result<(), EskfError> {
     if !(finite_vec(&w.r) && finite_vec(&w.ht)) {
         return Err(EskfError::NonFinite);
     }
     if !first {
-        chart_jacobian(w.dx.as_slice(), w.ht.as_mut_slice());
+        let ht = w.ht.as_mut_slice();
+        chart_jacobian(
+            head(w.dx.as_slice(), n),
+            ht.get_mut(..n * C).unwrap_or_default(),
+        );
     }
     Ok(())
 }
@@ -445,7 +507,6 @@ where
 /// `J_rᵀ h` ([`mv`](super::imu::mv), the sums of nalgebra's `J_rᵀ · Hᵀ[0..3, ..]`), over every
 /// column (the zero padding too, as that product did). Not generic over the sizes: one copy
 /// for both filters.
-#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn chart_jacobian<T: Real>(dx: &[T], ht: &mut [T]) {
     let dth = Vector3::new(at(dx, 0), at(dx, 1), at(dx, 2));
     let jrt = super::imu::tr33(&So3::right_jacobian(&dth));
@@ -460,45 +521,33 @@ pub(crate) fn chart_jacobian<T: Real>(dx: &[T], ht: &mut [T]) {
     }
 }
 
-/// `U = P H̃ᵀ`, `S = H̃ U + R`, `S⁻¹`, `K = U S⁻¹` into `w`. The per-size entry of
-/// [`gain_shared`] (see [`commit`] for the two builds).
-#[cfg_attr(estimator_compact, inline(always))]
-#[cfg_attr(not(estimator_compact), inline(never))]
-fn gain_into<T: Real, const N: usize, const C: usize>(
-    p: &SMatrix<T, N, N>,
-    r_noise: &SMatrix<T, C, C>,
-    w: &mut Work<T, N, C>,
+/// `U = P H̃ᵀ`, `S = H̃ U + R`, `S⁻¹`, `K = U S⁻¹` into `w`, for the `n × n` covariance `p`
+/// (column-major), over the `n × C` matrices of the working set (column `c` is entries
+/// `c·n .. c·n + n`), for the `m` active columns only.
+#[inline(always)]
+fn gain_into<T: Real, const C: usize>(
+    p: &[T],
+    n: usize,
+    w: &mut Work<T, C>,
 ) -> Result<(), EskfError> {
-    gain_shared(
-        p.as_slice(),
-        N,
-        w.m,
-        r_noise,
-        w.ht.as_slice(),
+    gain_shared(p, n, w)
+}
+
+/// The body of [`gain_into`]: one out-of-line copy built for size, inlined at opt-level 2 or 3.
+#[cfg_attr(estimator_compact, inline(never))]
+#[cfg_attr(not(estimator_compact), inline(always))]
+fn gain_shared<T: Real, const C: usize>(
+    p: &[T],
+    n: usize,
+    w: &mut Work<T, C>,
+) -> Result<(), EskfError> {
+    let (m, r_noise, ht) = (w.m, &w.noise, w.ht.as_slice());
+    let (u, s, s_inv_out, k) = (
         w.u.as_mut_slice(),
         &mut w.s,
         &mut w.s_inv,
         w.k.as_mut_slice(),
-    )
-}
-
-/// [`gain_into`] on the column-major storage of an `n × n` covariance `p` and of the `n × C`
-/// matrices `ht`, `u`, `k` (column `c` is entries `c·n .. c·n + n`), for the `m` active
-/// columns only.
-#[cfg_attr(estimator_compact, inline(never))]
-#[cfg_attr(not(estimator_compact), inline(always))]
-#[allow(clippy::too_many_arguments)] // the working set, lent field by field
-fn gain_shared<T: Real, const C: usize>(
-    p: &[T],
-    n: usize,
-    m: usize,
-    r_noise: &SMatrix<T, C, C>,
-    ht: &[T],
-    u: &mut [T],
-    s: &mut SMatrix<T, C, C>,
-    s_inv_out: &mut SMatrix<T, C, C>,
-    k: &mut [T],
-) -> Result<(), EskfError> {
+    );
     // Column c of U = Σ_j P e_j H_cj over the nonzero entries of row c of H only (most models
     // touch 3–6 of the 15 error components).
     u.fill(T::zero());
@@ -533,7 +582,7 @@ fn gain_shared<T: Real, const C: usize>(
     }
     #[cfg(not(estimator_compact))]
     {
-        *s_inv_out = Cholesky::new(*s)
+        *s_inv_out = nalgebra::Cholesky::new(*s)
             .ok_or(EskfError::SingularInnovation)?
             .inverse();
     }
@@ -567,65 +616,22 @@ pub(crate) fn symmetrize<T: Real, const C: usize>(s: &mut SMatrix<T, C, C>) {
 }
 
 /// `A⁻¹` by `nalgebra::Cholesky::new(A)?.inverse()`, operation for operation (the same bits;
-/// `None` exactly when nalgebra's factorization fails), in plain loops over the column arrays
-/// instead of nalgebra's run-time-sized views: nalgebra's order of operations is the factor
-/// column by column, `a_ij ← (−l_jk) l_ik + a_ij` for `k < j ≤ i`, then `l_jj = √a_jj` (failing
-/// for a zero, negative or NaN `a_jj`) and `l_ij = a_ij / l_jj` (`i > j`; the strict upper
-/// triangle keeps `A`); then, per column `b` of the identity, the forward solve
-/// `b_i ← b_i / l_ii`, `b_k ← (−b_i) l_ki + b_k` (`k > i`) and the backward solve
-/// `b_i ← (b_i − (0 + Σ_{k>i} l_ki b_k)) / l_ii` (`i` descending).
-#[cfg_attr(estimator_compact, inline(never))]
+/// `None` exactly when nalgebra's factorization fails), over the column arrays instead of
+/// nalgebra's run-time-sized views: the factor by [`factor_lower`], then, per column `b` of the
+/// identity, the forward solve `b_i ← b_i / l_ii`, `b_k ← (−b_i) l_ki + b_k` (`k > i`) and the
+/// backward solve `b_i ← (b_i − (0 + Σ_{k>i} l_ki b_k)) / l_ii` (`i` descending): the
+/// substitution the solver's factor uses (`gn::linalg::substitute`), one copy for both.
 #[cfg_attr(not(estimator_compact), allow(dead_code))] // tests only, unless built for size
 pub(crate) fn cholesky_inverse<T: Real, const C: usize>(
     a: &SMatrix<T, C, C>,
 ) -> Option<SMatrix<T, C, C>> {
     let mut l = *a;
-    let l = l.as_mut_slice();
-    for j in 0..C {
-        for k in 0..j {
-            let f = -at(l, k * C + j);
-            for i in j..C {
-                let x = at(l, k * C + i);
-                if let Some(e) = l.get_mut(j * C + i) {
-                    *e = f * x + *e;
-                }
-            }
-        }
-        let d = at(l, j * C + j);
-        if d == T::zero() {
-            return None;
-        }
-        let d = d.try_sqrt()?;
-        for i in j..C {
-            if let Some(e) = l.get_mut(j * C + i) {
-                *e = if i == j { d } else { *e / d };
-            }
-        }
+    if !factor_lower(l.as_mut_slice(), C) {
+        return None;
     }
-    let l: &[T] = l;
     let mut inv = SMatrix::<T, C, C>::identity();
     for b in inv.as_mut_slice().chunks_exact_mut(C.max(1)) {
-        for i in 0..C {
-            let coeff = at(b, i) / at(l, i * C + i);
-            if let Some(e) = b.get_mut(i) {
-                *e = coeff;
-            }
-            for k in i + 1..C {
-                let x = at(l, i * C + k);
-                if let Some(e) = b.get_mut(k) {
-                    *e = -coeff * x + *e;
-                }
-            }
-        }
-        for i in (0..C).rev() {
-            let mut dot = T::zero();
-            for k in i + 1..C {
-                dot += at(l, i * C + k) * at(b, k);
-            }
-            if let Some(e) = b.get_mut(i) {
-                *e = (*e - dot) / at(l, i * C + i);
-            }
-        }
+        crate::gn::linalg::substitute(l.as_slice(), C, b);
     }
     Some(inv)
 }
@@ -634,7 +640,6 @@ pub(crate) fn cholesky_inverse<T: Real, const C: usize>(
 /// storage of the `n × C` matrices `ht` (`H̃ᵀ`) and `k` (`K`), `n = prev.len()`: `y = r`,
 /// `y_c += (row c of H̃)·prev`, then `next = Σ_c y_c k_c` from zero. Generic over the row
 /// capacity only: one copy for both filters.
-#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn gauss_newton_step<T: Real, const C: usize>(
     ht: &[T],
     k: &[T],
@@ -665,7 +670,6 @@ fn axpy<T: Real>(y: &mut [T], a: T, x: &[T]) {
 
 /// `‖a − b‖` over two equally long slices: `√(a − b)·(a − b)`, the differences then [`dot`]'s
 /// sum. Not generic over the length: one copy for both filters.
-#[cfg_attr(estimator_compact, inline(never))]
 pub(crate) fn distance<T: Real>(a: &[T], b: &[T]) -> T {
     a.iter()
         .zip(b)
@@ -686,14 +690,14 @@ fn dot<T: Real>(a: &[T], b: &[T]) -> T {
 /// The Gauss-Newton iterations (step 2 after the first): at `x̂ ⊕ δx_k`,
 /// `δx_{k+1} = K_k (r_k + H̃_k δx_k)`. A failure to re-linearize stops at the last good iterate
 /// (whose `K`, `U`, `S` are restored). Returns the number of linearizations used.
-#[inline(never)]
+#[cfg_attr(estimator_compact, inline(always))]
+#[cfg_attr(not(estimator_compact), inline(never))]
 fn iterate<T, S, const N: usize, const C: usize>(
     x: &S,
     p: &SMatrix<T, N, N>,
     model: &dyn Rows<T, S, N, C>,
     opts: &UpdateOptions<T>,
-    r_noise: &SMatrix<T, C, C>,
-    w: &mut Work<T, N, C>,
+    w: &mut Work<T, C>,
 ) -> u8
 where
     T: Real,
@@ -701,32 +705,52 @@ where
 {
     let mut iterations: u8 = 1;
     while iterations < opts.max_iterations {
-        let (u, s, k, prev) = (w.u, w.s, w.k, w.dx);
-        let ok = linearize_into(model, x, w, false).is_ok() && gain_into(p, r_noise, w).is_ok();
-        // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
-        let mut next = SVector::<T, N>::zeros();
-        gauss_newton_step(
-            w.ht.as_slice(),
-            w.k.as_slice(),
-            &w.r,
-            w.m,
-            prev.as_slice(),
-            next.as_mut_slice(),
-        );
-        if !(ok && finite_vec(&next)) {
-            w.u = u;
-            w.s = s;
-            w.k = k;
-            w.dx = prev;
+        let linearized = linearize_into(model, x, w, false).is_ok();
+        let Some(converged) = step_shared(p.as_slice(), N, opts, w, linearized) else {
             break;
-        }
-        w.dx = next;
+        };
         iterations += 1;
-        if distance(next.as_slice(), prev.as_slice()) < opts.step_tolerance {
+        if converged {
             break;
         }
     }
     iterations
+}
+
+/// One Gauss-Newton step after a re-linearization (`linearized` tells whether it succeeded):
+/// the gain there, then `δx_{k+1} = K_k (r_k + H̃_k δx_k)` into `w.dx`; `None` (with `U`, `S`,
+/// `K` and `δx` as they were) when the linearization, the gain or the step failed, else whether
+/// `‖δx_{k+1} − δx_k‖ < tol`. For the `n × n` covariance `p` (column-major).
+#[cfg_attr(not(estimator_compact), inline(always))]
+fn step_shared<T: Real, const C: usize>(
+    p: &[T],
+    n: usize,
+    opts: &UpdateOptions<T>,
+    w: &mut Work<T, C>,
+    linearized: bool,
+) -> Option<bool> {
+    if !linearized {
+        return None;
+    }
+    // The linearization wrote `H̃` and `r` only; the gain overwrites these.
+    let (u, s, k) = (w.u, w.s, w.k);
+    let ok = gain_into(p, n, w).is_ok();
+    // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
+    let mut next = SVector::<T, MAX_STATE>::zeros();
+    let next = next.as_mut_slice().get_mut(..n).unwrap_or_default();
+    let prev = head(w.dx.as_slice(), n);
+    gauss_newton_step(w.ht.as_slice(), w.k.as_slice(), &w.r, w.m, prev, next);
+    if !(ok && sum_times_zero_is_zero(next)) {
+        w.u = u;
+        w.s = s;
+        w.k = k;
+        return None;
+    }
+    let converged = distance(next, prev) < opts.step_tolerance;
+    for (d, e) in w.dx.as_mut_slice().iter_mut().zip(next.iter()) {
+        *d = *e;
+    }
+    Some(converged)
 }
 
 /// Steps 3–4: Joseph-form covariance, injection and reset; writes `x` and `P` only when every
@@ -742,46 +766,35 @@ where
 fn commit<T, S, const N: usize, const C: usize>(
     x: &mut S,
     p: &mut SMatrix<T, N, N>,
-    w: &mut Work<T, N, C>,
+    w: &mut Work<T, C>,
 ) -> Result<(), EskfError>
 where
     T: Real,
     S: ErrorState<T, N>,
 {
-    let new_x = x.oplus(&w.dx);
-    commit_shared(
-        p.as_mut_slice(),
-        N,
-        w.m,
-        w.u.as_mut_slice(),
-        w.k.as_slice(),
-        &w.s,
-        w.dx.as_slice(),
-        new_x.is_finite(),
-    )?;
+    let dx = head(w.dx.as_slice(), N);
+    let new_x = x.oplus(&error_vector(dx));
+    commit_shared(p.as_mut_slice(), N, w, new_x.is_finite())?;
     *x = new_x;
     Ok(())
 }
 
-/// The covariance of steps 3–4 on the column-major storage of the `n × n` covariance `p` and
-/// the `n × C` matrices `u` (`U`, overwritten by `V`), `k` (`K`); `s` is `S`, `dx` the
-/// correction. Writes `p` only when `state_ok` and every check passes.
+/// The covariance of steps 3–4 on the column-major storage of the `n × n` covariance `p`,
+/// from the working set: the `n × C` matrices `U` (overwritten by `V`) and `K`, `S` and the
+/// correction `δx`. Writes `p` only when `state_ok` and every check passes.
 #[cfg_attr(estimator_compact, inline(never))]
 #[cfg_attr(not(estimator_compact), inline(always))]
-#[allow(clippy::too_many_arguments)] // the working set, lent field by field
 fn commit_shared<T: Real, const C: usize>(
     p: &mut [T],
     n: usize,
-    m: usize,
-    u: &mut [T],
-    k: &[T],
-    s: &SMatrix<T, C, C>,
-    dx: &[T],
+    w: &mut Work<T, C>,
     state_ok: bool,
 ) -> Result<(), EskfError> {
     if !(3..=MAX_STATE).contains(&n) {
         return Err(EskfError::NumericalFailure); // no filter has such a state
     }
+    let (m, u, k, s) = (w.m, w.u.as_mut_slice(), w.k.as_slice(), &w.s);
+    let dx = head(w.dx.as_slice(), n);
     // Joseph form, expanded and written as m symmetric rank-2 corrections:
     //   P⁺ = P − K Uᵀ − U Kᵀ + K S Kᵀ = P + V Kᵀ + K Vᵀ = P + Σ_c (v_c k_cᵀ + k_c v_cᵀ),
     //   V = ½ K S − U (columns v_c, k_c of V and K): exactly symmetric, computed in place

@@ -230,8 +230,8 @@ fn run_benchmarks(w: &scenario::Workload<f32>) {
     bench(&mut i, "sincos_f32", || {
         black_box(estimator_core::scalar::sincos_f32(black_box(x)));
     });
-    bench(&mut i, "libm_sqrtf", || {
-        black_box(libm::sqrtf(black_box(x)));
+    bench(&mut i, "sqrt_f32", || {
+        black_box(estimator_core::scalar::sqrt_f32(black_box(x)));
     });
     bench(&mut i, "atan2_f32", || {
         black_box(estimator_core::scalar::atan2_f32(

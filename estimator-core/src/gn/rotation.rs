@@ -196,6 +196,9 @@ impl<T: Real> Problem<T, So3<T>, 3, 3> for RotProblem<'_, T> {
 /// [`SolveError::NonFiniteGuess`]; [`SolveError::DegenerateGeometry`] (a zero vector, or all
 /// body or all world directions parallel); [`SolveError::NotPositiveDefinite`],
 /// [`SolveError::NonFiniteResidual`] from the solver.
+// Built for size, out of line: inlined into a large caller its loop would work in that
+// caller's stack frame, with longer addressing for every spill.
+#[cfg_attr(estimator_compact, inline(never))]
 pub fn solve_rotation_from_vectors<T: Real>(
     pairs: &[VectorPair<T>],
     guess: Option<&So3<T>>,

@@ -36,9 +36,14 @@ impl<T: Real, const N: usize> Factor<T, N> {
     /// when a diagonal entry is not positive or a relative pivot `dᵢ / Aᵢᵢ` is at or below
     /// `PIVOT_TOLERANCE_EPS · N · ε`.
     pub fn new(a: &SMatrix<T, N, N>) -> Result<Self, SolveError> {
-        let mut l = *a;
-        cholesky_in_place(l.as_mut_slice(), N)?;
-        Ok(Self { l })
+        // Factorized in the returned value (no copy of `L` into the `Result`).
+        let mut out = Ok(Self { l: *a });
+        if let Ok(f) = &mut out {
+            if let Err(e) = cholesky_in_place(f.l.as_mut_slice(), N) {
+                out = Err(e);
+            }
+        }
+        out
     }
 
     /// `A⁻¹ b` by forward and back substitution.
@@ -60,9 +65,14 @@ impl<T: Real, const N: usize> Factor<T, N> {
     /// # Errors
     /// [`SolveError::NonFiniteResidual`] if an entry is not finite.
     pub fn inverse(&self) -> Result<SMatrix<T, N, N>, SolveError> {
-        let mut x = SMatrix::zeros();
-        self.inverse_into(&mut x)?;
-        Ok(x)
+        // Written in the returned value (no copy of `A⁻¹` into the `Result`).
+        let mut out = Ok(SMatrix::zeros());
+        if let Ok(x) = &mut out {
+            if let Err(e) = self.inverse_into(x) {
+                out = Err(e);
+            }
+        }
+        out
     }
 
     /// [`Self::inverse`] written into `x`, without `N × N` temporaries (for small stacks).

@@ -105,10 +105,11 @@ where
                 "Product<A, B, NA, NB> has NA + NB degrees of freedom"
             )
         };
-        let (xa, xb) = Self::split(xi);
+        // Read where it lies (a destructuring `let` copies both parts).
+        let x = Self::split(xi);
         Self {
-            a: self.a.oplus(&xa),
-            b: self.b.oplus(&xb),
+            a: self.a.oplus(&x.0),
+            b: self.b.oplus(&x.1),
         }
     }
     #[inline]

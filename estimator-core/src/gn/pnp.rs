@@ -354,8 +354,11 @@ fn cauchy_retry<T: Real>(
         loss: Loss::Huber(k),
         ..*options
     };
-    // One buffer serves both solves: only the Huber state is kept for the second.
-    let mut c = Solution::placeholder(guess);
+    // One buffer serves both solves: only the Huber state is kept for the second. It starts as
+    // a copy of `best` with the guess as its state (solve_into overwrites the rest on success,
+    // and `c` is dropped on failure): one block copy instead of a fresh placeholder.
+    let mut c = *best.0;
+    c.state = *guess;
     if solve_into(problem, &huber, &mut c).is_err() {
         return 0;
     }

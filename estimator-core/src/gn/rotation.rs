@@ -105,9 +105,12 @@ pub(super) fn triad<T: Real>(
     w1: &Vector3<T>,
     w2: &Vector3<T>,
 ) -> Option<So3<T>> {
-    let b = triad_frame(b1, b2)?;
-    let w = triad_frame(w1, w2)?;
-    So3::from_rotation_matrix(&mul_transpose(&w, &b))
+    // Each frame read where it lies (`?` on the value would copy it out of the `Option`).
+    let b = triad_frame(b1, b2);
+    let b = b.as_ref()?;
+    let w = triad_frame(w1, w2);
+    let w = w.as_ref()?;
+    So3::from_rotation_matrix(&mul_transpose(w, b))
 }
 
 /// `w bᵀ` for 3×3 matrices as the sum of the outer products of their columns,
@@ -133,9 +136,10 @@ pub(super) fn mul_transpose<T: Real>(w: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<
 
 /// [`triad`] of the unit vectors of two pairs; `None` for a zero vector or parallel directions.
 fn triad_pairs<T: Real>(first: &VectorPair<T>, second: &VectorPair<T>) -> Option<So3<T>> {
-    let (b1, w1) = (unit(&first.body)?, unit(&first.world)?);
-    let (b2, w2) = (unit(&second.body)?, unit(&second.world)?);
-    triad(&b1, &b2, &w1, &w2)
+    // Read where they lie (`?` on the values would copy them out of the `Option`s).
+    let (b1, w1) = (unit(&first.body), unit(&first.world));
+    let (b2, w2) = (unit(&second.body), unit(&second.world));
+    triad(b1.as_ref()?, b2.as_ref()?, w1.as_ref()?, w2.as_ref()?)
 }
 
 /// The TRIAD start of [`solve_rotation_from_vectors`]: from the first pair and the pair whose body
@@ -192,6 +196,9 @@ impl<T: Real> Problem<T, So3<T>, 3, 3> for RotProblem<'_, T> {
 /// [`SolveError::NonFiniteGuess`]; [`SolveError::DegenerateGeometry`] (a zero vector, or all
 /// body or all world directions parallel); [`SolveError::NotPositiveDefinite`],
 /// [`SolveError::NonFiniteResidual`] from the solver.
+// Built for size, out of line: inlined into a large caller its loop would work in that
+// caller's stack frame, with longer addressing for every spill.
+#[cfg_attr(estimator_compact, inline(never))]
 pub fn solve_rotation_from_vectors<T: Real>(
     pairs: &[VectorPair<T>],
     guess: Option<&So3<T>>,

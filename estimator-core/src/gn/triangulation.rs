@@ -129,6 +129,9 @@ impl<T: Real> Problem<T, Vector3<T>, 3, 2> for TriProblem<'_, T> {
 /// parallax); [`SolveError::PointBehindCamera`] (the point lies at depth `≤ min_depth` in a view
 /// at the start or the solution); [`SolveError::NotPositiveDefinite`],
 /// [`SolveError::NonFiniteResidual`] from the solver.
+// Built for size, out of line: inlined into a large caller its loop would work in that
+// caller's stack frame, with longer addressing for every spill.
+#[cfg_attr(estimator_compact, inline(never))]
 pub fn triangulate<T: Real>(
     cameras_from_world: &[Se3<T>],
     pixels: &[Vector2<T>],

@@ -126,7 +126,7 @@ pub(crate) fn cholesky_in_place<T: Real>(a: &mut [T], n: usize) -> Result<(), So
         if !positive {
             return Err(SolveError::NotPositiveDefinite);
         }
-        let l_jj = d.sqrt();
+        let l_jj = d.sqrt_rn();
         let own_information = l_jj * l_jj > tol * a_jj;
         if !own_information {
             return Err(SolveError::NotPositiveDefinite);

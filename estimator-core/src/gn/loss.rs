@@ -60,7 +60,7 @@ impl<T: Real> Loss<T> {
                 if s <= k * k {
                     (s, T::one())
                 } else {
-                    let r = s.sqrt();
+                    let r = s.sqrt_rn();
                     (T::lit(2.0) * k * r - k * k, k / r)
                 }
             }

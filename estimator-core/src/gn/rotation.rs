@@ -79,7 +79,7 @@ pub(super) fn unit<T: Real>(v: &Vector3<T>) -> Option<Vector3<T>> {
 /// [`triangulate`](super::triangulate)).
 #[cfg_attr(estimator_compact, inline(never))]
 pub(super) fn normalized<T: Real>(v: &Vector3<T>) -> (Vector3<T>, T) {
-    let n = v.norm();
+    let n = v.norm_squared().sqrt_rn();
     (Vector3::new(v.x / n, v.y / n, v.z / n), n)
 }
 
@@ -89,7 +89,7 @@ pub(super) fn normalized<T: Real>(v: &Vector3<T>) -> (Vector3<T>, T) {
 #[inline(never)]
 fn triad_frame<T: Real>(u: &Vector3<T>, v: &Vector3<T>) -> Option<Matrix3<T>> {
     let n = u.cross(v);
-    let nn = n.norm();
+    let nn = n.norm_squared().sqrt_rn();
     let not_parallel = nn > T::lit(PARALLEL_REL);
     if !not_parallel {
         return None;
@@ -157,7 +157,7 @@ pub(super) fn triad_start<T: Real>(pairs: &[VectorPair<T>]) -> Result<So3<T>, So
     for p in rest {
         let b = unit(&p.body).ok_or(SolveError::DegenerateGeometry)?;
         unit(&p.world).ok_or(SolveError::DegenerateGeometry)?;
-        let s = b1.cross(&b).norm();
+        let s = b1.cross(&b).norm_squared().sqrt_rn();
         if best.is_none_or(|(sb, _)| s > sb) {
             best = Some((s, p));
         }

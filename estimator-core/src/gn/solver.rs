@@ -748,7 +748,7 @@ fn step_stats<T: Real>(a: &[T], g: &[T], step: &[T]) -> StepStats<T> {
             .fold(T::zero(), |acc, (col, &x)| acc + x * dot(col, step))
     };
     StepStats {
-        norm: dot(step, step).sqrt(),
+        norm: dot(step, step).sqrt_rn(),
         info,
         gradient: dot(step, g),
     }

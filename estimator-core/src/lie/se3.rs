@@ -44,11 +44,13 @@ fn join<T: Real>(v: &Vector3<T>, w: &Vector3<T>) -> Vector6<T> {
     Vector6::new(v.x, v.y, v.z, w.x, w.y, w.z)
 }
 
-/// `[[a, b], [0, a]]` from 3×3 blocks (the shape of every SE(3) Jacobian).
-fn upper_block<T: Real>(diag: &Matrix3<T>, upper: &Matrix3<T>) -> Matrix6<T> {
+/// `[[a, bᵀ], [0, a]]` from 3×3 blocks (the shape of every SE(3) Jacobian), the upper block given
+/// transposed: each caller builds `bᵀ` as cheaply as `b` (the adjoint's `[σt]×R` is
+/// `(Rᵀ[−σt]×)ᵀ`), so no transposed temporary is made.
+fn upper_block<T: Real>(diag: &Matrix3<T>, upper_t: &Matrix3<T>) -> Matrix6<T> {
     let mut m = Matrix6::zeros();
     m.fixed_view_mut::<3, 3>(0, 0).copy_from(diag);
-    m.fixed_view_mut::<3, 3>(0, 3).copy_from(upper);
+    m.fixed_view_mut::<3, 3>(0, 3).tr_copy_from(upper_t);
     m.fixed_view_mut::<3, 3>(3, 3).copy_from(diag);
     m
 }
@@ -173,7 +175,8 @@ impl<T: Real> Se3<T> {
     fn jr_from(k: &AngleCoeffs<T>, xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
         let w = Vector3::new(xi.w, xi.a, xi.b);
         let jr = skew_poly(T::one(), -k.b * sigma, k.c, &w);
-        upper_block(&jr, &q_block(k, xi, T::one(), -sigma))
+        // `Q(−σv, −σω)ᵀ`: the skew part's sign flipped (exact, see `q_block`).
+        upper_block(&jr, &q_block(k, xi, T::one(), sigma))
     }
 
     /// `ρ·J_r⁻¹(σξ)` for `σ, ρ = ±1`: `[[ρJ, −ρ J Q(−σv, −σω) J], [0, ρJ]]` with `J = J_r⁻¹(σω)`
@@ -182,12 +185,14 @@ impl<T: Real> Se3<T> {
     fn jr_inv_from(k: &AngleCoeffs<T>, xi: &Vector6<T>, sigma: T, rho: T) -> Matrix6<T> {
         let w = &Vector3::new(xi.w, xi.a, xi.b);
         let (half_sigma, d) = (T::lit(0.5) * sigma, k.d());
-        let jinv = skew_poly(T::one(), half_sigma, d, w);
-        let q = q_block(k, xi, -rho, rho * sigma);
+        // Transposed for `upper_block`: `((J Q) J)ᵀ = Jᵀ (Qᵀ Jᵀ)`, the same products and sums
+        // (`Jᵀ` and `Qᵀ` flip the sign of the skew parts, exactly).
+        let jinv_t = skew_poly(T::one(), -half_sigma, d, w);
+        let q_t = q_block(k, xi, -rho, -(rho * sigma));
         // `ρJ` as `skew_poly(ρ, ½σρ, ρd)`: the same numbers as `J·ρ` up to the sign of zeros
         // (see `skew_poly`), without a scaled copy of `J`.
         let diag = skew_poly(rho, half_sigma * rho, d * rho, w);
-        upper_block(&diag, &mul3(&mul3(&jinv, &q), &jinv))
+        upper_block(&diag, &mul3(&jinv_t, &mul3(&q_t, &jinv_t)))
     }
 
     /// `J_r(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left Jacobians. Out of line
@@ -217,7 +222,7 @@ impl<T: Real> Se3<T> {
         let rt = self.rotation.inverse().rotation_matrix();
         let t = &self.translation;
         let p = Vector3::new(t.x * -sigma, t.y * -sigma, t.z * -sigma);
-        upper_block(&(r * sigma), &mul_skew(&rt, &p).transpose())
+        upper_block(&(r * sigma), &mul_skew(&rt, &p))
     }
 
     /// `−Ad_T`.

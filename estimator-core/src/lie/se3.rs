@@ -113,7 +113,11 @@ fn q_block<T: Real>(k: &AngleCoeffs<T>, xi: &Vector6<T>, sym: T, skew: T) -> Mat
 
 /// `x + p ω×x + q ω×(ω×x)`, entry by entry: `J_l(ω) x` of SO(3) (`p = b`, `q = c`, the
 /// exponential's translation) and `J_l⁻¹(ω) x` (`p = −½`, `q = d`, the logarithm's).
-fn cross_poly<T: Real>(p: T, q: T, w: &Vector3<T>, x: &Vector3<T>) -> Vector3<T> {
+///
+/// The vectors by component (in registers, not copied to the stack for a pointer).
+#[allow(clippy::too_many_arguments)]
+fn cross_poly<T: Real>(p: T, q: T, w0: T, w1: T, w2: T, x0: T, x1: T, x2: T) -> Vector3<T> {
+    let (w, x) = (&Vector3::new(w0, w1, w2), &Vector3::new(x0, x1, x2));
     let wx = w.cross(x);
     let wwx = w.cross(&wx);
     Vector3::new(
@@ -164,7 +168,7 @@ impl<T: Real> Se3<T> {
         let (v, w) = split(xi);
         Self {
             rotation: So3::exp_from(k, &w),
-            translation: cross_poly(k.b, k.c, &w, &v),
+            translation: cross_poly(k.b, k.c, w.x, w.y, w.z, v.x, v.y, v.z),
         }
     }
 
@@ -235,7 +239,10 @@ impl<T: Real> Se3<T> {
         let lk = self.rotation.log_with_coeffs();
         let w = &lk.0;
         // J_l⁻¹(ω) t = t − ½ ω×t + d ω×(ω×t).
-        let v = cross_poly(T::lit(-0.5), lk.1.d(), w, &self.translation);
+        let v = {
+            let t = &self.translation;
+            cross_poly(T::lit(-0.5), lk.1.d(), w.x, w.y, w.z, t.x, t.y, t.z)
+        };
         (join(&v, w), lk.1)
     }
 }

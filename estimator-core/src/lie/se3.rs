@@ -429,13 +429,17 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         // Not destructured: the blocks are read where SO(3)'s `act_jac` put them.
         let a = self.rotation.act_jac(p);
         let (rp, h, r) = (&a.0, &a.1, &a.2);
-        // The two 3×3 blocks copied whole into the column-major 3×6 (two block copies instead of
-        // six column copies through a temporary).
-        let mut j = Matrix3x6::zeros();
-        let (jr, jh) = j.as_mut_slice().split_at_mut(9);
+        let t = &self.translation;
+        let mut out = (
+            Vector3::new(rp.x + t.x, rp.y + t.y, rp.z + t.z),
+            Matrix3x6::zeros(),
+            *r,
+        );
+        // The two 3×3 blocks copied whole into the column-major 3×6 where it is returned (two
+        // block copies, no temporary 3×6 copied into the tuple).
+        let (jr, jh) = out.1.as_mut_slice().split_at_mut(9);
         jr.copy_from_slice(r.as_slice());
         jh.copy_from_slice(h.as_slice());
-        let t = &self.translation;
-        (Vector3::new(rp.x + t.x, rp.y + t.y, rp.z + t.z), j, *r)
+        out
     }
 }

@@ -129,8 +129,25 @@ fn cross_poly<T: Real>(p: T, q: T, w0: T, w1: T, w2: T, x0: T, x1: T, x2: T) -> 
 
 /// `a·b` for 3×3 matrices: one out-of-line copy when built for size.
 #[cfg_attr(estimator_compact, inline(never))]
-fn mul3<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
-    a * b
+pub(super) fn mul3<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    #[cfg(not(estimator_compact))]
+    {
+        a * b
+    }
+    // A loop over the entries, each `(a_i1 b_1j + a_i2 b_2j) + a_i3 b_3j` as nalgebra sums it.
+    #[cfg(estimator_compact)]
+    {
+        // Column `j` of the product overwrites column `j` of a copy of `b` once it is read.
+        let [a1, a2, a3] = &a.data.0;
+        let mut c = *b;
+        for cj in &mut c.data.0 {
+            let [x, y, z] = *cj;
+            for (((e, p), q), r) in cj.iter_mut().zip(a1).zip(a2).zip(a3) {
+                *e = *p * x + *q * y + *r * z;
+            }
+        }
+        c
+    }
 }
 
 impl<T: Real> Se3<T> {

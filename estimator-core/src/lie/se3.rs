@@ -20,7 +20,9 @@
 
 use super::so3::So3;
 use super::trig::AngleCoeffs;
-use super::{all_finite, eye, mul_skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{
+    all_finite, eye, mul_skew, negate, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE,
+};
 use nalgebra::{Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
 
 /// A rigid motion `T = (R, t) ∈ SE(3)`; `a_from_b` maps `b` coordinates into `a`.
@@ -237,13 +239,18 @@ impl<T: Real> Se3<T> {
     /// (no negation pass over 36 entries); `[σt]×R = (Rᵀ[−σt]×)ᵀ` since `[t]×ᵀ = −[t]×`.
     #[cfg_attr(estimator_compact, inline(never))]
     fn signed_adjoint(&self, sigma: T) -> Matrix6<T> {
-        let r = self.rotation.rotation_matrix();
+        let mut r = self.rotation.rotation_matrix();
         // `Rᵀ` as the rotation matrix of the conjugate (the same bits, see `compose_jac` of SO(3))
         // and `−σt` per component: no transposing copy and no loop over a temporary.
         let rt = self.rotation.inverse().rotation_matrix();
         let t = &self.translation;
         let p = Vector3::new(t.x * -sigma, t.y * -sigma, t.z * -sigma);
-        upper_block(&(r * sigma), &mul_skew(&rt, &p))
+        // `σR` in place through the shared `negate` (no multiply loop over a temporary; `σ = ±1`,
+        // so the numbers are those of `R·σ`).
+        if sigma < T::zero() {
+            negate(&mut r);
+        }
+        upper_block(&r, &mul_skew(&rt, &p))
     }
 
     /// `−Ad_T`.

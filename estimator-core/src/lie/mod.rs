@@ -360,7 +360,16 @@ pub(crate) fn orthogonality_error<T: Real, const N: usize>(m: &SMatrix<T, N, N>)
 /// `R[p]×`, row by row: row `i` is `rᵢᵀ[p]× = (rᵢ × p)ᵀ` for the row `rᵢ` of `R` (no zero
 /// products of a full 3×3 multiplication by the skew matrix, no 3×3 temporary).
 #[must_use]
+#[inline(always)]
 pub(crate) fn mul_skew<T: Real>(r: &Matrix3<T>, p: &Vector3<T>) -> Matrix3<T> {
+    mul_skew_xyz(r, p.x, p.y, p.z)
+}
+
+/// [`mul_skew`] with `p` by component, in registers (the callers build `p` negated or scaled:
+/// no store of it to the stack for a pointer).
+#[must_use]
+fn mul_skew_xyz<T: Real>(r: &Matrix3<T>, x: T, y: T, z: T) -> Matrix3<T> {
+    let p = Vector3::new(x, y, z);
     let row = |a: T, b: T, c: T| (b * p.z - c * p.y, c * p.x - a * p.z, a * p.y - b * p.x);
     let (a1, a2, a3) = row(r.m11, r.m12, r.m13);
     let (b1, b2, b3) = row(r.m21, r.m22, r.m23);

@@ -20,7 +20,9 @@
 
 use super::so3::So3;
 use super::trig::AngleCoeffs;
-use super::{all_finite, eye, mul_skew, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{
+    all_finite, eye, mul_skew, negate, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE,
+};
 use nalgebra::{Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
 
 /// A rigid motion `T = (R, t) ∈ SE(3)`; `a_from_b` maps `b` coordinates into `a`.
@@ -44,11 +46,13 @@ fn join<T: Real>(v: &Vector3<T>, w: &Vector3<T>) -> Vector6<T> {
     Vector6::new(v.x, v.y, v.z, w.x, w.y, w.z)
 }
 
-/// `[[a, b], [0, a]]` from 3×3 blocks (the shape of every SE(3) Jacobian).
-fn upper_block<T: Real>(diag: &Matrix3<T>, upper: &Matrix3<T>) -> Matrix6<T> {
+/// `[[a, bᵀ], [0, a]]` from 3×3 blocks (the shape of every SE(3) Jacobian), the upper block given
+/// transposed: each caller builds `bᵀ` as cheaply as `b` (the adjoint's `[σt]×R` is
+/// `(Rᵀ[−σt]×)ᵀ`), so no transposed temporary is made.
+fn upper_block<T: Real>(diag: &Matrix3<T>, upper_t: &Matrix3<T>) -> Matrix6<T> {
     let mut m = Matrix6::zeros();
     m.fixed_view_mut::<3, 3>(0, 0).copy_from(diag);
-    m.fixed_view_mut::<3, 3>(0, 3).copy_from(upper);
+    m.fixed_view_mut::<3, 3>(0, 3).tr_copy_from(upper_t);
     m.fixed_view_mut::<3, 3>(3, 3).copy_from(diag);
     m
 }
@@ -111,7 +115,11 @@ fn q_block<T: Real>(k: &AngleCoeffs<T>, xi: &Vector6<T>, sym: T, skew: T) -> Mat
 
 /// `x + p ω×x + q ω×(ω×x)`, entry by entry: `J_l(ω) x` of SO(3) (`p = b`, `q = c`, the
 /// exponential's translation) and `J_l⁻¹(ω) x` (`p = −½`, `q = d`, the logarithm's).
-fn cross_poly<T: Real>(p: T, q: T, w: &Vector3<T>, x: &Vector3<T>) -> Vector3<T> {
+///
+/// The vectors by component (in registers, not copied to the stack for a pointer).
+#[allow(clippy::too_many_arguments)]
+fn cross_poly<T: Real>(p: T, q: T, w0: T, w1: T, w2: T, x0: T, x1: T, x2: T) -> Vector3<T> {
+    let (w, x) = (&Vector3::new(w0, w1, w2), &Vector3::new(x0, x1, x2));
     let wx = w.cross(x);
     let wwx = w.cross(&wx);
     Vector3::new(
@@ -123,8 +131,25 @@ fn cross_poly<T: Real>(p: T, q: T, w: &Vector3<T>, x: &Vector3<T>) -> Vector3<T>
 
 /// `a·b` for 3×3 matrices: one out-of-line copy when built for size.
 #[cfg_attr(estimator_compact, inline(never))]
-fn mul3<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
-    a * b
+pub(super) fn mul3<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    #[cfg(not(estimator_compact))]
+    {
+        a * b
+    }
+    // A loop over the entries, each `(a_i1 b_1j + a_i2 b_2j) + a_i3 b_3j` as nalgebra sums it.
+    #[cfg(estimator_compact)]
+    {
+        // Column `j` of the product overwrites column `j` of a copy of `b` once it is read.
+        let [a1, a2, a3] = &a.data.0;
+        let mut c = *b;
+        for cj in &mut c.data.0 {
+            let [x, y, z] = *cj;
+            for (((e, p), q), r) in cj.iter_mut().zip(a1).zip(a2).zip(a3) {
+                *e = *p * x + *q * y + *r * z;
+            }
+        }
+        c
+    }
 }
 
 impl<T: Real> Se3<T> {
@@ -162,7 +187,7 @@ impl<T: Real> Se3<T> {
         let (v, w) = split(xi);
         Self {
             rotation: So3::exp_from(k, &w),
-            translation: cross_poly(k.b, k.c, &w, &v),
+            translation: cross_poly(k.b, k.c, w.x, w.y, w.z, v.x, v.y, v.z),
         }
     }
 
@@ -173,7 +198,8 @@ impl<T: Real> Se3<T> {
     fn jr_from(k: &AngleCoeffs<T>, xi: &Vector6<T>, sigma: T) -> Matrix6<T> {
         let w = Vector3::new(xi.w, xi.a, xi.b);
         let jr = skew_poly(T::one(), -k.b * sigma, k.c, &w);
-        upper_block(&jr, &q_block(k, xi, T::one(), -sigma))
+        // `Q(−σv, −σω)ᵀ`: the skew part's sign flipped (exact, see `q_block`).
+        upper_block(&jr, &q_block(k, xi, T::one(), sigma))
     }
 
     /// `ρ·J_r⁻¹(σξ)` for `σ, ρ = ±1`: `[[ρJ, −ρ J Q(−σv, −σω) J], [0, ρJ]]` with `J = J_r⁻¹(σω)`
@@ -182,12 +208,14 @@ impl<T: Real> Se3<T> {
     fn jr_inv_from(k: &AngleCoeffs<T>, xi: &Vector6<T>, sigma: T, rho: T) -> Matrix6<T> {
         let w = &Vector3::new(xi.w, xi.a, xi.b);
         let (half_sigma, d) = (T::lit(0.5) * sigma, k.d());
-        let jinv = skew_poly(T::one(), half_sigma, d, w);
-        let q = q_block(k, xi, -rho, rho * sigma);
+        // Transposed for `upper_block`: `((J Q) J)ᵀ = Jᵀ (Qᵀ Jᵀ)`, the same products and sums
+        // (`Jᵀ` and `Qᵀ` flip the sign of the skew parts, exactly).
+        let jinv_t = skew_poly(T::one(), -half_sigma, d, w);
+        let q_t = q_block(k, xi, -rho, -(rho * sigma));
         // `ρJ` as `skew_poly(ρ, ½σρ, ρd)`: the same numbers as `J·ρ` up to the sign of zeros
         // (see `skew_poly`), without a scaled copy of `J`.
         let diag = skew_poly(rho, half_sigma * rho, d * rho, w);
-        upper_block(&diag, &mul3(&mul3(&jinv, &q), &jinv))
+        upper_block(&diag, &mul3(&jinv_t, &mul3(&q_t, &jinv_t)))
     }
 
     /// `J_r(σξ)` from `ξ` (`σ = ±1`): shared source of the right and left Jacobians. Out of line
@@ -211,13 +239,18 @@ impl<T: Real> Se3<T> {
     /// (no negation pass over 36 entries); `[σt]×R = (Rᵀ[−σt]×)ᵀ` since `[t]×ᵀ = −[t]×`.
     #[cfg_attr(estimator_compact, inline(never))]
     fn signed_adjoint(&self, sigma: T) -> Matrix6<T> {
-        let r = self.rotation.rotation_matrix();
+        let mut r = self.rotation.rotation_matrix();
         // `Rᵀ` as the rotation matrix of the conjugate (the same bits, see `compose_jac` of SO(3))
         // and `−σt` per component: no transposing copy and no loop over a temporary.
         let rt = self.rotation.inverse().rotation_matrix();
         let t = &self.translation;
         let p = Vector3::new(t.x * -sigma, t.y * -sigma, t.z * -sigma);
-        upper_block(&(r * sigma), &mul_skew(&rt, &p).transpose())
+        // `σR` in place through the shared `negate` (no multiply loop over a temporary; `σ = ±1`,
+        // so the numbers are those of `R·σ`).
+        if sigma < T::zero() {
+            negate(&mut r);
+        }
+        upper_block(&r, &mul_skew(&rt, &p))
     }
 
     /// `−Ad_T`.
@@ -230,7 +263,10 @@ impl<T: Real> Se3<T> {
         let lk = self.rotation.log_with_coeffs();
         let w = &lk.0;
         // J_l⁻¹(ω) t = t − ½ ω×t + d ω×(ω×t).
-        let v = cross_poly(T::lit(-0.5), lk.1.d(), w, &self.translation);
+        let v = {
+            let t = &self.translation;
+            cross_poly(T::lit(-0.5), lk.1.d(), w.x, w.y, w.z, t.x, t.y, t.z)
+        };
         (join(&v, w), lk.1)
     }
 }
@@ -417,13 +453,17 @@ impl<T: Real> LieGroup<T> for Se3<T> {
         // Not destructured: the blocks are read where SO(3)'s `act_jac` put them.
         let a = self.rotation.act_jac(p);
         let (rp, h, r) = (&a.0, &a.1, &a.2);
-        // The two 3×3 blocks copied whole into the column-major 3×6 (two block copies instead of
-        // six column copies through a temporary).
-        let mut j = Matrix3x6::zeros();
-        let (jr, jh) = j.as_mut_slice().split_at_mut(9);
+        let t = &self.translation;
+        let mut out = (
+            Vector3::new(rp.x + t.x, rp.y + t.y, rp.z + t.z),
+            Matrix3x6::zeros(),
+            *r,
+        );
+        // The two 3×3 blocks copied whole into the column-major 3×6 where it is returned (two
+        // block copies, no temporary 3×6 copied into the tuple).
+        let (jr, jh) = out.1.as_mut_slice().split_at_mut(9);
         jr.copy_from_slice(r.as_slice());
         jh.copy_from_slice(h.as_slice());
-        let t = &self.translation;
-        (Vector3::new(rp.x + t.x, rp.y + t.y, rp.z + t.z), j, *r)
+        out
     }
 }

@@ -33,7 +33,7 @@ impl<T: Real> So2<T> {
         if !positive_finite(n2) {
             return None;
         }
-        let inv = T::one() / n2.sqrt();
+        let inv = T::one() / n2.sqrt_rn();
         Some(Self {
             re: re * inv,
             im: im * inv,

@@ -38,7 +38,7 @@ impl<T: Real> So3<T> {
         if !positive_finite(n2) {
             return None;
         }
-        Some(Self::scaled(q, T::one() / n2.sqrt()))
+        Some(Self::scaled(q, T::one() / n2.sqrt_rn()))
     }
 
     /// `s·q`, trusted to be unit, written per component (no 4-vector temporary at opt-level "s").
@@ -126,7 +126,7 @@ impl<T: Real> So3<T> {
             )
         };
         let from = from.to_le_bytes();
-        let s = radicand.sqrt() * T::lit(2.0);
+        let s = radicand.sqrt_rn() * T::lit(2.0);
         let q = from.map(|j| match pairs.get(usize::from(j)) {
             Some(p) => *p / s,
             None => T::lit(0.25) * s,
@@ -146,7 +146,7 @@ impl<T: Real> So3<T> {
             (q.w, q.i, q.j, q.k)
         };
         let n2 = x * x + y * y + z * z;
-        let n = n2.sqrt();
+        let n = n2.sqrt_rn();
         // θ = 2·atan2(n, w); below the cutoff (n/w small) use 2·atan(r)/r's series, r = n/w.
         let scale = if n2 < T::lit(Cutoff::<T>::ATAN_RATIO) * w * w {
             let r2 = n2 / (w * w);
@@ -297,7 +297,7 @@ impl<T: Real> LieGroup<T> for So3<T> {
     #[cfg(not(estimator_compact))]
     fn exp(w: &Vector3<T>) -> Self {
         let theta_sq = w.norm_squared();
-        let theta = theta_sq.sqrt();
+        let theta = theta_sq.sqrt_rn();
         let (s, c) = (theta * T::lit(0.5)).sincos();
         let v = w * super::trig::half_sinc(theta_sq, theta, s);
         Self {

@@ -104,7 +104,7 @@ impl<T: Real> AngleCoeffs<T> {
     /// From `θ²` alone (one `sqrt` and one `sincos` of `θ/2`). Not `#[inline]` (see
     /// [`Self::from_half_angle`]).
     pub fn from_theta_sq(theta_sq: T) -> Self {
-        let theta = theta_sq.sqrt();
+        let theta = theta_sq.sqrt_rn();
         let (sin_half, cos_half) = (theta * T::lit(0.5)).sincos();
         Self::from_half_angle(theta_sq, theta, sin_half, cos_half)
     }

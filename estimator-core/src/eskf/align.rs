@@ -115,7 +115,8 @@ pub fn align_at_rest<T: Real>(
     }
     let ub = div3(&f, nf);
     let uw = div3(&neg3(gravity), ng);
-    let (hb, hw) = match mag {
+    // Matched in place (not moved into new bindings): no copy of the pair at opt-level "s".
+    let pair = match mag {
         Some(m) => {
             let mb = mean(m.samples)?;
             if !finite(&m.reference) {
@@ -125,12 +126,12 @@ pub fn align_at_rest<T: Real>(
         }
         None => (level_axis(&ub), level_axis(&uw)),
     };
-    let (Some(hb), Some(hw)) = (hb, hw) else {
+    let (Some(hb), Some(hw)) = &pair else {
         return Err(EskfError::ZeroNorm);
     };
     let from_mag = mag.is_some();
     // R = W Bᵀ, W = [u_w, h_w, u_w × h_w], B = [u_b, h_b, u_b × h_b] (columns).
-    let attitude = So3::from_rotation_matrix(&mm(&triad(&uw, &hw, false), &triad(&ub, &hb, true)))
+    let attitude = So3::from_rotation_matrix(&mm(&triad(&uw, hw, false), &triad(&ub, hb, true)))
         .ok_or(EskfError::NonFinite)?;
     Ok(Alignment {
         attitude,

@@ -101,19 +101,23 @@ pub fn align_at_rest<T: Real>(
     mag: Option<&MagnetometerWindow<'_, T>>,
     rest_tolerance: T,
 ) -> Result<Alignment<T>, EskfError> {
-    let f = mean(accel)?;
-    let w = mean(gyro)?;
+    // The means read inside their `Result`s, not moved out of them (no copies at opt-level "s").
+    let (f, w) = (mean(accel), mean(gyro));
+    let (f, w) = match (&f, &w) {
+        (Ok(f), Ok(w)) => (f, w),
+        (Err(e), _) | (_, Err(e)) => return Err(*e),
+    };
     if !(finite(gravity) && rest_tolerance.is_finite()) {
         return Err(EskfError::NonFinite);
     }
-    let (nf, ng) = (norm3(&f), norm3(gravity));
+    let (nf, ng) = (norm3(f), norm3(gravity));
     if !(nf > T::zero() && ng > T::zero()) {
         return Err(EskfError::ZeroNorm);
     }
     if (nf - ng).abs() > rest_tolerance {
         return Err(EskfError::NotAtRest);
     }
-    let ub = div3(&f, nf);
+    let ub = div3(f, nf);
     let uw = div3(&neg3(gravity), ng);
     // Matched in place (not moved into new bindings): no copy of the pair at opt-level "s".
     let pair = match mag {
@@ -135,7 +139,7 @@ pub fn align_at_rest<T: Real>(
         .ok_or(EskfError::NonFinite)?;
     Ok(Alignment {
         attitude,
-        gyro_bias: w,
+        gyro_bias: *w,
         heading_from_magnetometer: from_mag,
     })
 }

@@ -122,11 +122,15 @@ pub fn align_at_rest<T: Real>(
     // Matched in place (not moved into new bindings): no copy of the pair at opt-level "s".
     let pair = match mag {
         Some(m) => {
-            let mb = mean(m.samples)?;
+            let mb = mean(m.samples);
+            let mb = match &mb {
+                Ok(mb) => mb,
+                Err(e) => return Err(*e),
+            };
             if !finite(&m.reference) {
                 return Err(EskfError::NonFinite);
             }
-            (horizontal(&mb, &ub), horizontal(&m.reference, &uw))
+            (horizontal(mb, &ub), horizontal(&m.reference, &uw))
         }
         None => (level_axis(&ub), level_axis(&uw)),
     };

@@ -139,10 +139,12 @@ pub fn align_at_rest<T: Real>(
     };
     let from_mag = mag.is_some();
     // R = W Bᵀ, W = [u_w, h_w, u_w × h_w], B = [u_b, h_b, u_b × h_b] (columns).
-    let attitude = So3::from_rotation_matrix(&mm(&triad(&uw, hw, false), &triad(&ub, hb, true)))
-        .ok_or(EskfError::NonFinite)?;
+    let attitude = So3::from_rotation_matrix(&mm(&triad(&uw, hw, false), &triad(&ub, hb, true)));
+    let Some(attitude) = &attitude else {
+        return Err(EskfError::NonFinite);
+    };
     Ok(Alignment {
-        attitude,
+        attitude: *attitude,
         gyro_bias: *w,
         heading_from_magnetometer: from_mag,
     })

@@ -569,7 +569,12 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
         {
             return Err(EskfError::NonFinite);
         }
-        let (uv, c, q) = self.project_parts(x)?;
+        // Read inside the `Result`, not moved out of it (no copy of the parts at opt-level "s").
+        let parts = self.project_parts(x);
+        let (uv, c, q) = match &parts {
+            Ok(p) => p,
+            Err(e) => return Err(*e),
+        };
         let rcb = tr33(&self.body_from_camera.rotation().rotation_matrix());
         let rt = tr33(&x.attitude.rotation_matrix());
         let iz = T::one() / c.z;
@@ -594,7 +599,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
         }
         Ok(Linearization {
             residual: Vector2::new(self.pixel.x - uv.x, self.pixel.y - uv.y),
-            jacobian: jacobian(&[(0, mm(&jc, &skew(&q))), (6, jp)]),
+            jacobian: jacobian(&[(0, mm(&jc, &skew(q))), (6, jp)]),
         })
     }
     fn noise(&self) -> Matrix2<T> {

@@ -358,7 +358,7 @@ where
     T: Real,
     S: ErrorState<T, N>,
 {
-    let mut w = Work {
+    let mut w = Work::<T, C> {
         ht: SMatrix::zeros(),
         r: SVector::zeros(),
         u: SMatrix::zeros(),
@@ -366,9 +366,15 @@ where
         k: SMatrix::zeros(),
         s_inv: SMatrix::zeros(),
         dx: SVector::zeros(),
-        noise: SMatrix::identity(),
+        noise: SMatrix::zeros(),
         m,
     };
+    // The identity written in place (not built aside and copied in).
+    for i in 0..C {
+        if let Some(e) = w.noise.as_mut_slice().get_mut(i * (C + 1)) {
+            *e = T::one();
+        }
+    }
     start(opts, noise, &mut w)?;
     linearize_into(model, x, &mut w, true)?;
     let nis = match gate_step(p.as_slice(), N, m, opts, &mut w)? {

@@ -511,7 +511,7 @@ pub(crate) fn predict_ahrs<T: Real>(
     let n00 = Matrix3::new(
         n.m11, n.m12, n.m13, n.m12, n.m22, n.m23, n.m13, n.m23, n.m33,
     );
-    let att = x.attitude.compose(&dr).renormalize();
+    let att = x.attitude.compose(dr).renormalize();
     if !(finite_vec(&n00) && finite_vec(&m01) && att.is_finite()) {
         return Err(EskfError::NonFinite);
     }

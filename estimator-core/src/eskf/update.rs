@@ -377,9 +377,11 @@ where
     }
     start(opts, noise, &mut w)?;
     linearize_into(model, x, &mut w, true)?;
-    let nis = match gate_step(p.as_slice(), N, m, opts, &mut w)? {
-        UpdateOutcome::Accepted { nis, .. } => nis,
-        rejected => return Ok(rejected),
+    // Read inside the `Result` (not moved out of it by `?`).
+    let gated = gate_step(p.as_slice(), N, m, opts, &mut w);
+    let nis = match &gated {
+        Ok(UpdateOutcome::Accepted { nis, .. }) => *nis,
+        _ => return gated,
     };
     let iterations = iterate(x, p, model, opts, &mut w);
     commit(x, p, &mut w)?;

@@ -295,8 +295,8 @@ impl<T: Real> Magnetometer<T> {
         {
             return Err(EskfError::ZeroNorm);
         }
-        let (hx, h_att) = in_body(attitude, &self.reference);
-        Ok((sub3(&self.field, &hx), h_att))
+        let b = in_body(attitude, &self.reference);
+        Ok((sub3(&self.field, &b.0), b.1))
     }
 }
 
@@ -349,8 +349,8 @@ impl<T: Real> GravityDirection<T> {
         if !(na > T::zero() && nu > T::zero()) {
             return Err(EskfError::ZeroNorm);
         }
-        let (hx, h_att) = in_body(attitude, &div3(&self.up, nu));
-        Ok((sub3(&div3(&self.accel, na), &hx), h_att))
+        let b = in_body(attitude, &div3(&self.up, nu));
+        Ok((sub3(&div3(&self.accel, na), &b.0), b.1))
     }
 }
 

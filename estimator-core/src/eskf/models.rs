@@ -399,10 +399,10 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
         if dot3(&self.accel, &self.accel) <= T::zero() {
             return Err(EskfError::ZeroNorm);
         }
-        let (f, h_att) = in_body(&x.attitude, &neg3(&self.gravity));
+        let b = in_body(&x.attitude, &neg3(&self.gravity));
         let mut lin = Linearization {
-            residual: sub3(&self.accel, &add3(&f, &x.accel_bias)),
-            jacobian: jacobian(&[(0, h_att)]),
+            residual: sub3(&self.accel, &add3(&b.0, &x.accel_bias)),
+            jacobian: jacobian(&[(0, b.1)]),
         };
         set_identity(&mut lin.jacobian, 12);
         Ok(lin)

@@ -183,15 +183,11 @@ pub(crate) const CORE_ROWS: usize = 3;
 /// The core takes `&dyn Rows<T, S, N, C>`, so it is compiled once per `(T, S, N, C)`, not once per
 /// model; only [`Padded::linearize_rows`] (the model's own `linearize` and a copy) is per model.
 trait Rows<T: Real, S, const N: usize, const C: usize> {
-    /// Linearizes at `x` into `ht = Hᵀ` (`N × C`, column-major in the first `N·C` entries of the
-    /// storage; column `c` is row `c` of `H`, so that each row of `H` is contiguous) and `r`;
-    /// the columns and rows past `M` are zero, and so is the rest of the storage.
-    fn linearize_rows(
-        &self,
-        x: &S,
-        ht: &mut SMatrix<T, MAX_STATE, C>,
-        r: &mut SVector<T, C>,
-    ) -> Result<(), EskfError>;
+    /// Linearizes at `x` into `w.ht = Hᵀ` (`N × C`, column-major in the first `N·C` entries of
+    /// the storage; column `c` is row `c` of `H`, so that each row of `H` is contiguous) and
+    /// `w.r`; the columns and rows past `M` are zero, and so is the rest of the storage. Nothing
+    /// else in `w` is written.
+    fn linearize_rows(&self, x: &S, w: &mut Work<T, C>) -> Result<(), EskfError>;
 }
 
 /// A model with `M` rows, seen through any capacity `C ≥ M`.
@@ -203,12 +199,7 @@ where
     T: Real,
     Mo: Measurement<T, S, N, M>,
 {
-    fn linearize_rows(
-        &self,
-        x: &S,
-        ht: &mut SMatrix<T, MAX_STATE, C>,
-        r: &mut SVector<T, C>,
-    ) -> Result<(), EskfError> {
+    fn linearize_rows(&self, x: &S, w: &mut Work<T, C>) -> Result<(), EskfError> {
         // Borrowed inside the `Result`, not moved out of it: one copy of the linearization on
         // the stack instead of two (this frame is on the deepest path of the update).
         let lin = self.0.linearize(x);
@@ -216,14 +207,16 @@ where
             Ok(lin) => lin,
             Err(e) => return Err(*e),
         };
-        rows_into(
-            lin.jacobian.as_slice(),
-            lin.residual.as_slice(),
-            ht.as_mut_slice(),
-            r.as_mut_slice(),
-        );
+        rows_into_work(lin.jacobian.as_slice(), lin.residual.as_slice(), w);
         Ok(())
     }
+}
+
+/// [`rows_into`] into the working set's `H̃ᵀ` and `r`: one pointer to pass from each model's
+/// [`Padded::linearize_rows`] instead of two slices (fewer arguments on the stack per model).
+#[cfg_attr(estimator_compact, inline(never))]
+fn rows_into_work<T: Real, const C: usize>(h: &[T], r_in: &[T], w: &mut Work<T, C>) {
+    rows_into(h, r_in, w.ht.as_mut_slice(), w.r.as_mut_slice());
 }
 
 /// Copies `H` (`m × n`, column-major in `h`, `m = r_in.len()`) into `ht` as `Hᵀ` (`n × C`,
@@ -481,10 +474,10 @@ where
     S: ErrorState<T, N>,
 {
     if first {
-        model.linearize_rows(x, &mut w.ht, &mut w.r)?;
+        model.linearize_rows(x, w)?;
     } else {
         let dx = error_vector::<T, N>(w.dx.as_slice());
-        model.linearize_rows(&x.oplus(&dx), &mut w.ht, &mut w.r)?;
+        model.linearize_rows(&x.oplus(&dx), w)?;
     }
     check_rows(N, w, first)
 }

@@ -222,7 +222,7 @@ fn rows_into_work<T: Real, const C: usize>(h: &[T], r_in: &[T], w: &mut Work<T, 
 /// Copies `H` (`m × n`, column-major in `h`, `m = r_in.len()`) into `ht` as `Hᵀ` (`n × C`,
 /// column `c` = row `c` of `H`) and the residual into `r`, zeros past `m`. Not generic over the
 /// model or its size: one copy of this code serves every model.
-#[cfg_attr(estimator_compact, inline(never))]
+#[cfg_attr(estimator_compact, inline(always))] // into its one caller, rows_into_work
 pub(crate) fn rows_into<T: Real>(h: &[T], r_in: &[T], ht: &mut [T], r: &mut [T]) {
     let m = r_in.len().max(1);
     let n = h.len() / m;

@@ -43,12 +43,13 @@ impl<T: Real> Ahrs<T> {
     ) -> Result<Self, EskfError> {
         config.validate()?;
         let mut p = SMatrix::<T, 6, 6>::zeros();
-        set_blk(
-            &mut p,
-            0,
-            0,
-            &prior_attitude_covariance(alignment, sigmas, &config)?,
-        );
+        // Read inside the `Result`, not moved out of it by `?` (no copy at opt-level "s").
+        let att = prior_attitude_covariance(alignment, sigmas, &config);
+        let att = match &att {
+            Ok(att) => att,
+            Err(e) => return Err(*e),
+        };
+        set_blk(&mut p, 0, 0, att);
         add_diag(&mut p, 1, sigmas.gyro_bias * sigmas.gyro_bias);
         Self::new(
             AhrsState {

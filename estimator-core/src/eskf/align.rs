@@ -101,40 +101,51 @@ pub fn align_at_rest<T: Real>(
     mag: Option<&MagnetometerWindow<'_, T>>,
     rest_tolerance: T,
 ) -> Result<Alignment<T>, EskfError> {
-    let f = mean(accel)?;
-    let w = mean(gyro)?;
+    // The means read inside their `Result`s, not moved out of them (no copies at opt-level "s").
+    let (f, w) = (mean(accel), mean(gyro));
+    let (f, w) = match (&f, &w) {
+        (Ok(f), Ok(w)) => (f, w),
+        (Err(e), _) | (_, Err(e)) => return Err(*e),
+    };
     if !(finite(gravity) && rest_tolerance.is_finite()) {
         return Err(EskfError::NonFinite);
     }
-    let (nf, ng) = (norm3(&f), norm3(gravity));
+    let (nf, ng) = (norm3(f), norm3(gravity));
     if !(nf > T::zero() && ng > T::zero()) {
         return Err(EskfError::ZeroNorm);
     }
     if (nf - ng).abs() > rest_tolerance {
         return Err(EskfError::NotAtRest);
     }
-    let ub = div3(&f, nf);
+    let ub = div3(f, nf);
     let uw = div3(&neg3(gravity), ng);
-    let (hb, hw) = match mag {
+    // Matched in place (not moved into new bindings): no copy of the pair at opt-level "s".
+    let pair = match mag {
         Some(m) => {
-            let mb = mean(m.samples)?;
+            let mb = mean(m.samples);
+            let mb = match &mb {
+                Ok(mb) => mb,
+                Err(e) => return Err(*e),
+            };
             if !finite(&m.reference) {
                 return Err(EskfError::NonFinite);
             }
-            (horizontal(&mb, &ub), horizontal(&m.reference, &uw))
+            (horizontal(mb, &ub), horizontal(&m.reference, &uw))
         }
         None => (level_axis(&ub), level_axis(&uw)),
     };
-    let (Some(hb), Some(hw)) = (hb, hw) else {
+    let (Some(hb), Some(hw)) = &pair else {
         return Err(EskfError::ZeroNorm);
     };
     let from_mag = mag.is_some();
     // R = W Bᵀ, W = [u_w, h_w, u_w × h_w], B = [u_b, h_b, u_b × h_b] (columns).
-    let attitude = So3::from_rotation_matrix(&mm(&triad(&uw, &hw, false), &triad(&ub, &hb, true)))
-        .ok_or(EskfError::NonFinite)?;
+    let attitude = So3::from_rotation_matrix(&mm(&triad(&uw, hw, false), &triad(&ub, hb, true)));
+    let Some(attitude) = &attitude else {
+        return Err(EskfError::NonFinite);
+    };
     Ok(Alignment {
-        attitude,
-        gyro_bias: w,
+        attitude: *attitude,
+        gyro_bias: *w,
         heading_from_magnetometer: from_mag,
     })
 }

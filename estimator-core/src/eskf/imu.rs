@@ -492,7 +492,9 @@ pub(crate) fn predict_ahrs<T: Real>(
         return Err(EskfError::NonFinite);
     }
     check_dt(dt, cfg.max_dt)?;
-    let (dr, jr) = So3::exp_jac(&(axpy(gyro, &x.gyro_bias, -T::one()) * dt));
+    // Read in place (`e.0`, `e.1`), not destructured into copies at opt-level "s".
+    let e = So3::exp_jac(&(axpy(gyro, &x.gyro_bias, -T::one()) * dt));
+    let (dr, jr) = (&e.0, e.1);
     // F00 = ΔRᵀ, so F00ᵀ = ΔR (no transpose pass).
     let f00t = dr.rotation_matrix();
     let f00 = tr33(&f00t);
@@ -509,7 +511,7 @@ pub(crate) fn predict_ahrs<T: Real>(
     let n00 = Matrix3::new(
         n.m11, n.m12, n.m13, n.m12, n.m22, n.m23, n.m13, n.m23, n.m33,
     );
-    let att = x.attitude.compose(&dr).renormalize();
+    let att = x.attitude.compose(dr).renormalize();
     if !(finite_vec(&n00) && finite_vec(&m01) && att.is_finite()) {
         return Err(EskfError::NonFinite);
     }

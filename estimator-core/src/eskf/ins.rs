@@ -54,12 +54,13 @@ impl<T: Real> Ins<T> {
             accel_bias: Vector3::zeros(),
         };
         let mut p = SMatrix::<T, 15, 15>::zeros();
-        set_blk(
-            &mut p,
-            0,
-            0,
-            &prior_attitude_covariance(alignment, sigmas, &config)?,
-        );
+        // Read inside the `Result`, not moved out of it by `?` (no copy at opt-level "s").
+        let att = prior_attitude_covariance(alignment, sigmas, &config);
+        let att = match &att {
+            Ok(att) => att,
+            Err(e) => return Err(*e),
+        };
+        set_blk(&mut p, 0, 0, att);
         let sq = |s: T| s * s;
         add_diag(&mut p, 1, sq(sigmas.velocity));
         add_diag(&mut p, 2, sq(sigmas.position));

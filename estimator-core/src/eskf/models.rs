@@ -295,8 +295,8 @@ impl<T: Real> Magnetometer<T> {
         {
             return Err(EskfError::ZeroNorm);
         }
-        let (hx, h_att) = in_body(attitude, &self.reference);
-        Ok((sub3(&self.field, &hx), h_att))
+        let b = in_body(attitude, &self.reference);
+        Ok((sub3(&self.field, &b.0), b.1))
     }
 }
 
@@ -349,8 +349,8 @@ impl<T: Real> GravityDirection<T> {
         if !(na > T::zero() && nu > T::zero()) {
             return Err(EskfError::ZeroNorm);
         }
-        let (hx, h_att) = in_body(attitude, &div3(&self.up, nu));
-        Ok((sub3(&div3(&self.accel, na), &hx), h_att))
+        let b = in_body(attitude, &div3(&self.up, nu));
+        Ok((sub3(&div3(&self.accel, na), &b.0), b.1))
     }
 }
 
@@ -399,10 +399,10 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
         if dot3(&self.accel, &self.accel) <= T::zero() {
             return Err(EskfError::ZeroNorm);
         }
-        let (f, h_att) = in_body(&x.attitude, &neg3(&self.gravity));
+        let b = in_body(&x.attitude, &neg3(&self.gravity));
         let mut lin = Linearization {
-            residual: sub3(&self.accel, &add3(&f, &x.accel_bias)),
-            jacobian: jacobian(&[(0, h_att)]),
+            residual: sub3(&self.accel, &add3(&b.0, &x.accel_bias)),
+            jacobian: jacobian(&[(0, b.1)]),
         };
         set_identity(&mut lin.jacobian, 12);
         Ok(lin)
@@ -569,7 +569,12 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
         {
             return Err(EskfError::NonFinite);
         }
-        let (uv, c, q) = self.project_parts(x)?;
+        // Read inside the `Result`, not moved out of it (no copy of the parts at opt-level "s").
+        let parts = self.project_parts(x);
+        let (uv, c, q) = match &parts {
+            Ok(p) => p,
+            Err(e) => return Err(*e),
+        };
         let rcb = tr33(&self.body_from_camera.rotation().rotation_matrix());
         let rt = tr33(&x.attitude.rotation_matrix());
         let iz = T::one() / c.z;
@@ -594,7 +599,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
         }
         Ok(Linearization {
             residual: Vector2::new(self.pixel.x - uv.x, self.pixel.y - uv.y),
-            jacobian: jacobian(&[(0, mm(&jc, &skew(&q))), (6, jp)]),
+            jacobian: jacobian(&[(0, mm(&jc, &skew(q))), (6, jp)]),
         })
     }
     fn noise(&self) -> Matrix2<T> {

@@ -183,15 +183,11 @@ pub(crate) const CORE_ROWS: usize = 3;
 /// The core takes `&dyn Rows<T, S, N, C>`, so it is compiled once per `(T, S, N, C)`, not once per
 /// model; only [`Padded::linearize_rows`] (the model's own `linearize` and a copy) is per model.
 trait Rows<T: Real, S, const N: usize, const C: usize> {
-    /// Linearizes at `x` into `ht = Hᵀ` (`N × C`, column-major in the first `N·C` entries of the
-    /// storage; column `c` is row `c` of `H`, so that each row of `H` is contiguous) and `r`;
-    /// the columns and rows past `M` are zero, and so is the rest of the storage.
-    fn linearize_rows(
-        &self,
-        x: &S,
-        ht: &mut SMatrix<T, MAX_STATE, C>,
-        r: &mut SVector<T, C>,
-    ) -> Result<(), EskfError>;
+    /// Linearizes at `x` into `w.ht = Hᵀ` (`N × C`, column-major in the first `N·C` entries of
+    /// the storage; column `c` is row `c` of `H`, so that each row of `H` is contiguous) and
+    /// `w.r`; the columns and rows past `M` are zero, and so is the rest of the storage. Nothing
+    /// else in `w` is written.
+    fn linearize_rows(&self, x: &S, w: &mut Work<T, C>) -> Result<(), EskfError>;
 }
 
 /// A model with `M` rows, seen through any capacity `C ≥ M`.
@@ -203,12 +199,7 @@ where
     T: Real,
     Mo: Measurement<T, S, N, M>,
 {
-    fn linearize_rows(
-        &self,
-        x: &S,
-        ht: &mut SMatrix<T, MAX_STATE, C>,
-        r: &mut SVector<T, C>,
-    ) -> Result<(), EskfError> {
+    fn linearize_rows(&self, x: &S, w: &mut Work<T, C>) -> Result<(), EskfError> {
         // Borrowed inside the `Result`, not moved out of it: one copy of the linearization on
         // the stack instead of two (this frame is on the deepest path of the update).
         let lin = self.0.linearize(x);
@@ -216,20 +207,22 @@ where
             Ok(lin) => lin,
             Err(e) => return Err(*e),
         };
-        rows_into(
-            lin.jacobian.as_slice(),
-            lin.residual.as_slice(),
-            ht.as_mut_slice(),
-            r.as_mut_slice(),
-        );
+        rows_into_work(lin.jacobian.as_slice(), lin.residual.as_slice(), w);
         Ok(())
     }
+}
+
+/// [`rows_into`] into the working set's `H̃ᵀ` and `r`: one pointer to pass from each model's
+/// [`Padded::linearize_rows`] instead of two slices (fewer arguments on the stack per model).
+#[cfg_attr(estimator_compact, inline(never))]
+fn rows_into_work<T: Real, const C: usize>(h: &[T], r_in: &[T], w: &mut Work<T, C>) {
+    rows_into(h, r_in, w.ht.as_mut_slice(), w.r.as_mut_slice());
 }
 
 /// Copies `H` (`m × n`, column-major in `h`, `m = r_in.len()`) into `ht` as `Hᵀ` (`n × C`,
 /// column `c` = row `c` of `H`) and the residual into `r`, zeros past `m`. Not generic over the
 /// model or its size: one copy of this code serves every model.
-#[cfg_attr(estimator_compact, inline(never))]
+#[cfg_attr(estimator_compact, inline(always))] // into its one caller, rows_into_work
 pub(crate) fn rows_into<T: Real>(h: &[T], r_in: &[T], ht: &mut [T], r: &mut [T]) {
     let m = r_in.len().max(1);
     let n = h.len() / m;
@@ -358,7 +351,7 @@ where
     T: Real,
     S: ErrorState<T, N>,
 {
-    let mut w = Work {
+    let mut w = Work::<T, C> {
         ht: SMatrix::zeros(),
         r: SVector::zeros(),
         u: SMatrix::zeros(),
@@ -366,14 +359,22 @@ where
         k: SMatrix::zeros(),
         s_inv: SMatrix::zeros(),
         dx: SVector::zeros(),
-        noise: SMatrix::identity(),
+        noise: SMatrix::zeros(),
         m,
     };
+    // The identity written in place (not built aside and copied in).
+    for i in 0..C {
+        if let Some(e) = w.noise.as_mut_slice().get_mut(i * (C + 1)) {
+            *e = T::one();
+        }
+    }
     start(opts, noise, &mut w)?;
     linearize_into(model, x, &mut w, true)?;
-    let nis = match gate_step(p.as_slice(), N, m, opts, &mut w)? {
-        UpdateOutcome::Accepted { nis, .. } => nis,
-        rejected => return Ok(rejected),
+    // Read inside the `Result` (not moved out of it by `?`).
+    let gated = gate_step(p.as_slice(), N, m, opts, &mut w);
+    let nis = match &gated {
+        Ok(UpdateOutcome::Accepted { nis, .. }) => *nis,
+        _ => return gated,
     };
     let iterations = iterate(x, p, model, opts, &mut w);
     commit(x, p, &mut w)?;
@@ -473,10 +474,10 @@ where
     S: ErrorState<T, N>,
 {
     if first {
-        model.linearize_rows(x, &mut w.ht, &mut w.r)?;
+        model.linearize_rows(x, w)?;
     } else {
         let dx = error_vector::<T, N>(w.dx.as_slice());
-        model.linearize_rows(&x.oplus(&dx), &mut w.ht, &mut w.r)?;
+        model.linearize_rows(&x.oplus(&dx), w)?;
     }
     check_rows(N, w, first)
 }

@@ -92,7 +92,7 @@ impl GateProbability {
             Self::P99 => T::lit(2.326_347_9),
             Self::P999 => T::lit(3.090_232_3),
         };
-        let base = T::one() - c + z * c.sqrt();
+        let base = T::one() - c + z * c.sqrt_rn();
         m * base * base * base
     }
 }

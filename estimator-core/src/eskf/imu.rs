@@ -547,7 +547,7 @@ pub(crate) fn sigmas<T: Real, const N: usize>(p: &SMatrix<T, N, N>) -> SVector<T
             .get(i * (N + 1))
             .copied()
             .unwrap_or_else(T::zero);
-        *e = d.max(T::zero()).sqrt();
+        *e = d.max(T::zero()).sqrt_rn();
     }
     out
 }

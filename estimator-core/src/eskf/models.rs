@@ -103,7 +103,7 @@ pub(crate) fn dot3<T: Real>(a: &Vector3<T>, b: &Vector3<T>) -> T {
 
 /// `‖v‖ = √(v · v)`, as nalgebra's `norm`.
 pub(crate) fn norm3<T: Real>(v: &Vector3<T>) -> T {
-    dot3(v, v).sqrt()
+    dot3(v, v).sqrt_rn()
 }
 
 /// GNSS antenna position in the world frame, with the antenna at `lever_arm` in the body frame.

@@ -130,7 +130,7 @@ pub(crate) fn factor_lower<T: Real>(l: &mut [T], n: usize) -> bool {
         if !greater(*diagonal, T::zero()) {
             return false;
         }
-        let d = diagonal.sqrt();
+        let d = diagonal.sqrt_rn();
         *diagonal = d;
         for e in below {
             *e /= d;
@@ -678,7 +678,7 @@ pub(crate) fn distance<T: Real>(a: &[T], b: &[T]) -> T {
             let d = *x - *y;
             acc + d * d
         })
-        .sqrt()
+        .sqrt_rn()
 }
 
 /// `a · b` over two equally long slices.

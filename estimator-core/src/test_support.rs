@@ -23,6 +23,31 @@ impl Lcg {
     }
 }
 
+/// One number of every class, as `f64` (`T::lit` rounds them into `f32`): signed zeros,
+/// subnormals of `f64` and `f32`, ±1, the edges of `f32`'s range, ±`f64::MAX`, the infinities
+/// and both `NaN` signs. The finiteness and sign tests of the rewrites run on these.
+pub(crate) fn every_class() -> [f64; 17] {
+    [
+        0.0,
+        -0.0,
+        1e-310,
+        -1e-310,
+        1e-45,
+        -1e-45,
+        1.0,
+        -1.0,
+        3.4e38,
+        -3.4e38,
+        1e300,
+        f64::MAX,
+        -f64::MAX,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+        -f64::NAN,
+    ]
+}
+
 /// Equal bits, entry by entry (any two `NaN`s count as equal).
 pub(crate) fn same_bits<T: Real>(a: &[T], b: &[T]) -> bool {
     a.len() == b.len()

@@ -3,7 +3,7 @@
 
 use super::rotation::{triad, triad_start, unit};
 use super::*;
-use crate::test_support::{same_bits as same, Lcg};
+use crate::test_support::{every_class, same_bits as same, Lcg};
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -166,26 +166,7 @@ fn triad_start_is_the_carried_form() {
 /// `all_positive` and `all_non_negative` (size form: `x · 0 = 0` as the finiteness test)
 /// against `x > 0 && x.is_finite()` and `x ≥ 0 && x.is_finite()` on every class of number.
 fn sign_checks<T: Real>() {
-    let mut xs = [
-        0.0,
-        -0.0,
-        1e-310,
-        -1e-310,
-        1e-45,
-        -1e-45,
-        1.0,
-        -1.0,
-        3.4e38,
-        -3.4e38,
-        1e300,
-        f64::MAX,
-        -f64::MAX,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::NAN,
-        -f64::NAN,
-    ]
-    .to_vec();
+    let mut xs = every_class().to_vec();
     let mut rng = Lcg(29);
     xs.extend((0..200).map(|_| (rng.next() - 0.5) * 10f64.powf(80.0 * rng.next() - 40.0)));
     for x in xs.into_iter().map(T::lit) {

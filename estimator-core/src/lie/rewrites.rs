@@ -3,7 +3,7 @@
 
 use super::trig::AngleCoeffs;
 use super::*;
-use crate::test_support::{same_up_to_zero_sign as same, Lcg};
+use crate::test_support::{every_class, same_up_to_zero_sign as same, Lcg};
 use nalgebra::{Matrix2, Quaternion, UnitQuaternion, Vector2};
 
 /// Rotation matrices of every Shepperd branch (angles up to and at π about each axis and
@@ -560,24 +560,7 @@ fn poly_is_bit_identical_to_the_loop() {
 
 /// `positive_finite` against `is_finite() && > 0` on every class of number.
 fn positive_finite_cases<T: Real>() {
-    let mut xs = [
-        0.0,
-        -0.0,
-        1e-310,
-        -1e-310,
-        1e-45,
-        1.0,
-        -1.0,
-        3.4e38,
-        1e300,
-        f64::MAX,
-        -f64::MAX,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::NAN,
-        -f64::NAN,
-    ]
-    .to_vec();
+    let mut xs = every_class().to_vec();
     let mut rng = Lcg(53);
     xs.extend((0..100).map(|_| rng.next() * 10f64.powf(40.0 * rng.next())));
     for x in xs.into_iter().map(T::lit) {

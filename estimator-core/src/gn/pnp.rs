@@ -176,20 +176,29 @@ pub fn reprojection_error<T: Real>(
 ) -> Option<(Vector2<T>, Matrix2x6<T>)> {
     let x = camera_point(r, t, p);
     let (uv, jp) = camera.project_jac(&x, min_depth)?;
-    let jp = jp * inv_sigma;
-    let b = jp * r; // Jπ R: the translation block.
-    let mut j = Matrix2x6::zeros();
-    j.fixed_view_mut::<2, 3>(0, 0).copy_from(&b);
-    let b0 = Vector3::new(b.m11, b.m12, b.m13);
-    let b1 = Vector3::new(b.m21, b.m22, b.m23);
+    // Jπ/σ has zeros at (0, 1) and (1, 0): (Jπ/σ) R from its four other entries only. Without
+    // those products the result may differ from the full product in the sign of a zero (and
+    // stays finite where a non-finite R entry met a zero).
+    let (fu, au) = (jp.m11 * inv_sigma, jp.m13 * inv_sigma);
+    let (fv, av) = (jp.m22 * inv_sigma, jp.m23 * inv_sigma);
+    // Jπ R: the translation block, row by row.
+    let b0 = Vector3::new(
+        fu * r.m11 + au * r.m31,
+        fu * r.m12 + au * r.m32,
+        fu * r.m13 + au * r.m33,
+    );
+    let b1 = Vector3::new(
+        fv * r.m21 + av * r.m31,
+        fv * r.m22 + av * r.m32,
+        fv * r.m23 + av * r.m33,
+    );
     let r0 = p.cross(&b0); // bᵀ(−[p]×) = (p × b)ᵀ
     let r1 = p.cross(&b1);
-    j.m14 = r0.x;
-    j.m15 = r0.y;
-    j.m16 = r0.z;
-    j.m24 = r1.x;
-    j.m25 = r1.y;
-    j.m26 = r1.z;
+    #[rustfmt::skip]
+    let j = Matrix2x6::new(
+        b0.x, b0.y, b0.z, r0.x, r0.y, r0.z,
+        b1.x, b1.y, b1.z, r1.x, r1.y, r1.z,
+    );
     let e = Vector2::new((uv.x - z.x) * inv_sigma, (uv.y - z.y) * inv_sigma);
     Some((e, j))
 }

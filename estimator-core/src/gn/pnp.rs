@@ -52,7 +52,7 @@ impl<T: Real> Default for PnpOptions<T> {
     /// Levenberg-Marquardt, least squares, `sigma_px = 1`, 30 iterations, the solver's default
     /// tolerances, `min_depth = 1e-3` m, `inlier_chi2 = 9.21`.
     fn default() -> Self {
-        let s = SolverOptions::<T>::default();
+        let s = SolverOptions::<T>::defaults_inline();
         Self {
             method: Method::LevenbergMarquardt,
             loss: Loss::LeastSquares,
@@ -460,7 +460,7 @@ pub fn solve_pnp<T: Real>(
         step_tolerance: options.step_tolerance,
         cost_tolerance: options.cost_tolerance,
         information_step_tolerance: options.information_step_tolerance,
-        initial_damping: SolverOptions::<T>::default().initial_damping,
+        initial_damping: SolverOptions::<T>::defaults_inline().initial_damping,
     };
     let mut sol = Solution::placeholder(camera_from_world_guess);
     solve_into(&problem, &solver_options, &mut sol)?;

@@ -179,26 +179,28 @@ pub fn reprojection_error<T: Real>(
     // Jπ/σ has zeros at (0, 1) and (1, 0): (Jπ/σ) R from its four other entries only. Without
     // those products the result may differ from the full product in the sign of a zero (and
     // stays finite where a non-finite R entry met a zero).
-    let (fu, au) = (jp.m11 * inv_sigma, jp.m13 * inv_sigma);
-    let (fv, av) = (jp.m22 * inv_sigma, jp.m23 * inv_sigma);
-    // Jπ R: the translation block, row by row.
-    let b0 = Vector3::new(
-        fu * r.m11 + au * r.m31,
-        fu * r.m12 + au * r.m32,
-        fu * r.m13 + au * r.m33,
-    );
-    let b1 = Vector3::new(
-        fv * r.m21 + av * r.m31,
-        fv * r.m22 + av * r.m32,
-        fv * r.m23 + av * r.m33,
-    );
-    let r0 = p.cross(&b0); // bᵀ(−[p]×) = (p × b)ᵀ
-    let r1 = p.cross(&b1);
-    #[rustfmt::skip]
-    let j = Matrix2x6::new(
-        b0.x, b0.y, b0.z, r0.x, r0.y, r0.z,
-        b1.x, b1.y, b1.z, r1.x, r1.y, r1.z,
-    );
+    let rows = [
+        (jp.m11 * inv_sigma, jp.m13 * inv_sigma, r.row(0)),
+        (jp.m22 * inv_sigma, jp.m23 * inv_sigma, r.row(1)),
+    ];
+    let mut j = Matrix2x6::zeros();
+    for (i, (f, a, ri)) in rows.iter().enumerate() {
+        // Row i of Jπ R (the translation block): f·(row i of R) + a·(row 2 of R), then p × it.
+        // One loop body for both rows.
+        let bi = Vector3::new(
+            *f * ri[0] + *a * r.m31,
+            *f * ri[1] + *a * r.m32,
+            *f * ri[2] + *a * r.m33,
+        );
+        let ci = p.cross(&bi); // bᵀ(−[p]×) = (p × b)ᵀ
+        let mut row = j.row_mut(i);
+        row[0] = bi.x;
+        row[1] = bi.y;
+        row[2] = bi.z;
+        row[3] = ci.x;
+        row[4] = ci.y;
+        row[5] = ci.z;
+    }
     let e = Vector2::new((uv.x - z.x) * inv_sigma, (uv.y - z.y) * inv_sigma);
     Some((e, j))
 }

@@ -52,7 +52,7 @@ impl<T: Real> Default for PnpOptions<T> {
     /// Levenberg-Marquardt, least squares, `sigma_px = 1`, 30 iterations, the solver's default
     /// tolerances, `min_depth = 1e-3` m, `inlier_chi2 = 9.21`.
     fn default() -> Self {
-        let s = SolverOptions::<T>::default();
+        let s = SolverOptions::<T>::defaults_inline();
         Self {
             method: Method::LevenbergMarquardt,
             loss: Loss::LeastSquares,
@@ -176,20 +176,31 @@ pub fn reprojection_error<T: Real>(
 ) -> Option<(Vector2<T>, Matrix2x6<T>)> {
     let x = camera_point(r, t, p);
     let (uv, jp) = camera.project_jac(&x, min_depth)?;
-    let jp = jp * inv_sigma;
-    let b = jp * r; // Jπ R: the translation block.
+    // Jπ/σ has zeros at (0, 1) and (1, 0): (Jπ/σ) R from its four other entries only. Without
+    // those products the result may differ from the full product in the sign of a zero (and
+    // stays finite where a non-finite R entry met a zero).
+    let rows = [
+        (jp.m11 * inv_sigma, jp.m13 * inv_sigma, r.row(0)),
+        (jp.m22 * inv_sigma, jp.m23 * inv_sigma, r.row(1)),
+    ];
     let mut j = Matrix2x6::zeros();
-    j.fixed_view_mut::<2, 3>(0, 0).copy_from(&b);
-    let b0 = Vector3::new(b.m11, b.m12, b.m13);
-    let b1 = Vector3::new(b.m21, b.m22, b.m23);
-    let r0 = p.cross(&b0); // bᵀ(−[p]×) = (p × b)ᵀ
-    let r1 = p.cross(&b1);
-    j.m14 = r0.x;
-    j.m15 = r0.y;
-    j.m16 = r0.z;
-    j.m24 = r1.x;
-    j.m25 = r1.y;
-    j.m26 = r1.z;
+    for (i, (f, a, ri)) in rows.iter().enumerate() {
+        // Row i of Jπ R (the translation block): f·(row i of R) + a·(row 2 of R), then p × it.
+        // One loop body for both rows.
+        let bi = Vector3::new(
+            *f * ri[0] + *a * r.m31,
+            *f * ri[1] + *a * r.m32,
+            *f * ri[2] + *a * r.m33,
+        );
+        let ci = p.cross(&bi); // bᵀ(−[p]×) = (p × b)ᵀ
+        let mut row = j.row_mut(i);
+        row[0] = bi.x;
+        row[1] = bi.y;
+        row[2] = bi.z;
+        row[3] = ci.x;
+        row[4] = ci.y;
+        row[5] = ci.z;
+    }
     let e = Vector2::new((uv.x - z.x) * inv_sigma, (uv.y - z.y) * inv_sigma);
     Some((e, j))
 }
@@ -451,7 +462,7 @@ pub fn solve_pnp<T: Real>(
         step_tolerance: options.step_tolerance,
         cost_tolerance: options.cost_tolerance,
         information_step_tolerance: options.information_step_tolerance,
-        initial_damping: SolverOptions::<T>::default().initial_damping,
+        initial_damping: SolverOptions::<T>::defaults_inline().initial_damping,
     };
     let mut sol = Solution::placeholder(camera_from_world_guess);
     solve_into(&problem, &solver_options, &mut sol)?;

@@ -285,3 +285,79 @@ fn split_is_the_indexed_copy() {
         split_case::<f64, 0, 2, 2>(&mut rng);
     }
 }
+
+/// `reprojection_error`'s former body: `Jπ/σ` as a full 2×3 matrix times `R` (nalgebra's
+/// product), then the rotation block as `p × b` per row.
+#[allow(clippy::type_complexity)]
+fn reprojection_error_before<T: Real>(
+    camera: &PinholeCamera<T>,
+    r: &nalgebra::Matrix3<T>,
+    t: &Vector3<T>,
+    p: &Vector3<T>,
+    z: &nalgebra::Vector2<T>,
+    inv_sigma: T,
+    min_depth: T,
+) -> Option<(nalgebra::Vector2<T>, nalgebra::Matrix2x6<T>)> {
+    let x = super::pnp::camera_point(r, t, p);
+    let (uv, jp) = camera.project_jac(&x, min_depth)?;
+    let b = jp * inv_sigma * r;
+    let mut j = nalgebra::Matrix2x6::zeros();
+    j.fixed_view_mut::<2, 3>(0, 0).copy_from(&b);
+    for i in 0..2 {
+        let c = p.cross(&Vector3::new(b[(i, 0)], b[(i, 1)], b[(i, 2)]));
+        for k in 0..3 {
+            j[(i, 3 + k)] = c[k];
+        }
+    }
+    let e = nalgebra::Vector2::new((uv.x - z.x) * inv_sigma, (uv.y - z.y) * inv_sigma);
+    Some((e, j))
+}
+
+/// `reprojection_error` (the structural zeros of `Jπ` left out of `(Jπ/σ) R`) against the full
+/// product: the same values on finite inputs, up to the sign of a zero.
+fn reprojection_cases<T: Real>() {
+    let mut rng = Lcg(29);
+    for i in 0..3000 {
+        let mut r = nalgebra::Matrix3::<T>::zeros();
+        for (h, x) in r.iter_mut().enumerate() {
+            *x = T::lit(rng.next());
+            match (i * 5 + h) % 17 {
+                0 => *x = T::zero(),
+                1 => *x = T::lit(-0.0),
+                _ => {}
+            }
+        }
+        let t = rng.vector::<T>(1.0) + Vector3::new(T::zero(), T::zero(), T::lit(4.0));
+        let mut p = rng.vector::<T>([1.0, 1e-20, 1e10][i % 3]);
+        if i % 11 == 0 {
+            p.y = T::lit(-0.0);
+        }
+        let z = nalgebra::Vector2::new(T::lit(300.0 * rng.next()), T::lit(200.0 * rng.next()));
+        let cam = PinholeCamera::new(
+            T::lit(500.0 + rng.next()),
+            T::lit(480.0),
+            T::lit(320.0),
+            T::lit(240.0),
+        );
+        let s = T::lit([0.5, 2.0, 1e-30, 0.0][i % 4]);
+        let md = T::lit([0.1, 10.0][i % 2]);
+        let got = reprojection_error(&cam, &r, &t, &p, &z, s, md);
+        let want = reprojection_error_before(&cam, &r, &t, &p, &z, s, md);
+        match (got, want) {
+            (Some((ge, gj)), Some((we, wj))) => {
+                assert!(same(ge.as_slice(), we.as_slice()), "{r:?} {p:?}");
+                assert!(
+                    crate::test_support::same_up_to_zero_sign(gj.as_slice(), wj.as_slice()),
+                    "{r:?} {p:?} {gj:?} {wj:?}"
+                );
+            }
+            (g, w) => assert!(g.is_none() && w.is_none()),
+        }
+    }
+}
+
+#[test]
+fn reprojection_error_is_the_full_product_up_to_zero_signs() {
+    reprojection_cases::<f32>();
+    reprojection_cases::<f64>();
+}

@@ -266,7 +266,18 @@ impl<T: Real> Default for SolverOptions<T> {
     /// Levenberg-Marquardt, least squares, 50 iterations, step tolerance
     /// `max(1e3 ε, 1e-9)`, cost tolerance `max(1e2 ε, 1e-12)`, information step tolerance
     /// `1e-6`, `λ₀ = 1e-3`.
+    // One copy of the four constants for every caller in a build for size.
+    #[cfg_attr(estimator_compact, inline(never))]
     fn default() -> Self {
+        Self::defaults_inline()
+    }
+}
+
+impl<T: Real> SolverOptions<T> {
+    /// `Default::default`'s values, always inlined: for the callers that read one or two of
+    /// them (the constants then fold into their code instead of a call and a copy).
+    #[inline(always)]
+    pub(super) fn defaults_inline() -> Self {
         Self {
             method: Method::LevenbergMarquardt,
             loss: Loss::LeastSquares,

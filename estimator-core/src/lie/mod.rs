@@ -369,12 +369,24 @@ pub(crate) fn mul_skew<T: Real>(r: &Matrix3<T>, p: &Vector3<T>) -> Matrix3<T> {
 /// no store of it to the stack for a pointer).
 #[must_use]
 fn mul_skew_xyz<T: Real>(r: &Matrix3<T>, x: T, y: T, z: T) -> Matrix3<T> {
-    let p = Vector3::new(x, y, z);
-    let row = |a: T, b: T, c: T| (b * p.z - c * p.y, c * p.x - a * p.z, a * p.y - b * p.x);
-    let (a1, a2, a3) = row(r.m11, r.m12, r.m13);
-    let (b1, b2, b3) = row(r.m21, r.m22, r.m23);
-    let (c1, c2, c3) = row(r.m31, r.m32, r.m33);
-    Matrix3::new(a1, a2, a3, b1, b2, b3, c1, c2, c3)
+    let mut m = *r;
+    mul_skew_in_place(&mut m, x, y, z);
+    m
+}
+
+/// `M ← M[p]×` with `p` by component: each row is replaced by `rᵢ × p` once read (row `i` of
+/// the product depends on row `i` of `M` only), the operations of [`mul_skew`].
+pub(crate) fn mul_skew_in_place<T: Real>(m: &mut Matrix3<T>, x: T, y: T, z: T) {
+    // Column-major storage: row `i` is entry `i` of each of the three columns. A loop over the
+    // rows (one copy of the body when built for size), no indexing.
+    let (c1, rest) = m.as_mut_slice().split_at_mut(3);
+    let (c2, c3) = rest.split_at_mut(3);
+    for ((a, b), c) in c1.iter_mut().zip(c2.iter_mut()).zip(c3.iter_mut()) {
+        let (ra, rb, rc) = (*a, *b, *c);
+        *a = rb * z - rc * y;
+        *b = rc * x - ra * z;
+        *c = ra * y - rb * x;
+    }
 }
 
 #[cfg(test)]

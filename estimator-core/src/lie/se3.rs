@@ -81,20 +81,13 @@ fn q_block<T: Real>(k: &AngleCoeffs<T>, xi: &Vector6<T>, sym: T, skew: T) -> Mat
     let (v, w) = (&v, &w);
     let se = k.se();
     let dot = w.dot(v);
-    let sc = dot * (k.c + se.e + se.e);
-    let fa = T::lit(0.5) * se.f * dot;
     let g = dot * (k.c + k.c + se.f * k.theta_sq) * sym;
-    // α (times `sym`) and s = b v − δ(c + 2e) ω (times `skew`).
-    let (ax, ay, az) = (
-        (v.x * k.c + w.x * fa) * sym,
-        (v.y * k.c + w.y * fa) * sym,
-        (v.z * k.c + w.z * fa) * sym,
-    );
-    let (sx, sy, sz) = (
-        (v.x * k.b - w.x * sc) * skew,
-        (v.y * k.b - w.y * sc) * skew,
-        (v.z * k.b - w.z * sc) * skew,
-    );
+    // α (times `sym`) and s = b v − δ(c + 2e) ω (times `skew`), the signs folded into the
+    // coefficients: as `sym`, `skew` = ±1, `(x + y)σ` and `xσ + yσ` differ at most in a zero's sign.
+    let (c, fa) = (k.c * sym, T::lit(0.5) * se.f * dot * sym);
+    let (b, sc) = (k.b * skew, dot * (k.c + se.e + se.e) * skew);
+    let (ax, ay, az) = (v.x * c + w.x * fa, v.y * c + w.y * fa, v.z * c + w.z * fa);
+    let (sx, sy, sz) = (v.x * b - w.x * sc, v.y * b - w.y * sc, v.z * b - w.z * sc);
     let (xy, xz, yz) = (
         ax * w.y + ay * w.x,
         ax * w.z + az * w.x,
@@ -329,11 +322,12 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     fn inverse(&self) -> Self {
         let r_inv = self.rotation.inverse();
-        // `−(R⁻¹ t)` entry by entry (no `Neg` loop over a temporary).
-        let u = r_inv.act(&self.translation);
+        // `R⁻¹(−t)`: the operations of `−(R⁻¹ t)` on negated operands, so the same numbers up to
+        // the sign of zeros (rounding is symmetric), with `−t` built in registers.
+        let t = &self.translation;
         Self {
+            translation: r_inv.act(&Vector3::new(-t.x, -t.y, -t.z)),
             rotation: r_inv,
-            translation: Vector3::new(-u.x, -u.y, -u.z),
         }
     }
 

@@ -18,8 +18,8 @@
 
 use super::trig::{poly, AngleCoeffs, Cutoff};
 use super::{
-    all_finite, eye, mul_skew, negate, orthogonality_error, positive_finite, skew, skew_poly,
-    LieGroup, Real, ORTHOGONALITY_TOLERANCE,
+    all_finite, eye, mul_skew_in_place, negate, orthogonality_error, positive_finite, skew,
+    skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE,
 };
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3, Vector4};
 
@@ -438,12 +438,15 @@ impl<T: Real> LieGroup<T> for So3<T> {
     /// `(R p, −R[p]×, R)`: seed Theorem 5.1 with `H(p) = [−p]×` (Example 5.2).
     fn act_jac(&self, p: &Vector3<T>) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {
         let r = self.rotation_matrix();
-        // `R p` and `−p` entry by entry (nalgebra's order of operations for `R p`).
+        // `R p` and `−p` entry by entry (nalgebra's order of operations for `R p`); `R[−p]×`
+        // computed over a copy of `R` where it is returned.
         let rp = Vector3::new(
             r.m11 * p.x + r.m12 * p.y + r.m13 * p.z,
             r.m21 * p.x + r.m22 * p.y + r.m23 * p.z,
             r.m31 * p.x + r.m32 * p.y + r.m33 * p.z,
         );
-        (rp, mul_skew(&r, &Vector3::new(-p.x, -p.y, -p.z)), r)
+        let mut out = (rp, r, r);
+        mul_skew_in_place(&mut out.1, -p.x, -p.y, -p.z);
+        out
     }
 }

@@ -435,11 +435,11 @@ impl<T: Real> Heading<T> {
         }
     }
 
-    /// The wrapped residual and the attitude row (row 0 of the returned block), one copy for
-    /// both filters. With `R e₁ = (c_x, c_y, ·)` and `∂(R e₁)/∂δθ = −R[e₁]× = [0, −R e₃, R e₂]`
+    /// The wrapped residual and the attitude row, one copy for both filters. With
+    /// `R e₁ = (c_x, c_y, ·)` and `∂(R e₁)/∂δθ = −R[e₁]× = [0, −R e₃, R e₂]`
     /// (columns; `[e₁]× = [0, e₃, −e₂]`), the row `(c_x ∂c_y − c_y ∂c_x)/(c_x² + c_y²)` is
     /// `(0, c_y R₁₃ − c_x R₂₃, c_x R₂₂ − c_y R₁₂)/(c_x² + c_y²)`.
-    fn attitude_parts(&self, attitude: &So3<T>) -> Result<(T, Matrix3<T>), EskfError> {
+    fn attitude_parts(&self, attitude: &So3<T>) -> Result<(T, [T; 3]), EskfError> {
         if !self.yaw.is_finite() {
             return Err(EskfError::NonFinite);
         }
@@ -449,18 +449,11 @@ impl<T: Real> Heading<T> {
         if !greater(n2, T::lit(1e-6)) {
             return Err(EskfError::SingularGeometry);
         }
-        let z = T::zero();
-        let row = Matrix3::new(
-            z,
+        let row = [
+            T::zero(),
             (cy * r.m13 - cx * r.m23) / n2,
             (cx * r.m22 - cy * r.m12) / n2,
-            z,
-            z,
-            z,
-            z,
-            z,
-            z,
-        );
+        ];
         let psi = cy.arctan2(cx);
         let (s, c) = (self.yaw - psi).sincos();
         Ok((s.arctan2(c), row))
@@ -470,10 +463,15 @@ impl<T: Real> Heading<T> {
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for Heading<T> {
     #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &S) -> Result<Linearization<T, N, 1>, EskfError> {
-        let (residual, h_att) = self.attitude_parts(x.attitude())?;
+        let (residual, row) = self.attitude_parts(x.attitude())?;
+        // The row's three entries in the attitude columns 0..3, zero elsewhere.
+        let mut jacobian = SMatrix::<T, 1, N>::zeros();
+        for (d, s) in jacobian.as_mut_slice().iter_mut().zip(&row) {
+            *d = *s;
+        }
         Ok(Linearization {
             residual: Vector1::new(residual),
-            jacobian: jacobian(&[(0, h_att)]),
+            jacobian,
         })
     }
     fn noise(&self) -> Matrix1<T> {

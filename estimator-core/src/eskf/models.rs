@@ -472,14 +472,19 @@ impl<T: Real> Heading<T> {
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for Heading<T> {
     #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &S) -> Result<Linearization<T, N, 1>, EskfError> {
-        let (residual, row) = self.attitude_parts(x.attitude())?;
+        // Read inside the `Result` (not moved out of it by `?`).
+        let parts = self.attitude_parts(x.attitude());
+        let (residual, row) = match &parts {
+            Ok(p) => p,
+            Err(e) => return Err(*e),
+        };
         // The row's three entries in the attitude columns 0..3, zero elsewhere.
         let mut jacobian = SMatrix::<T, 1, N>::zeros();
-        for (d, s) in jacobian.as_mut_slice().iter_mut().zip(&row) {
+        for (d, s) in jacobian.as_mut_slice().iter_mut().zip(row) {
             *d = *s;
         }
         Ok(Linearization {
-            residual: Vector1::new(residual),
+            residual: Vector1::new(*residual),
             jacobian,
         })
     }

@@ -5,7 +5,7 @@
 //! `R[−b]×`).
 
 use super::error::EskfError;
-use super::imu::{finite, greater, mm, tr33};
+use super::imu::{finite, greater, mm, set_blk_rc, tr33};
 use super::state::{ErrorState, InsState};
 use super::update::{Linearization, Measurement};
 use crate::lie::{skew, LieGroup, Se3, So3};
@@ -22,7 +22,7 @@ fn iso3<T: Real>(sigma: T) -> Matrix3<T> {
 /// The `M × N` Jacobian that is zero except for the given blocks: the first `M` rows of each
 /// `(column, block)` go to columns `column..column + 3`. One helper for every model, so that
 /// each shape has one copy of the loop.
-fn jacobian<T: Real, const M: usize, const N: usize>(
+pub(crate) fn jacobian<T: Real, const M: usize, const N: usize>(
     blocks: &[(usize, Matrix3<T>)],
 ) -> SMatrix<T, M, N> {
     let mut h = SMatrix::<T, M, N>::zeros();
@@ -38,6 +38,15 @@ fn jacobian<T: Real, const M: usize, const N: usize>(
     h
 }
 
+/// The `3 × N` Jacobian that is `b` in columns `0..3` and zero elsewhere: the block written by
+/// the filters' block store (one out-of-line copy for every shape when built for size) instead
+/// of a block loop per shape.
+pub(crate) fn attitude_jacobian<T: Real, const N: usize>(b: &Matrix3<T>) -> SMatrix<T, 3, N> {
+    let mut h = SMatrix::<T, 3, N>::zeros();
+    set_blk_rc(&mut h, 0, 0, b);
+    h
+}
+
 /// The linearization of a three-row model that sees only the attitude, from its residual and
 /// attitude block: one copy per filter shared by the direction models ([`Magnetometer`],
 /// [`GravityDirection`]).
@@ -47,7 +56,7 @@ fn attitude_only<T: Real, const N: usize>(
     let (residual, h_att) = parts?;
     Ok(Linearization {
         residual,
-        jacobian: jacobian(&[(0, h_att)]),
+        jacobian: attitude_jacobian(&h_att),
     })
 }
 
@@ -140,7 +149,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssPosition<T> {
         let (rl, d_att, _) = x.attitude.act_jac(&self.lever_arm);
         let mut lin = Linearization {
             residual: sub3(&self.position, &add3(&x.position, &rl)),
-            jacobian: jacobian(&[(0, d_att)]),
+            jacobian: attitude_jacobian(&d_att),
         };
         set_identity(&mut lin.jacobian, 6);
         Ok(lin)
@@ -402,7 +411,7 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
         let b = in_body(&x.attitude, &neg3(&self.gravity));
         let mut lin = Linearization {
             residual: sub3(&self.accel, &add3(&b.0, &x.accel_bias)),
-            jacobian: jacobian(&[(0, b.1)]),
+            jacobian: attitude_jacobian(&b.1),
         };
         set_identity(&mut lin.jacobian, 12);
         Ok(lin)
@@ -435,11 +444,11 @@ impl<T: Real> Heading<T> {
         }
     }
 
-    /// The wrapped residual and the attitude row (row 0 of the returned block), one copy for
-    /// both filters. With `R e₁ = (c_x, c_y, ·)` and `∂(R e₁)/∂δθ = −R[e₁]× = [0, −R e₃, R e₂]`
+    /// The wrapped residual and the attitude row, one copy for both filters. With
+    /// `R e₁ = (c_x, c_y, ·)` and `∂(R e₁)/∂δθ = −R[e₁]× = [0, −R e₃, R e₂]`
     /// (columns; `[e₁]× = [0, e₃, −e₂]`), the row `(c_x ∂c_y − c_y ∂c_x)/(c_x² + c_y²)` is
     /// `(0, c_y R₁₃ − c_x R₂₃, c_x R₂₂ − c_y R₁₂)/(c_x² + c_y²)`.
-    fn attitude_parts(&self, attitude: &So3<T>) -> Result<(T, Matrix3<T>), EskfError> {
+    fn attitude_parts(&self, attitude: &So3<T>) -> Result<(T, [T; 3]), EskfError> {
         if !self.yaw.is_finite() {
             return Err(EskfError::NonFinite);
         }
@@ -449,18 +458,11 @@ impl<T: Real> Heading<T> {
         if !greater(n2, T::lit(1e-6)) {
             return Err(EskfError::SingularGeometry);
         }
-        let z = T::zero();
-        let row = Matrix3::new(
-            z,
+        let row = [
+            T::zero(),
             (cy * r.m13 - cx * r.m23) / n2,
             (cx * r.m22 - cy * r.m12) / n2,
-            z,
-            z,
-            z,
-            z,
-            z,
-            z,
-        );
+        ];
         let psi = cy.arctan2(cx);
         let (s, c) = (self.yaw - psi).sincos();
         Ok((s.arctan2(c), row))
@@ -470,10 +472,20 @@ impl<T: Real> Heading<T> {
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for Heading<T> {
     #[cfg_attr(estimator_compact, inline(never))]
     fn linearize(&self, x: &S) -> Result<Linearization<T, N, 1>, EskfError> {
-        let (residual, h_att) = self.attitude_parts(x.attitude())?;
+        // Read inside the `Result` (not moved out of it by `?`).
+        let parts = self.attitude_parts(x.attitude());
+        let (residual, row) = match &parts {
+            Ok(p) => p,
+            Err(e) => return Err(*e),
+        };
+        // The row's three entries in the attitude columns 0..3, zero elsewhere.
+        let mut jacobian = SMatrix::<T, 1, N>::zeros();
+        for (d, s) in jacobian.as_mut_slice().iter_mut().zip(row) {
+            *d = *s;
+        }
         Ok(Linearization {
-            residual: Vector1::new(residual),
-            jacobian: jacobian(&[(0, h_att)]),
+            residual: Vector1::new(*residual),
+            jacobian,
         })
     }
     fn noise(&self) -> Matrix1<T> {

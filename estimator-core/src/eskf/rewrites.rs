@@ -681,3 +681,108 @@ fn camera_noise_is_the_scaled_identity() {
     camera_noise::<f32>();
     camera_noise::<f64>();
 }
+
+/// `Heading::linearize` against its former body: the attitude row as row 0 of a `3 × 3` block
+/// (`Matrix3::new(0, a, b, 0, …)`) copied into the `1 × N` Jacobian by the block loop.
+fn heading_case<T: Real, S: super::state::ErrorState<T, N>, const N: usize>(
+    seed: u64,
+    state: impl Fn(So3<T>) -> S,
+) {
+    use super::models::Heading;
+    use super::update::Measurement;
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    let mut accepted = 0;
+    for i in 0..400 {
+        let axis = Vector3::new(rng.next(), rng.next(), rng.next());
+        let q = UnitQuaternion::from_scaled_axis(axis * 3.0)
+            .coords
+            .map(T::lit);
+        let attitude = So3::from_unit_quaternion(UnitQuaternion::new_unchecked(q.into()));
+        let model = Heading::new(number(&mut rng, i), T::lit(0.1));
+        let new = model.linearize(&state(attitude));
+        // The former body.
+        let old = (|| {
+            if !model.yaw.is_finite() {
+                return None;
+            }
+            let r = attitude.rotation_matrix();
+            let (cx, cy) = (r.m11, r.m21);
+            let n2 = cx * cx + cy * cy;
+            if !super::imu::greater(n2, T::lit(1e-6)) {
+                return None;
+            }
+            let z = T::zero();
+            let b = Matrix3::new(
+                z,
+                (cy * r.m13 - cx * r.m23) / n2,
+                (cx * r.m22 - cy * r.m12) / n2,
+                z,
+                z,
+                z,
+                z,
+                z,
+                z,
+            );
+            let psi = cy.arctan2(cx);
+            let (s, c) = (model.yaw - psi).sincos();
+            let mut h = SMatrix::<T, 1, N>::zeros();
+            for c in 0..3 {
+                h[(0, c)] = b[(0, c)];
+            }
+            Some((s.arctan2(c), h))
+        })();
+        match (new, old) {
+            (Ok(lin), Some((res, h))) => {
+                assert!(same(lin.residual.as_slice(), &[res]));
+                assert!(same(lin.jacobian.as_slice(), h.as_slice()));
+                accepted += 1;
+            }
+            (Err(_), None) => {}
+            _ => panic!("Heading: accepted by one body only"),
+        }
+    }
+    assert!(accepted > 200);
+}
+
+#[test]
+fn heading_linearization_is_the_former_body() {
+    use super::state::{AhrsState, InsState};
+    fn ins<T: Real>(attitude: So3<T>) -> InsState<T> {
+        InsState {
+            attitude,
+            ..InsState::identity()
+        }
+    }
+    fn ahrs<T: Real>(attitude: So3<T>) -> AhrsState<T> {
+        AhrsState {
+            attitude,
+            ..AhrsState::identity()
+        }
+    }
+    heading_case::<f32, _, 15>(41, ins);
+    heading_case::<f64, _, 15>(42, ins);
+    heading_case::<f32, _, 6>(43, ahrs);
+    heading_case::<f64, _, 6>(44, ahrs);
+}
+
+/// `attitude_jacobian` (the block store) against the block loop it replaces,
+/// `jacobian(&[(0, b)])`, bit for bit (special values included).
+fn attitude_jacobian_case<T: Real, const N: usize>(seed: u64) {
+    use super::models::{attitude_jacobian, jacobian};
+    let mut rng = Lcg(seed);
+    for i in 0..300 {
+        let b = Matrix3::<T>::from_fn(|r, c| number(&mut rng, i + 3 * r + c));
+        let new = attitude_jacobian::<T, N>(&b);
+        let old = jacobian::<T, 3, N>(&[(0, b)]);
+        assert!(same(new.as_slice(), old.as_slice()));
+    }
+}
+
+#[test]
+fn attitude_jacobian_is_the_block_loop() {
+    attitude_jacobian_case::<f32, 15>(51);
+    attitude_jacobian_case::<f64, 15>(52);
+    attitude_jacobian_case::<f32, 6>(53);
+    attitude_jacobian_case::<f64, 6>(54);
+}

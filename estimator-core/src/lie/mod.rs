@@ -357,25 +357,9 @@ pub(crate) fn orthogonality_error<T: Real, const N: usize>(m: &SMatrix<T, N, N>)
     err
 }
 
-/// `R[p]×`, row by row: row `i` is `rᵢᵀ[p]× = (rᵢ × p)ᵀ` for the row `rᵢ` of `R` (no zero
-/// products of a full 3×3 multiplication by the skew matrix, no 3×3 temporary).
-#[must_use]
-#[inline(always)]
-pub(crate) fn mul_skew<T: Real>(r: &Matrix3<T>, p: &Vector3<T>) -> Matrix3<T> {
-    mul_skew_xyz(r, p.x, p.y, p.z)
-}
-
-/// [`mul_skew`] with `p` by component, in registers (the callers build `p` negated or scaled:
-/// no store of it to the stack for a pointer).
-#[must_use]
-fn mul_skew_xyz<T: Real>(r: &Matrix3<T>, x: T, y: T, z: T) -> Matrix3<T> {
-    let mut m = *r;
-    mul_skew_in_place(&mut m, x, y, z);
-    m
-}
-
 /// `M ← M[p]×` with `p` by component: each row is replaced by `rᵢ × p` once read (row `i` of
-/// the product depends on row `i` of `M` only), the operations of [`mul_skew`].
+/// the product depends on row `i` of `M` only): row `i` of `R[p]×` is `rᵢᵀ[p]× = (rᵢ × p)ᵀ`,
+/// with no zero products of a full multiplication by the skew matrix and no 3×3 temporary.
 pub(crate) fn mul_skew_in_place<T: Real>(m: &mut Matrix3<T>, x: T, y: T, z: T) {
     // Column-major storage: row `i` is entry `i` of each of the three columns. A loop over the
     // rows (one copy of the body when built for size), no indexing.

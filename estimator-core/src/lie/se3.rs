@@ -21,7 +21,7 @@
 use super::so3::So3;
 use super::trig::AngleCoeffs;
 use super::{
-    all_finite, eye, mul_skew, negate, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE,
+    all_finite, eye, mul_skew_in_place, negate, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE,
 };
 use nalgebra::{Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};
 
@@ -235,15 +235,15 @@ impl<T: Real> Se3<T> {
         let mut r = self.rotation.rotation_matrix();
         // `Rᵀ` as the rotation matrix of the conjugate (the same bits, see `compose_jac` of SO(3))
         // and `−σt` per component: no transposing copy and no loop over a temporary.
-        let rt = self.rotation.inverse().rotation_matrix();
+        let mut rt = self.rotation.inverse().rotation_matrix();
         let t = &self.translation;
-        let p = Vector3::new(t.x * -sigma, t.y * -sigma, t.z * -sigma);
         // `σR` in place through the shared `negate` (no multiply loop over a temporary; `σ = ±1`,
         // so the numbers are those of `R·σ`).
         if sigma < T::zero() {
             negate(&mut r);
         }
-        upper_block(&r, &mul_skew(&rt, &p))
+        mul_skew_in_place(&mut rt, t.x * -sigma, t.y * -sigma, t.z * -sigma);
+        upper_block(&r, &rt)
     }
 
     /// `−Ad_T`.

@@ -66,6 +66,17 @@ pub(crate) fn positive_finite<T: Real>(x: T) -> bool {
     return x.is_finite() && x > T::zero();
 }
 
+/// `x ≥ 0` and finite (`false` for NaN). Built for size, `x · 0 = 0` is the finiteness test
+/// (`∞ · 0` and `NaN · 0` are NaN): two comparisons instead of a class test.
+#[inline(always)]
+#[must_use]
+pub(crate) fn non_negative_finite<T: Real>(x: T) -> bool {
+    #[cfg(estimator_compact)]
+    return x >= T::zero() && x * T::zero() == T::zero();
+    #[cfg(not(estimator_compact))]
+    return x >= T::zero() && x.is_finite();
+}
+
 /// A real scalar: `f32` or `f64` (sealed).
 pub trait Real: RealField + Copy + sealed::Sealed {
     /// Machine epsilon of `Self` (`2⁻²³` for `f32`, `2⁻⁵²` for `f64`), widened to `f64` so that

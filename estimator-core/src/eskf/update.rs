@@ -5,6 +5,7 @@ use super::error::{EskfError, UpdateOutcome};
 use super::gate::{Gate, GateProbability};
 use super::imu::{finite_vec, greater, sum_times_zero_is_zero};
 use super::state::ErrorState;
+use crate::gn::linalg::dot;
 use crate::lie::{LieGroup, So3};
 use crate::scalar::positive_finite;
 use crate::Real;
@@ -679,13 +680,6 @@ pub(crate) fn distance<T: Real>(a: &[T], b: &[T]) -> T {
             acc + d * d
         })
         .sqrt_rn()
-}
-
-/// `a · b` over two equally long slices.
-#[cfg_attr(not(estimator_compact), inline)]
-#[cfg_attr(estimator_compact, inline(never))]
-fn dot<T: Real>(a: &[T], b: &[T]) -> T {
-    a.iter().zip(b).fold(T::zero(), |acc, (x, y)| acc + *x * *y)
 }
 
 /// The Gauss-Newton iterations (step 2 after the first): at `x̂ ⊕ δx_k`,

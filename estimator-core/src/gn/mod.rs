@@ -95,15 +95,5 @@ pub(crate) fn all_positive<T: crate::Real>(xs: &[T]) -> bool {
 /// `true` when every `x` is finite and `x ≥ 0` (`false` for NaN); see [`all_positive`].
 #[inline(never)]
 pub(crate) fn all_non_negative<T: crate::Real>(xs: &[T]) -> bool {
-    xs.iter().all(|&x| non_negative_finite(x))
-}
-
-/// `x ≥ 0` and finite (`false` for NaN). Built for size, `x · 0 = 0` is the finiteness test
-/// (`∞ · 0` and `NaN · 0` are NaN): two comparisons instead of a class test.
-#[inline(always)]
-pub(crate) fn non_negative_finite<T: crate::Real>(x: T) -> bool {
-    #[cfg(estimator_compact)]
-    return x >= T::zero() && x * T::zero() == T::zero();
-    #[cfg(not(estimator_compact))]
-    return x >= T::zero() && x.is_finite();
+    xs.iter().all(|&x| crate::scalar::non_negative_finite(x))
 }

@@ -3,6 +3,7 @@
 
 use super::rotation::{triad, triad_start, unit};
 use super::*;
+use crate::scalar::non_negative_finite;
 use crate::test_support::{every_class, same_bits as same, Lcg};
 use crate::Real;
 use nalgebra::Vector3;

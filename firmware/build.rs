@@ -20,4 +20,10 @@ fn main() {
     println!("cargo:rerun-if-env-changed=FIRMWARE_EXPECTED");
     println!("cargo:rerun-if-changed={expected}");
     println!("cargo:rerun-if-changed=build.rs");
+    // Size builds link the size-first memory routines of src/mem.rs.
+    println!("cargo::rustc-check-cfg=cfg(firmware_size)");
+    println!("cargo:rerun-if-env-changed=OPT_LEVEL");
+    if matches!(env::var("OPT_LEVEL").as_deref(), Ok("s" | "z")) {
+        println!("cargo:rustc-cfg=firmware_size");
+    }
 }

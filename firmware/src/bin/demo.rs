@@ -16,6 +16,8 @@
 mod expected {
     include!(concat!(env!("OUT_DIR"), "/expected.rs"));
 }
+#[path = "../mem.rs"]
+mod mem;
 #[path = "../scenario.rs"]
 mod scenario;
 #[path = "../vectors.rs"]
@@ -158,6 +160,52 @@ impl Checker {
             if ok { "ok" } else { "FAIL" }
         );
     }
+}
+
+extern "C" {
+    // The ARM run-time ABI's aligned copy and clear (src/mem.rs in size builds,
+    // compiler_builtins otherwise): `dest`/`src` 4-byte aligned, `n` any byte count.
+    fn __aeabi_memcpy4(dest: *mut u8, src: *const u8, n: usize);
+    fn __aeabi_memclr4(dest: *mut u8, n: usize);
+}
+
+/// Byte `k` of a little-endian word buffer.
+fn byte(words: &[u32; 12], k: usize) -> u32 {
+    words.get(k / 4).map_or(0, |w| (w >> (8 * (k % 4))) & 0xff)
+}
+
+/// Copies and clears every length from 0 to 40 bytes into word 1 onwards of a 48-byte buffer
+/// filled with guard bytes, and counts the lengths where a byte inside is wrong or a guard byte
+/// (word 0, and everything after the end) changed.
+fn mem_routine_errors() -> u32 {
+    let mut src = [0u32; 12];
+    for (i, w) in src.iter_mut().enumerate() {
+        *w = 0x0403_0201u32.wrapping_mul(i as u32 + 1) ^ 0x8040_2010;
+    }
+    let mut errors = 0;
+    for n in 0..=40usize {
+        let (mut copy, mut clear) = ([0xa5a5_a5a5u32; 12], [0xa5a5_a5a5u32; 12]);
+        // SAFETY: both buffers hold 44 bytes from word 1 on, and n <= 40; all are 4-byte aligned.
+        unsafe {
+            __aeabi_memcpy4(
+                copy.as_mut_ptr().wrapping_add(1).cast(),
+                src.as_ptr().cast(),
+                black_box(n),
+            );
+            __aeabi_memclr4(clear.as_mut_ptr().wrapping_add(1).cast(), black_box(n));
+        }
+        let wrong = (0..48).any(|k| {
+            let inside = (4..4 + n).contains(&k);
+            let (want_copy, want_clear) = if inside {
+                (byte(&src, k - 4), 0)
+            } else {
+                (0xa5, 0xa5)
+            };
+            byte(&copy, k) != want_copy || byte(&clear, k) != want_clear
+        });
+        errors += u32::from(wrong);
+    }
+    errors
 }
 
 fn check_outcome(c: &mut Checker, o: &scenario::Outcome<f32>) {
@@ -311,6 +359,7 @@ fn main() -> ! {
     let (outcome, work) = scenario::run::<f32>();
     let mut c = Checker { failures: 0 };
     check_outcome(&mut c, &outcome);
+    c.equal("mem routines, lengths wrong", mem_routine_errors(), 0);
 
     run_benchmarks(&work);
 

@@ -419,3 +419,6 @@ mod no_panic_handler;
 
 #[path = "../vectors.rs"]
 mod vectors;
+
+#[path = "../mem.rs"]
+mod mem;

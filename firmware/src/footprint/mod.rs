@@ -34,3 +34,6 @@ mod no_panic_handler;
 
 #[path = "../vectors.rs"]
 mod vectors;
+
+#[path = "../mem.rs"]
+mod mem;

@@ -217,6 +217,12 @@ echo "-- opt-level 3 (budgeted)"
 python3 tools/check_budgets.py budgets.txt "$OUT/demo-3.txt" "$OUT/icount-3.txt" "$OUT/extra.txt" \
   || fail "a figure is over its budget"
 
+# The firmware crate is outside the root workspace, so the root's fmt and clippy do not see it.
+step "fmt and clippy of the firmware crate (warnings are errors)"
+cargo fmt --check || fail "cargo fmt --check (firmware)"
+(cd host-check && cargo fmt --check) || fail "cargo fmt --check (firmware/host-check)"
+cargo clippy -q --profile release-s --bins --features f64 -- -D warnings || fail "clippy (firmware)"
+
 if [ "$status" = 0 ]; then
   echo "firmware: all checks passed"
 else

@@ -381,7 +381,9 @@ fn dummy_workload<T: Real>(config: FilterConfig<T>, options: UpdateOptions<T>) -
     // `new` cannot fail on these inputs with the default configuration; loop rather than panic.
     let (ins, ahrs) = match (ins, ahrs) {
         (Ok(i), Ok(a)) => (i, a),
-        _ => loop {},
+        _ => loop {
+            core::hint::spin_loop();
+        },
     };
     Workload {
         ins,

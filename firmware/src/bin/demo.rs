@@ -112,7 +112,7 @@ impl Checker {
             } else {
                 f32::INFINITY
             };
-            if !(d <= worst) {
+            if d > worst || d.is_nan() {
                 worst = d;
             }
         }
@@ -385,12 +385,16 @@ fn main() -> ! {
         hprintln!("RESULT FAIL ({} checks failed)", c.failures);
         debug::exit(debug::EXIT_FAILURE);
     }
-    loop {}
+    loop {
+        cortex_m::asm::nop();
+    }
 }
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     hprintln!("PANIC {}", info);
     debug::exit(debug::EXIT_FAILURE);
-    loop {}
+    loop {
+        cortex_m::asm::nop();
+    }
 }

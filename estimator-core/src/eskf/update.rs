@@ -266,12 +266,8 @@ struct Work<T: Real, const C: usize> {
     ht: SMatrix<T, MAX_STATE, C>,
     /// Residual `r = z ⊖ h(x̂ ⊕ δx)` at the current iterate.
     r: SVector<T, C>,
-    /// `U = P H̃ᵀ`.
-    u: SMatrix<T, MAX_STATE, C>,
-    /// `S = H̃ P H̃ᵀ + R` (identity past `m`).
-    s: SMatrix<T, C, C>,
-    /// `K = U S⁻¹`.
-    k: SMatrix<T, MAX_STATE, C>,
+    /// `U`, `S` and `K` at the current iterate.
+    g: Gain<T, C>,
     /// `S⁻¹` (for the NIS at the prior).
     s_inv: SMatrix<T, C, C>,
     /// The current correction `δx` (the first `n` entries; the rest zero).
@@ -280,6 +276,18 @@ struct Work<T: Real, const C: usize> {
     noise: SMatrix<T, C, C>,
     /// The number of active rows, `M`.
     m: usize,
+}
+
+/// The gain part of the working set: kept together so that the iterated update saves and
+/// restores it as one block (one copy each way instead of three).
+#[derive(Clone, Copy)]
+struct Gain<T: Real, const C: usize> {
+    /// `U = P H̃ᵀ`.
+    u: SMatrix<T, MAX_STATE, C>,
+    /// `S = H̃ P H̃ᵀ + R` (identity past `m`).
+    s: SMatrix<T, C, C>,
+    /// `K = U S⁻¹`.
+    k: SMatrix<T, MAX_STATE, C>,
 }
 
 /// The first `len` entries of `s` (all of `s` if shorter; no caller asks for more).
@@ -355,9 +363,11 @@ where
     let mut w = Work::<T, C> {
         ht: SMatrix::zeros(),
         r: SVector::zeros(),
-        u: SMatrix::zeros(),
-        s: SMatrix::zeros(),
-        k: SMatrix::zeros(),
+        g: Gain {
+            u: SMatrix::zeros(),
+            s: SMatrix::zeros(),
+            k: SMatrix::zeros(),
+        },
         s_inv: SMatrix::zeros(),
         dx: SVector::zeros(),
         noise: SMatrix::zeros(),
@@ -425,7 +435,7 @@ fn gate_step<T: Real, const C: usize>(
         return Ok(UpdateOutcome::Rejected { nis, threshold });
     }
     mat_vec(
-        w.k.as_slice(),
+        w.g.k.as_slice(),
         w.r.as_slice(),
         w.dx.as_mut_slice().get_mut(..n).unwrap_or_default(),
     );
@@ -545,10 +555,10 @@ fn gain_shared<T: Real, const C: usize>(
 ) -> Result<(), EskfError> {
     let (m, r_noise, ht) = (w.m, &w.noise, w.ht.as_slice());
     let (u, s, s_inv_out, k) = (
-        w.u.as_mut_slice(),
-        &mut w.s,
+        w.g.u.as_mut_slice(),
+        &mut w.g.s,
         &mut w.s_inv,
-        w.k.as_mut_slice(),
+        w.g.k.as_mut_slice(),
     );
     // Column c of U = Σ_j P e_j H_cj over the nonzero entries of row c of H only (most models
     // touch 3–6 of the 15 error components).
@@ -728,17 +738,15 @@ fn step_shared<T: Real, const C: usize>(
         return None;
     }
     // The linearization wrote `H̃` and `r` only; the gain overwrites these.
-    let (u, s, k) = (w.u, w.s, w.k);
+    let saved = w.g;
     let ok = gain_into(p, n, w).is_ok();
     // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
     let mut next = SVector::<T, MAX_STATE>::zeros();
     let next = next.as_mut_slice().get_mut(..n).unwrap_or_default();
     let prev = head(w.dx.as_slice(), n);
-    gauss_newton_step(w.ht.as_slice(), w.k.as_slice(), &w.r, w.m, prev, next);
+    gauss_newton_step(w.ht.as_slice(), w.g.k.as_slice(), &w.r, w.m, prev, next);
     if !(ok && sum_times_zero_is_zero(next)) {
-        w.u = u;
-        w.s = s;
-        w.k = k;
+        w.g = saved;
         return None;
     }
     let converged = distance(next, prev) < opts.step_tolerance;
@@ -749,7 +757,7 @@ fn step_shared<T: Real, const C: usize>(
 }
 
 /// Steps 3–4: Joseph-form covariance, injection and reset; writes `x` and `P` only when every
-/// check passed. Overwrites `w.u` (with `V`, see [`commit_shared`]).
+/// check passed. Overwrites `U` (with `V`, see [`commit_shared`]).
 ///
 /// The covariance part is [`commit_shared`], written over a run-time dimension. At opt-level 2
 /// or 3 it is inlined here, into one copy per filter where `n = N` is a constant (the
@@ -788,7 +796,7 @@ fn commit_shared<T: Real, const C: usize>(
     if !(3..=MAX_STATE).contains(&n) {
         return Err(EskfError::NumericalFailure); // no filter has such a state
     }
-    let (m, u, k, s) = (w.m, w.u.as_mut_slice(), w.k.as_slice(), &w.s);
+    let (m, u, k, s) = (w.m, w.g.u.as_mut_slice(), w.g.k.as_slice(), &w.g.s);
     let dx = head(w.dx.as_slice(), n);
     // Joseph form, expanded and written as m symmetric rank-2 corrections:
     //   P⁺ = P − K Uᵀ − U Kᵀ + K S Kᵀ = P + V Kᵀ + K Vᵀ = P + Σ_c (v_c k_cᵀ + k_c v_cᵀ),

@@ -381,11 +381,13 @@ pub(crate) fn predict_ins<T: Real>(
     // `a + b·(−1)` is `a − b` exactly (IEEE 754 negation is exact).
     let omega = axpy(&imu.gyro, &x.gyro_bias, -T::one());
     let f = axpy(&imu.accel, &x.accel_bias, -T::one());
-    let (dr, jr) = So3::exp_jac(&(omega * dt));
+    // Read in place (`e.0`, `e.1`), not destructured into copies at opt-level "s".
+    let e = So3::exp_jac(&(omega * dt));
+    let (dr, jr) = (&e.0, e.1);
     let r = x.attitude.rotation_matrix();
     let a = super::models::add3(&mv(&r, &f), &cfg.gravity);
     let new_x = InsState {
-        attitude: x.attitude.compose(&dr).renormalize(),
+        attitude: x.attitude.compose(dr).renormalize(),
         velocity: axpy(&x.velocity, &a, dt),
         position: axpy(&axpy(&x.position, &x.velocity, dt), &a, half * dt * dt),
         gyro_bias: x.gyro_bias,

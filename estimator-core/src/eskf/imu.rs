@@ -320,16 +320,19 @@ impl<T: Real> FRows<T> {
     /// Block rows 0..2 of `F Q` for a block column `Q = (Q₀, …, Q₄)`:
     /// `(F Q)₀ = F00 Q₀ + F03 Q₃` (only when `rot`, else zero), `(F Q)₁ = Q₁ + C`,
     /// `(F Q)₂ = Q₂ + dt (Q₁ + ½ C)`, with `C = A Q₀ + B Q₄ = B([f]× Q₀ + Q₄)`.
-    fn apply(&self, q: &[T; 45], rot: bool) -> [Matrix3<T>; 3] {
+    ///
+    /// Written into `out` (no copies of the blocks through a returned array).
+    fn apply(&self, q: &[T; 45], rot: bool, out: &mut [Matrix3<T>; 3]) {
         let (q0, q1) = (col_blk(q, 0), col_blk(q, 1));
         let c = mm(&self.b, &add33(&mm(&self.fx, &q0), &col_blk(q, 4)));
-        let top = if rot {
+        let [top, v, p] = out;
+        *top = if rot {
             add33(&mm(&self.f00, &q0), &mm(&self.f03, &col_blk(q, 3)))
         } else {
             Matrix3::zeros()
         };
-        let p_row = row_p(col_blk(q, 2), &q1, &c, self.dt);
-        [top, add33(&q1, &c), p_row]
+        *p = row_p(col_blk(q, 2), &q1, &c, self.dt);
+        *v = add33(&q1, &c);
     }
 }
 
@@ -414,6 +417,7 @@ pub(crate) fn predict_ins<T: Real>(
     //   place of L_ki: block column i of L is read once, and later columns are untouched.
     //   N_3i = L_3i and N_4i = L_4i (identity rows of F) are already there.
     let mut l = SMatrix::<T, 15, 9>::zeros();
+    let mut out = [Matrix3::<T>::zeros(); 3];
     for t in 0..8 {
         let (src, j) = if t < 5 {
             (p.as_slice(), t)
@@ -425,7 +429,7 @@ pub(crate) fn predict_ins<T: Real>(
         };
         // Row θ of F Q: for every column of F P, but of F L only N_00 (N_0i, i > 0, lies above
         // the diagonal).
-        let out = fr.apply(q, t <= 5);
+        fr.apply(q, t <= 5, &mut out);
         for (i, m) in out.iter().enumerate() {
             if t < 5 {
                 set_blk_rc(&mut l, j, i, &tr33(m));

@@ -397,13 +397,16 @@ pub(crate) fn predict_ins<T: Real>(
         accel_bias: x.accel_bias,
     };
 
-    let fr = FRows {
+    // F03 = J_r·(−dt) and B = R·(−dt) scaled in place (no copies into the struct).
+    let mut fr = FRows {
         f00: tr33(&dr.rotation_matrix()),
-        f03: scaled(jr, -dt),
-        b: scaled(r, -dt),
+        f03: jr,
+        b: r,
         fx: skew(&f),
         dt,
     };
+    scale(&mut fr.f03, -dt);
+    scale(&mut fr.b, -dt);
     let f_finite =
         finite_vec(&fr.f00) && finite_vec(&fr.f03) && finite_vec(&fr.b) && finite_vec(&fr.fx);
     // Two passes of the same kernel, `FRows::apply` (the nonzero blocks of F's rows θ, v, p
@@ -537,10 +540,15 @@ pub(crate) fn predict_ahrs<T: Real>(
 
 /// `m·s`, entry by entry over the storage (one small loop at opt-level "s").
 fn scaled<T: Real>(mut m: Matrix3<T>, s: T) -> Matrix3<T> {
+    scale(&mut m, s);
+    m
+}
+
+/// `m ← m·s`, entry by entry over the storage.
+fn scale<T: Real>(m: &mut Matrix3<T>, s: T) {
     for x in m.as_mut_slice() {
         *x *= s;
     }
-    m
 }
 
 /// `√max(P_ii, 0)` for each `i`: a filter's 1-σ, entry by entry over the storage (nalgebra's

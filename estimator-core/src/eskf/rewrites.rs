@@ -786,3 +786,48 @@ fn attitude_jacobian_is_the_block_loop() {
     attitude_jacobian_case::<f32, 6>(53);
     attitude_jacobian_case::<f64, 6>(54);
 }
+
+/// The covariance write-out of the update's commit against the former loops: rows 3.. mirrored
+/// from the upper triangle, then rows and columns 0..3 written both ways from `top`, block
+/// (0, 0) from `c00` (exactly symmetric, from `sym`); on an asymmetric `P` with special values.
+fn write_rows_case<T: Real, const N: usize>(seed: u64) {
+    use super::update::{write_rows, MAX_STATE};
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    for i in 0..300 {
+        let p0 = SMatrix::<T, N, N>::from_fn(|r, c| number(&mut rng, i + 3 * r + c));
+        let mut top = [Vector3::<T>::zeros(); MAX_STATE];
+        for (j, t) in top.iter_mut().enumerate().take(N) {
+            *t = Vector3::from_fn(|r, _| number(&mut rng, i / 3 + r + j));
+        }
+        let a = Matrix3::<T>::from_fn(|r, c| number(&mut rng, i / 2 + r + 2 * c));
+        let c00 = super::imu::sym(&a);
+
+        let mut old = p0;
+        let p = old.as_mut_slice();
+        for j in 3..N {
+            for i in 3..j {
+                p[i * N + j] = p[j * N + i];
+            }
+        }
+        for (j, col) in top.iter().enumerate().take(N) {
+            for (a, v) in col.iter().enumerate() {
+                let v = if j < 3 { c00[(a, j)] } else { *v };
+                p[j * N + a] = v;
+                p[a * N + j] = v;
+            }
+        }
+        let mut new = p0;
+        let mut t = top;
+        write_rows(new.as_mut_slice(), N, &mut t, &c00);
+        assert!(same(new.as_slice(), old.as_slice()));
+    }
+}
+
+#[test]
+fn covariance_write_out_is_the_former_loops() {
+    write_rows_case::<f32, 15>(211);
+    write_rows_case::<f32, 6>(223);
+    write_rows_case::<f64, 15>(227);
+    write_rows_case::<f64, 6>(229);
+}

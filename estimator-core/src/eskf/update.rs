@@ -100,7 +100,7 @@ pub(crate) fn check_spd<T: Real, const M: usize>(r: &SMatrix<T, M, M>) -> bool {
 
 /// The largest error state (`Ins`, 15): the size of the fixed buffers of the shared update
 /// steps ([`commit_shared`]).
-const MAX_STATE: usize = 15;
+pub(crate) const MAX_STATE: usize = 15;
 
 /// `A = L Lᵀ` in place on the column-major storage `l` of an `n × n` matrix, operation for
 /// operation as `nalgebra::Cholesky::new` (the same bits, failing exactly when it fails): column
@@ -863,32 +863,45 @@ fn commit_shared<T: Real, const C: usize>(
             }
         }
     }
-    // Mirror that triangle; then rows 0..3 ← top, columns 0..3 ← topᵀ, block (0, 0) ← c00
-    // (element by element: no transposed temporary).
-    for j in 3..n {
-        for i in 3..j {
+    write_rows(p, n, &mut top, &c00);
+    Ok(())
+}
+
+/// The last step of [`commit_shared`] on the column-major `n × n` storage `p` whose upper
+/// triangle from row 3 on is final: rows 0..3 ← `top` (column `j` of those rows is `top[j]`),
+/// block (0, 0) ← `c00` (overwriting `top[0..3]`), then the whole upper triangle mirrored
+/// (element by element: no transposed temporary). `c00` is exactly symmetric (from `sym`), so
+/// mirroring its upper half leaves it as written: the same matrix as mirroring rows 3.. and
+/// writing `top` and `c00` both ways, with one store per entry instead of two.
+#[inline(always)]
+pub(crate) fn write_rows<T: Real>(
+    p: &mut [T],
+    n: usize,
+    top: &mut [Vector3<T>; MAX_STATE],
+    c00: &Matrix3<T>,
+) {
+    for (t, c) in top.iter_mut().zip(c00.as_slice().chunks_exact(3)) {
+        copy_into(t.as_mut_slice(), c);
+    }
+    for (col, t) in p.chunks_exact_mut(n.max(1)).zip(top.iter()) {
+        copy_into(col, t.as_slice());
+    }
+    for j in 1..n {
+        for i in 0..j {
             let u = at(p, j * n + i);
             if let Some(e) = p.get_mut(i * n + j) {
                 *e = u;
             }
         }
     }
-    for (j, col) in top.iter().enumerate().take(n) {
-        for (a, v) in col.as_slice().iter().enumerate() {
-            let v = if j < 3 {
-                c00.get((a, j)).copied().unwrap_or(*v)
-            } else {
-                *v
-            };
-            if let Some(e) = p.get_mut(j * n + a) {
-                *e = v;
-            }
-            if let Some(e) = p.get_mut(a * n + j) {
-                *e = v;
-            }
-        }
+}
+
+/// `dst[i] = src[i]` over the shorter of the two.
+#[inline(always)]
+fn copy_into<T: Real>(dst: &mut [T], src: &[T]) {
+    for (d, s) in dst.iter_mut().zip(src) {
+        *d = *s;
     }
-    Ok(())
 }
 
 /// `s[i]`, or zero past the end (never reached: every caller indexes below the length).

@@ -23,7 +23,7 @@ fn iso3<T: Real>(sigma: T) -> Matrix3<T> {
 /// `(column, block)` go to columns `column..column + 3`. One helper for every model, so that
 /// each shape has one copy of the loop.
 pub(crate) fn jacobian<T: Real, const M: usize, const N: usize>(
-    blocks: &[(usize, Matrix3<T>)],
+    blocks: &[(usize, &Matrix3<T>)],
 ) -> SMatrix<T, M, N> {
     let mut h = SMatrix::<T, M, N>::zeros();
     for (col, b) in blocks {
@@ -611,7 +611,8 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
         }
         Ok(Linearization {
             residual: Vector2::new(self.pixel.x - uv.x, self.pixel.y - uv.y),
-            jacobian: jacobian(&[(0, mm(&jc, &skew(q))), (6, jp)]),
+            // The blocks by reference (no copies into the list).
+            jacobian: jacobian(&[(0, &mm(&jc, &skew(q))), (6, &jp)]),
         })
     }
     fn noise(&self) -> Matrix2<T> {

@@ -759,14 +759,14 @@ fn heading_linearization_is_the_former_body() {
 }
 
 /// `attitude_jacobian` (the block store) against the block loop it replaces,
-/// `jacobian(&[(0, b)])`, bit for bit (special values included).
+/// `jacobian(&[(0, &b)])`, bit for bit (special values included).
 fn attitude_jacobian_case<T: Real, const N: usize>(seed: u64) {
     use super::models::{attitude_jacobian, jacobian};
     let mut rng = Lcg(seed);
     for i in 0..300 {
         let b = Matrix3::<T>::from_fn(|r, c| number(&mut rng, i + 3 * r + c));
         let new = attitude_jacobian::<T, N>(&b);
-        let old = jacobian::<T, 3, N>(&[(0, b)]);
+        let old = jacobian::<T, 3, N>(&[(0, &b)]);
         assert!(same(new.as_slice(), old.as_slice()));
     }
 }

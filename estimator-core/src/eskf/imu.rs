@@ -453,15 +453,7 @@ pub(crate) fn predict_ins<T: Real>(
         return Err(EskfError::NonFinite);
     }
     // Write the lower blocks and their transposes; P_33, P_34, P_44 are unchanged before Q.
-    for i in 0..3 {
-        for k in i..5 {
-            let n = blk_rc(&l, k, i);
-            set_blk(p, k, i, &n);
-            if k > i {
-                set_blk(p, i, k, &tr33(&n));
-            }
-        }
-    }
+    write_lower(p, &l);
     let n = &cfg.imu_noise;
     let qa = n.accelerometer_noise_density * n.accelerometer_noise_density * dt;
     add_diag(
@@ -480,6 +472,46 @@ pub(crate) fn predict_ins<T: Real>(
     );
     *x = new_x;
     Ok(())
+}
+
+/// Writes the blocks `N_ki = L_ki`, `k ≥ i`, of block columns 0..3 of `L` into `P`, with
+/// `N_ik = N_kiᵀ` above them. Built for size, entry by entry over `L`'s storage: column `c`
+/// (block column `c/3`) from the diagonal block's first row down, each entry also mirrored
+/// above the diagonal block (`N_ii`, symmetric, is in `L` whole); the same stores as the block
+/// loop below.
+#[cfg(estimator_compact)]
+#[inline(always)]
+pub(crate) fn write_lower<T: Real>(p: &mut SMatrix<T, 15, 15>, l: &SMatrix<T, 15, 9>) {
+    let ps = p.as_mut_slice();
+    for (c, lc) in l.as_slice().chunks_exact(15).enumerate() {
+        let start = c - c % 3;
+        for (r, v) in lc.iter().enumerate().skip(start) {
+            if let Some(e) = ps.get_mut(15 * c + r) {
+                *e = *v;
+            }
+            if r >= start + 3 {
+                if let Some(e) = ps.get_mut(15 * r + c) {
+                    *e = *v;
+                }
+            }
+        }
+    }
+}
+
+/// The blocks of `L` into `P` (see the build for size above), block by block: at opt-level 2
+/// or 3 the copies unroll (the prediction's instruction count is budgeted).
+#[cfg(not(estimator_compact))]
+#[inline(always)]
+pub(crate) fn write_lower<T: Real>(p: &mut SMatrix<T, 15, 15>, l: &SMatrix<T, 15, 9>) {
+    for i in 0..3 {
+        for k in i..5 {
+            let n = blk_rc(l, k, i);
+            set_blk(p, k, i, &n);
+            if k > i {
+                set_blk(p, i, k, &tr33(&n));
+            }
+        }
+    }
 }
 
 impl<T: Real> InsState<T> {

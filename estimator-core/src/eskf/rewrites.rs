@@ -823,3 +823,34 @@ fn covariance_write_out_is_the_former_loops() {
     write_rows_case::<f64, 15>(227);
     write_rows_case::<f64, 6>(229);
 }
+
+/// The prediction's write-out of `N = F P Fᵀ` (both builds: entry by entry when built for size)
+/// against the block loop: blocks `L_ki`, `k ≥ i < 3`, into `P` and their transposes above.
+fn write_lower_case<T: Real>(seed: u64) {
+    use super::imu::{blk_rc, set_blk, tr33, write_lower};
+    use nalgebra::SMatrix;
+    let mut rng = Lcg(seed);
+    for i in 0..200 {
+        let p0 = SMatrix::<T, 15, 15>::from_fn(|r, c| number(&mut rng, i + 2 * r + c));
+        let l = SMatrix::<T, 15, 9>::from_fn(|r, c| number(&mut rng, i / 2 + r + 3 * c));
+        let mut old = p0;
+        for bi in 0..3 {
+            for k in bi..5 {
+                let n = blk_rc(&l, k, bi);
+                set_blk(&mut old, k, bi, &n);
+                if k > bi {
+                    set_blk(&mut old, bi, k, &tr33(&n));
+                }
+            }
+        }
+        let mut new = p0;
+        write_lower(&mut new, &l);
+        assert!(same(new.as_slice(), old.as_slice()));
+    }
+}
+
+#[test]
+fn prediction_write_out_is_the_block_loop() {
+    write_lower_case::<f32>(233);
+    write_lower_case::<f64>(239);
+}

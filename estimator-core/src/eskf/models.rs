@@ -54,10 +54,13 @@ fn attitude_only<T: Real, const N: usize>(
     parts: Result<(Vector3<T>, Matrix3<T>), EskfError>,
 ) -> Result<Linearization<T, N, 3>, EskfError> {
     let (residual, h_att) = parts?;
-    Ok(Linearization {
+    // The block stored into the result's own Jacobian (not built aside and copied in).
+    let mut lin = Linearization {
         residual,
-        jacobian: attitude_jacobian(&h_att),
-    })
+        jacobian: SMatrix::zeros(),
+    };
+    set_blk_rc(&mut lin.jacobian, 0, 0, &h_att);
+    Ok(lin)
 }
 
 /// Sets the identity block in columns `col..col + 3` of `h` (the models that observe a vector

@@ -40,7 +40,9 @@ pub(crate) fn jacobian<T: Real, const M: usize, const N: usize>(
 
 /// The `3 × N` Jacobian that is `b` in columns `0..3` and zero elsewhere: the block written by
 /// the filters' block store (one out-of-line copy for every shape when built for size) instead
-/// of a block loop per shape.
+/// of a block loop per shape. The models write it in place, into their result's zeroed
+/// Jacobian (no copy of it); this function is that construction, for the tests.
+#[cfg(test)]
 pub(crate) fn attitude_jacobian<T: Real, const N: usize>(b: &Matrix3<T>) -> SMatrix<T, 3, N> {
     let mut h = SMatrix::<T, 3, N>::zeros();
     set_blk_rc(&mut h, 0, 0, b);
@@ -152,8 +154,9 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssPosition<T> {
         let (rl, d_att, _) = x.attitude.act_jac(&self.lever_arm);
         let mut lin = Linearization {
             residual: sub3(&self.position, &add3(&x.position, &rl)),
-            jacobian: attitude_jacobian(&d_att),
+            jacobian: SMatrix::zeros(),
         };
+        set_blk_rc(&mut lin.jacobian, 0, 0, &d_att);
         set_identity(&mut lin.jacobian, 6);
         Ok(lin)
     }
@@ -414,8 +417,9 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
         let b = in_body(&x.attitude, &neg3(&self.gravity));
         let mut lin = Linearization {
             residual: sub3(&self.accel, &add3(&b.0, &x.accel_bias)),
-            jacobian: attitude_jacobian(&b.1),
+            jacobian: SMatrix::zeros(),
         };
+        set_blk_rc(&mut lin.jacobian, 0, 0, &b.1);
         set_identity(&mut lin.jacobian, 12);
         Ok(lin)
     }

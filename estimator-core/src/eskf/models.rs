@@ -262,14 +262,14 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 1> for BaroAltitude<T> {
         if !(self.altitude.is_finite() && self.offset.is_finite()) {
             return Err(EskfError::NonFinite);
         }
-        let mut h = SMatrix::<T, 1, 15>::zeros();
-        if let Some(e) = h.get_mut((0, 8)) {
+        let mut lin = Linearization {
+            residual: Vector1::new(self.altitude - (x.position.z + self.offset)),
+            jacobian: SMatrix::<T, 1, 15>::zeros(),
+        };
+        if let Some(e) = lin.jacobian.get_mut((0, 8)) {
             *e = T::one();
         }
-        Ok(Linearization {
-            residual: Vector1::new(self.altitude - (x.position.z + self.offset)),
-            jacobian: h,
-        })
+        Ok(lin)
     }
     fn noise(&self) -> Matrix1<T> {
         self.noise

@@ -836,7 +836,7 @@ fn commit_shared<T: Real, const C: usize>(
             for (e, (a, b)) in c0.as_mut_slice().iter_mut().zip(vc.iter().zip(kc)) {
                 *e += *a * kj + *b * vj;
             }
-            d = d + vj * kj;
+            d += vj * kj;
         }
         if j >= 3 {
             diag_ok &= ok(at(pc, j) + d * two);

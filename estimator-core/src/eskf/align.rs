@@ -70,21 +70,16 @@ fn level_axis<T: Real>(u: &Vector3<T>) -> Option<Vector3<T>> {
     horizontal(&Vector3::x(), u).or_else(|| horizontal(&Vector3::y(), u))
 }
 
-/// The triad `[u, h, u × h]` (columns), or its transpose (rows) when `transposed`; the cross
-/// product written out as nalgebra's `cross` (the same products and differences), without its
-/// generic code.
+/// The triad `[u, h, u × h]` (columns); the cross product written out as nalgebra's `cross`
+/// (the same products and differences), without its generic code.
 #[cfg_attr(estimator_compact, inline(never))]
-pub(crate) fn triad<T: Real>(u: &Vector3<T>, h: &Vector3<T>, transposed: bool) -> Matrix3<T> {
+pub(crate) fn triad<T: Real>(u: &Vector3<T>, h: &Vector3<T>) -> Matrix3<T> {
     let c = Vector3::new(
         u.y * h.z - u.z * h.y,
         u.z * h.x - u.x * h.z,
         u.x * h.y - u.y * h.x,
     );
-    if transposed {
-        Matrix3::new(u.x, u.y, u.z, h.x, h.y, h.z, c.x, c.y, c.z)
-    } else {
-        Matrix3::new(u.x, h.x, c.x, u.y, h.y, c.y, u.z, h.z, c.z)
-    }
+    Matrix3::new(u.x, h.x, c.x, u.y, h.y, c.y, u.z, h.z, c.z)
 }
 
 /// Static alignment from samples at rest.
@@ -139,7 +134,7 @@ pub fn align_at_rest<T: Real>(
     };
     let from_mag = mag.is_some();
     // R = W Bᵀ, W = [u_w, h_w, u_w × h_w], B = [u_b, h_b, u_b × h_b] (columns).
-    let attitude = So3::from_rotation_matrix(&mm(&triad(&uw, hw, false), &triad(&ub, hb, true)));
+    let attitude = So3::from_rotation_matrix(&mm(&triad(&uw, hw), &tr33(&triad(&ub, hb))));
     let Some(attitude) = &attitude else {
         return Err(EskfError::NonFinite);
     };

@@ -320,16 +320,19 @@ impl<T: Real> FRows<T> {
     /// Block rows 0..2 of `F Q` for a block column `Q = (Q₀, …, Q₄)`:
     /// `(F Q)₀ = F00 Q₀ + F03 Q₃` (only when `rot`, else zero), `(F Q)₁ = Q₁ + C`,
     /// `(F Q)₂ = Q₂ + dt (Q₁ + ½ C)`, with `C = A Q₀ + B Q₄ = B([f]× Q₀ + Q₄)`.
-    fn apply(&self, q: &[T; 45], rot: bool) -> [Matrix3<T>; 3] {
+    ///
+    /// Written into `out` (no copies of the blocks through a returned array).
+    fn apply(&self, q: &[T; 45], rot: bool, out: &mut [Matrix3<T>; 3]) {
         let (q0, q1) = (col_blk(q, 0), col_blk(q, 1));
         let c = mm(&self.b, &add33(&mm(&self.fx, &q0), &col_blk(q, 4)));
-        let top = if rot {
+        let [top, v, p] = out;
+        *top = if rot {
             add33(&mm(&self.f00, &q0), &mm(&self.f03, &col_blk(q, 3)))
         } else {
             Matrix3::zeros()
         };
-        let p_row = row_p(col_blk(q, 2), &q1, &c, self.dt);
-        [top, add33(&q1, &c), p_row]
+        *p = row_p(col_blk(q, 2), &q1, &c, self.dt);
+        *v = add33(&q1, &c);
     }
 }
 
@@ -381,24 +384,29 @@ pub(crate) fn predict_ins<T: Real>(
     // `a + b·(−1)` is `a − b` exactly (IEEE 754 negation is exact).
     let omega = axpy(&imu.gyro, &x.gyro_bias, -T::one());
     let f = axpy(&imu.accel, &x.accel_bias, -T::one());
-    let (dr, jr) = So3::exp_jac(&(omega * dt));
+    // Read in place (`e.0`, `e.1`), not destructured into copies at opt-level "s".
+    let e = So3::exp_jac(&(omega * dt));
+    let (dr, jr) = (&e.0, e.1);
     let r = x.attitude.rotation_matrix();
     let a = super::models::add3(&mv(&r, &f), &cfg.gravity);
     let new_x = InsState {
-        attitude: x.attitude.compose(&dr).renormalize(),
+        attitude: x.attitude.compose(dr).renormalize(),
         velocity: axpy(&x.velocity, &a, dt),
         position: axpy(&axpy(&x.position, &x.velocity, dt), &a, half * dt * dt),
         gyro_bias: x.gyro_bias,
         accel_bias: x.accel_bias,
     };
 
-    let fr = FRows {
+    // F03 = J_r·(−dt) and B = R·(−dt) scaled in place (no copies into the struct).
+    let mut fr = FRows {
         f00: tr33(&dr.rotation_matrix()),
-        f03: scaled(jr, -dt),
-        b: scaled(r, -dt),
+        f03: jr,
+        b: r,
         fx: skew(&f),
         dt,
     };
+    scale(&mut fr.f03, -dt);
+    scale(&mut fr.b, -dt);
     let f_finite =
         finite_vec(&fr.f00) && finite_vec(&fr.f03) && finite_vec(&fr.b) && finite_vec(&fr.fx);
     // Two passes of the same kernel, `FRows::apply` (the nonzero blocks of F's rows θ, v, p
@@ -412,6 +420,7 @@ pub(crate) fn predict_ins<T: Real>(
     //   place of L_ki: block column i of L is read once, and later columns are untouched.
     //   N_3i = L_3i and N_4i = L_4i (identity rows of F) are already there.
     let mut l = SMatrix::<T, 15, 9>::zeros();
+    let mut out = [Matrix3::<T>::zeros(); 3];
     for t in 0..8 {
         let (src, j) = if t < 5 {
             (p.as_slice(), t)
@@ -423,7 +432,7 @@ pub(crate) fn predict_ins<T: Real>(
         };
         // Row θ of F Q: for every column of F P, but of F L only N_00 (N_0i, i > 0, lies above
         // the diagonal).
-        let out = fr.apply(q, t <= 5);
+        fr.apply(q, t <= 5, &mut out);
         for (i, m) in out.iter().enumerate() {
             if t < 5 {
                 set_blk_rc(&mut l, j, i, &tr33(m));
@@ -444,15 +453,7 @@ pub(crate) fn predict_ins<T: Real>(
         return Err(EskfError::NonFinite);
     }
     // Write the lower blocks and their transposes; P_33, P_34, P_44 are unchanged before Q.
-    for i in 0..3 {
-        for k in i..5 {
-            let n = blk_rc(&l, k, i);
-            set_blk(p, k, i, &n);
-            if k > i {
-                set_blk(p, i, k, &tr33(&n));
-            }
-        }
-    }
+    write_lower(p, &l);
     let n = &cfg.imu_noise;
     let qa = n.accelerometer_noise_density * n.accelerometer_noise_density * dt;
     add_diag(
@@ -471,6 +472,46 @@ pub(crate) fn predict_ins<T: Real>(
     );
     *x = new_x;
     Ok(())
+}
+
+/// Writes the blocks `N_ki = L_ki`, `k ≥ i`, of block columns 0..3 of `L` into `P`, with
+/// `N_ik = N_kiᵀ` above them. Built for size, entry by entry over `L`'s storage: column `c`
+/// (block column `c/3`) from the diagonal block's first row down, each entry also mirrored
+/// above the diagonal block (`N_ii`, symmetric, is in `L` whole); the same stores as the block
+/// loop below.
+#[cfg(estimator_compact)]
+#[inline(always)]
+pub(crate) fn write_lower<T: Real>(p: &mut SMatrix<T, 15, 15>, l: &SMatrix<T, 15, 9>) {
+    let ps = p.as_mut_slice();
+    for (c, lc) in l.as_slice().chunks_exact(15).enumerate() {
+        let start = c - c % 3;
+        for (r, v) in lc.iter().enumerate().skip(start) {
+            if let Some(e) = ps.get_mut(15 * c + r) {
+                *e = *v;
+            }
+            if r >= start + 3 {
+                if let Some(e) = ps.get_mut(15 * r + c) {
+                    *e = *v;
+                }
+            }
+        }
+    }
+}
+
+/// The blocks of `L` into `P` (see the build for size above), block by block: at opt-level 2
+/// or 3 the copies unroll (the prediction's instruction count is budgeted).
+#[cfg(not(estimator_compact))]
+#[inline(always)]
+pub(crate) fn write_lower<T: Real>(p: &mut SMatrix<T, 15, 15>, l: &SMatrix<T, 15, 9>) {
+    for i in 0..3 {
+        for k in i..5 {
+            let n = blk_rc(l, k, i);
+            set_blk(p, k, i, &n);
+            if k > i {
+                set_blk(p, i, k, &tr33(&n));
+            }
+        }
+    }
 }
 
 impl<T: Real> InsState<T> {
@@ -531,10 +572,15 @@ pub(crate) fn predict_ahrs<T: Real>(
 
 /// `m·s`, entry by entry over the storage (one small loop at opt-level "s").
 fn scaled<T: Real>(mut m: Matrix3<T>, s: T) -> Matrix3<T> {
+    scale(&mut m, s);
+    m
+}
+
+/// `m ← m·s`, entry by entry over the storage.
+fn scale<T: Real>(m: &mut Matrix3<T>, s: T) {
     for x in m.as_mut_slice() {
         *x *= s;
     }
-    m
 }
 
 /// `√max(P_ii, 0)` for each `i`: a filter's 1-σ, entry by entry over the storage (nalgebra's

@@ -23,7 +23,7 @@ fn iso3<T: Real>(sigma: T) -> Matrix3<T> {
 /// `(column, block)` go to columns `column..column + 3`. One helper for every model, so that
 /// each shape has one copy of the loop.
 pub(crate) fn jacobian<T: Real, const M: usize, const N: usize>(
-    blocks: &[(usize, Matrix3<T>)],
+    blocks: &[(usize, &Matrix3<T>)],
 ) -> SMatrix<T, M, N> {
     let mut h = SMatrix::<T, M, N>::zeros();
     for (col, b) in blocks {
@@ -40,7 +40,9 @@ pub(crate) fn jacobian<T: Real, const M: usize, const N: usize>(
 
 /// The `3 × N` Jacobian that is `b` in columns `0..3` and zero elsewhere: the block written by
 /// the filters' block store (one out-of-line copy for every shape when built for size) instead
-/// of a block loop per shape.
+/// of a block loop per shape. The models write it in place, into their result's zeroed
+/// Jacobian (no copy of it); this function is that construction, for the tests.
+#[cfg(test)]
 pub(crate) fn attitude_jacobian<T: Real, const N: usize>(b: &Matrix3<T>) -> SMatrix<T, 3, N> {
     let mut h = SMatrix::<T, 3, N>::zeros();
     set_blk_rc(&mut h, 0, 0, b);
@@ -54,10 +56,13 @@ fn attitude_only<T: Real, const N: usize>(
     parts: Result<(Vector3<T>, Matrix3<T>), EskfError>,
 ) -> Result<Linearization<T, N, 3>, EskfError> {
     let (residual, h_att) = parts?;
-    Ok(Linearization {
+    // The block stored into the result's own Jacobian (not built aside and copied in).
+    let mut lin = Linearization {
         residual,
-        jacobian: attitude_jacobian(&h_att),
-    })
+        jacobian: SMatrix::zeros(),
+    };
+    set_blk_rc(&mut lin.jacobian, 0, 0, &h_att);
+    Ok(lin)
 }
 
 /// Sets the identity block in columns `col..col + 3` of `h` (the models that observe a vector
@@ -149,8 +154,9 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for GnssPosition<T> {
         let (rl, d_att, _) = x.attitude.act_jac(&self.lever_arm);
         let mut lin = Linearization {
             residual: sub3(&self.position, &add3(&x.position, &rl)),
-            jacobian: attitude_jacobian(&d_att),
+            jacobian: SMatrix::zeros(),
         };
+        set_blk_rc(&mut lin.jacobian, 0, 0, &d_att);
         set_identity(&mut lin.jacobian, 6);
         Ok(lin)
     }
@@ -256,14 +262,14 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 1> for BaroAltitude<T> {
         if !(self.altitude.is_finite() && self.offset.is_finite()) {
             return Err(EskfError::NonFinite);
         }
-        let mut h = SMatrix::<T, 1, 15>::zeros();
-        if let Some(e) = h.get_mut((0, 8)) {
+        let mut lin = Linearization {
+            residual: Vector1::new(self.altitude - (x.position.z + self.offset)),
+            jacobian: SMatrix::<T, 1, 15>::zeros(),
+        };
+        if let Some(e) = lin.jacobian.get_mut((0, 8)) {
             *e = T::one();
         }
-        Ok(Linearization {
-            residual: Vector1::new(self.altitude - (x.position.z + self.offset)),
-            jacobian: h,
-        })
+        Ok(lin)
     }
     fn noise(&self) -> Matrix1<T> {
         self.noise
@@ -411,8 +417,9 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
         let b = in_body(&x.attitude, &neg3(&self.gravity));
         let mut lin = Linearization {
             residual: sub3(&self.accel, &add3(&b.0, &x.accel_bias)),
-            jacobian: attitude_jacobian(&b.1),
+            jacobian: SMatrix::zeros(),
         };
+        set_blk_rc(&mut lin.jacobian, 0, 0, &b.1);
         set_identity(&mut lin.jacobian, 12);
         Ok(lin)
     }
@@ -611,7 +618,8 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
         }
         Ok(Linearization {
             residual: Vector2::new(self.pixel.x - uv.x, self.pixel.y - uv.y),
-            jacobian: jacobian(&[(0, mm(&jc, &skew(q))), (6, jp)]),
+            // The blocks by reference (no copies into the list).
+            jacobian: jacobian(&[(0, &mm(&jc, &skew(q))), (6, &jp)]),
         })
     }
     fn noise(&self) -> Matrix2<T> {

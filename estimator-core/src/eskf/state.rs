@@ -96,15 +96,16 @@ pub(crate) fn seg<T: Real, const N: usize>(dx: &SVector<T, N>, k: usize) -> Vect
     }
 }
 
-/// `v + dx[k..k + 3]`, entry by entry (the same sums as `v + dx.fixed_rows::<3>(k)`).
-#[cfg_attr(estimator_compact, inline(never))]
+/// `v + dx[k..k + 3]`, entry by entry (the same sums as `v + dx.fixed_rows::<3>(k)`): the
+/// segment read here, the sum by the shared out-of-line [`add3`](super::models::add3) (one
+/// copy for both states).
+#[inline(always)]
 pub(crate) fn plus_seg<T: Real, const N: usize>(
     v: &Vector3<T>,
     dx: &SVector<T, N>,
     k: usize,
 ) -> Vector3<T> {
-    let d = seg(dx, k);
-    Vector3::new(v.x + d.x, v.y + d.y, v.z + d.z)
+    super::models::add3(v, &seg(dx, k))
 }
 
 /// The attitude-only nominal state `x = (R, b_g)`, error `δx = (δθ, δb_g) ∈ R⁶`.

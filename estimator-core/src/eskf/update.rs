@@ -100,7 +100,7 @@ pub(crate) fn check_spd<T: Real, const M: usize>(r: &SMatrix<T, M, M>) -> bool {
 
 /// The largest error state (`Ins`, 15): the size of the fixed buffers of the shared update
 /// steps ([`commit_shared`]).
-const MAX_STATE: usize = 15;
+pub(crate) const MAX_STATE: usize = 15;
 
 /// `A = L Lᵀ` in place on the column-major storage `l` of an `n × n` matrix, operation for
 /// operation as `nalgebra::Cholesky::new` (the same bits, failing exactly when it fails): column
@@ -266,12 +266,8 @@ struct Work<T: Real, const C: usize> {
     ht: SMatrix<T, MAX_STATE, C>,
     /// Residual `r = z ⊖ h(x̂ ⊕ δx)` at the current iterate.
     r: SVector<T, C>,
-    /// `U = P H̃ᵀ`.
-    u: SMatrix<T, MAX_STATE, C>,
-    /// `S = H̃ P H̃ᵀ + R` (identity past `m`).
-    s: SMatrix<T, C, C>,
-    /// `K = U S⁻¹`.
-    k: SMatrix<T, MAX_STATE, C>,
+    /// `U`, `S` and `K` at the current iterate.
+    g: Gain<T, C>,
     /// `S⁻¹` (for the NIS at the prior).
     s_inv: SMatrix<T, C, C>,
     /// The current correction `δx` (the first `n` entries; the rest zero).
@@ -280,6 +276,18 @@ struct Work<T: Real, const C: usize> {
     noise: SMatrix<T, C, C>,
     /// The number of active rows, `M`.
     m: usize,
+}
+
+/// The gain part of the working set: kept together so that the iterated update saves and
+/// restores it as one block (one copy each way instead of three).
+#[derive(Clone, Copy)]
+struct Gain<T: Real, const C: usize> {
+    /// `U = P H̃ᵀ`.
+    u: SMatrix<T, MAX_STATE, C>,
+    /// `S = H̃ P H̃ᵀ + R` (identity past `m`).
+    s: SMatrix<T, C, C>,
+    /// `K = U S⁻¹`.
+    k: SMatrix<T, MAX_STATE, C>,
 }
 
 /// The first `len` entries of `s` (all of `s` if shorter; no caller asks for more).
@@ -355,9 +363,11 @@ where
     let mut w = Work::<T, C> {
         ht: SMatrix::zeros(),
         r: SVector::zeros(),
-        u: SMatrix::zeros(),
-        s: SMatrix::zeros(),
-        k: SMatrix::zeros(),
+        g: Gain {
+            u: SMatrix::zeros(),
+            s: SMatrix::zeros(),
+            k: SMatrix::zeros(),
+        },
         s_inv: SMatrix::zeros(),
         dx: SVector::zeros(),
         noise: SMatrix::zeros(),
@@ -425,7 +435,7 @@ fn gate_step<T: Real, const C: usize>(
         return Ok(UpdateOutcome::Rejected { nis, threshold });
     }
     mat_vec(
-        w.k.as_slice(),
+        w.g.k.as_slice(),
         w.r.as_slice(),
         w.dx.as_mut_slice().get_mut(..n).unwrap_or_default(),
     );
@@ -545,10 +555,10 @@ fn gain_shared<T: Real, const C: usize>(
 ) -> Result<(), EskfError> {
     let (m, r_noise, ht) = (w.m, &w.noise, w.ht.as_slice());
     let (u, s, s_inv_out, k) = (
-        w.u.as_mut_slice(),
-        &mut w.s,
+        w.g.u.as_mut_slice(),
+        &mut w.g.s,
         &mut w.s_inv,
-        w.k.as_mut_slice(),
+        w.g.k.as_mut_slice(),
     );
     // Column c of U = Σ_j P e_j H_cj over the nonzero entries of row c of H only (most models
     // touch 3–6 of the 15 error components).
@@ -728,17 +738,15 @@ fn step_shared<T: Real, const C: usize>(
         return None;
     }
     // The linearization wrote `H̃` and `r` only; the gain overwrites these.
-    let (u, s, k) = (w.u, w.s, w.k);
+    let saved = w.g;
     let ok = gain_into(p, n, w).is_ok();
     // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
     let mut next = SVector::<T, MAX_STATE>::zeros();
     let next = next.as_mut_slice().get_mut(..n).unwrap_or_default();
     let prev = head(w.dx.as_slice(), n);
-    gauss_newton_step(w.ht.as_slice(), w.k.as_slice(), &w.r, w.m, prev, next);
+    gauss_newton_step(w.ht.as_slice(), w.g.k.as_slice(), &w.r, w.m, prev, next);
     if !(ok && sum_times_zero_is_zero(next)) {
-        w.u = u;
-        w.s = s;
-        w.k = k;
+        w.g = saved;
         return None;
     }
     let converged = distance(next, prev) < opts.step_tolerance;
@@ -749,7 +757,7 @@ fn step_shared<T: Real, const C: usize>(
 }
 
 /// Steps 3–4: Joseph-form covariance, injection and reset; writes `x` and `P` only when every
-/// check passed. Overwrites `w.u` (with `V`, see [`commit_shared`]).
+/// check passed. Overwrites `U` (with `V`, see [`commit_shared`]).
 ///
 /// The covariance part is [`commit_shared`], written over a run-time dimension. At opt-level 2
 /// or 3 it is inlined here, into one copy per filter where `n = N` is a constant (the
@@ -788,7 +796,7 @@ fn commit_shared<T: Real, const C: usize>(
     if !(3..=MAX_STATE).contains(&n) {
         return Err(EskfError::NumericalFailure); // no filter has such a state
     }
-    let (m, u, k, s) = (w.m, w.u.as_mut_slice(), w.k.as_slice(), &w.s);
+    let (m, u, k, s) = (w.m, w.g.u.as_mut_slice(), w.g.k.as_slice(), &w.g.s);
     let dx = head(w.dx.as_slice(), n);
     // Joseph form, expanded and written as m symmetric rank-2 corrections:
     //   P⁺ = P − K Uᵀ − U Kᵀ + K S Kᵀ = P + V Kᵀ + K Vᵀ = P + Σ_c (v_c k_cᵀ + k_c v_cᵀ),
@@ -812,14 +820,26 @@ fn commit_shared<T: Real, const C: usize>(
     // columns change.
     let dth = Vector3::new(at(dx, 0), at(dx, 1), at(dx, 2));
     let gr: Matrix3<T> = So3::right_jacobian(&dth);
+    // K, U, S and P are finite, so P⁺ can only fail by overflow; for a positive semi-definite
+    // P⁺, |P⁺_ij| ≤ √(P⁺_ii P⁺_jj), so a finite positive diagonal bounds every entry. The
+    // diagonal from row 3 on is checked here as `P_jj + 2 Σ_c v_cj k_cj` (the sum from zero,
+    // over the same pairs as the attitude rows: one pass over V and K for both).
+    let ok = positive_finite::<T>;
+    let two = T::lit(2.0);
+    let mut diag_ok = true;
     let mut top = [Vector3::<T>::zeros(); MAX_STATE];
     for (j, (t, pc)) in top.iter_mut().zip(p.chunks_exact(n.max(1))).enumerate() {
         let mut c0 = Vector3::new(at(pc, 0), at(pc, 1), at(pc, 2));
+        let mut d = T::zero();
         for (vc, kc) in pairs() {
             let (vj, kj) = (at(vc, j), at(kc, j));
             for (e, (a, b)) in c0.as_mut_slice().iter_mut().zip(vc.iter().zip(kc)) {
                 *e += *a * kj + *b * vj;
             }
+            d += vj * kj;
+        }
+        if j >= 3 {
+            diag_ok &= ok(at(pc, j) + d * two);
         }
         *t = super::imu::mv(&gr, &c0);
     }
@@ -829,14 +849,7 @@ fn commit_shared<T: Real, const C: usize>(
         &super::imu::tr33(&gr),
     );
     let c00 = super::imu::sym(&c00);
-    // K, U, S and P are finite, so P⁺ can only fail by overflow; for a positive semi-definite
-    // P⁺, |P⁺_ij| ≤ √(P⁺_ii P⁺_jj), so a finite positive diagonal bounds every entry.
-    let ok = positive_finite::<T>;
-    let two = T::lit(2.0);
-    let diag_ok = (3..n).all(|i| {
-        let d = pairs().fold(T::zero(), |acc, (vc, kc)| acc + at(vc, i) * at(kc, i));
-        ok(at(p, i * n + i) + d * two)
-    }) && (0..3).all(|i| ok(at(c00.as_slice(), 4 * i)));
+    let diag_ok = diag_ok && (0..3).all(|i| ok(at(c00.as_slice(), 4 * i)));
     if !(state_ok && diag_ok) {
         return Err(EskfError::NumericalFailure);
     }
@@ -855,32 +868,45 @@ fn commit_shared<T: Real, const C: usize>(
             }
         }
     }
-    // Mirror that triangle; then rows 0..3 ← top, columns 0..3 ← topᵀ, block (0, 0) ← c00
-    // (element by element: no transposed temporary).
-    for j in 3..n {
-        for i in 3..j {
+    write_rows(p, n, &mut top, &c00);
+    Ok(())
+}
+
+/// The last step of [`commit_shared`] on the column-major `n × n` storage `p` whose upper
+/// triangle from row 3 on is final: rows 0..3 ← `top` (column `j` of those rows is `top[j]`),
+/// block (0, 0) ← `c00` (overwriting `top[0..3]`), then the whole upper triangle mirrored
+/// (element by element: no transposed temporary). `c00` is exactly symmetric (from `sym`), so
+/// mirroring its upper half leaves it as written: the same matrix as mirroring rows 3.. and
+/// writing `top` and `c00` both ways, with one store per entry instead of two.
+#[inline(always)]
+pub(crate) fn write_rows<T: Real>(
+    p: &mut [T],
+    n: usize,
+    top: &mut [Vector3<T>; MAX_STATE],
+    c00: &Matrix3<T>,
+) {
+    for (t, c) in top.iter_mut().zip(c00.as_slice().chunks_exact(3)) {
+        copy_into(t.as_mut_slice(), c);
+    }
+    for (col, t) in p.chunks_exact_mut(n.max(1)).zip(top.iter()) {
+        copy_into(col, t.as_slice());
+    }
+    for j in 1..n {
+        for i in 0..j {
             let u = at(p, j * n + i);
             if let Some(e) = p.get_mut(i * n + j) {
                 *e = u;
             }
         }
     }
-    for (j, col) in top.iter().enumerate().take(n) {
-        for (a, v) in col.as_slice().iter().enumerate() {
-            let v = if j < 3 {
-                c00.get((a, j)).copied().unwrap_or(*v)
-            } else {
-                *v
-            };
-            if let Some(e) = p.get_mut(j * n + a) {
-                *e = v;
-            }
-            if let Some(e) = p.get_mut(a * n + j) {
-                *e = v;
-            }
-        }
+}
+
+/// `dst[i] = src[i]` over the shorter of the two.
+#[inline(always)]
+fn copy_into<T: Real>(dst: &mut [T], src: &[T]) {
+    for (d, s) in dst.iter_mut().zip(src) {
+        *d = *s;
     }
-    Ok(())
 }
 
 /// `s[i]`, or zero past the end (never reached: every caller indexes below the length).

@@ -98,8 +98,9 @@ pub(crate) fn check_spd<T: Real, const M: usize>(r: &SMatrix<T, M, M>) -> bool {
     finite_symmetric(r.as_slice(), M) && factor_lower(l.as_mut_slice(), M)
 }
 
-/// The largest error state (`Ins`, 15): the size of the fixed buffers of the shared update
-/// steps ([`commit_shared`]).
+/// The largest error state (`Ins`, 15): the storage rows of the update's working set when built
+/// for size (see [`update`]).
+#[cfg_attr(not(any(estimator_compact, test)), allow(dead_code))]
 pub(crate) const MAX_STATE: usize = 15;
 
 /// `A = L Lᵀ` in place on the column-major storage `l` of an `n × n` matrix, operation for
@@ -181,26 +182,26 @@ pub(crate) const CORE_ROWS: usize = 3;
 
 /// A measurement model as the update core sees it: through a row capacity `C ≥ M`.
 ///
-/// The core takes `&dyn Rows<T, S, N, C>`, so it is compiled once per `(T, S, N, C)`, not once per
-/// model; only [`Padded::linearize_rows`] (the model's own `linearize` and a copy) is per model.
-trait Rows<T: Real, S, const N: usize, const C: usize> {
+/// The core takes `&dyn Rows<T, S, N, R, C>`, so it is compiled once per `(T, S, N, R, C)`, not
+/// once per model; only [`Padded::linearize_rows`] (the model's own `linearize` and a copy) is per model.
+trait Rows<T: Real, S, const N: usize, const R: usize, const C: usize> {
     /// Linearizes at `x` into `w.ht = Hᵀ` (`N × C`, column-major in the first `N·C` entries of
     /// the storage; column `c` is row `c` of `H`, so that each row of `H` is contiguous) and
     /// `w.r`; the columns and rows past `M` are zero, and so is the rest of the storage. Nothing
     /// else in `w` is written.
-    fn linearize_rows(&self, x: &S, w: &mut Work<T, C>) -> Result<(), EskfError>;
+    fn linearize_rows(&self, x: &S, w: &mut Work<T, R, C>) -> Result<(), EskfError>;
 }
 
 /// A model with `M` rows, seen through any capacity `C ≥ M`.
 struct Padded<'a, Mo, const M: usize>(&'a Mo);
 
-impl<T, S, Mo, const N: usize, const M: usize, const C: usize> Rows<T, S, N, C>
+impl<T, S, Mo, const N: usize, const M: usize, const R: usize, const C: usize> Rows<T, S, N, R, C>
     for Padded<'_, Mo, M>
 where
     T: Real,
     Mo: Measurement<T, S, N, M>,
 {
-    fn linearize_rows(&self, x: &S, w: &mut Work<T, C>) -> Result<(), EskfError> {
+    fn linearize_rows(&self, x: &S, w: &mut Work<T, R, C>) -> Result<(), EskfError> {
         // Borrowed inside the `Result`, not moved out of it: one copy of the linearization on
         // the stack instead of two (this frame is on the deepest path of the update).
         let lin = self.0.linearize(x);
@@ -216,7 +217,11 @@ where
 /// [`rows_into`] into the working set's `H̃ᵀ` and `r`: one pointer to pass from each model's
 /// [`Padded::linearize_rows`] instead of two slices (fewer arguments on the stack per model).
 #[cfg_attr(estimator_compact, inline(never))]
-fn rows_into_work<T: Real, const C: usize>(h: &[T], r_in: &[T], w: &mut Work<T, C>) {
+fn rows_into_work<T: Real, const R: usize, const C: usize>(
+    h: &[T],
+    r_in: &[T],
+    w: &mut Work<T, R, C>,
+) {
     rows_into(h, r_in, w.ht.as_mut_slice(), w.r.as_mut_slice());
 }
 
@@ -256,22 +261,23 @@ fn pad_into<T: Real>(src: &[T], m: usize, dst: &mut [T], c: usize) {
 
 /// The working set of one update, kept in one place on the caller's stack and filled in place
 /// by the phases below (the phases with large temporaries are separate, non-inlined functions,
-/// so their frames do not add up: the peak stack stays small on a Cortex-M). Its type does not depend on the filter:
-/// an `n × C` matrix (`n` the error-state dimension, 15 or 6) is stored column-major in the
-/// first `n·C` entries of a `MAX_STATE × C` array (column `c` at `c·n .. c·n + n`), the rest
-/// zero, so that the steps that do not touch the state are one compiled copy for both filters.
-/// Columns and rows past `m` are zero.
-struct Work<T: Real, const C: usize> {
+/// so their frames do not add up: the peak stack stays small on a Cortex-M). An `n × C` matrix
+/// (`n` the error-state dimension, 15 or 6) is stored column-major in the first `n·C` entries
+/// of an `R × C` array (column `c` at `c·n .. c·n + n`), the rest zero. Built for size,
+/// `R = MAX_STATE` for both filters: the type does not depend on the filter, so the steps that
+/// do not touch the state are one compiled copy for both. Otherwise `R = n`: each filter's frame
+/// holds only its own rows. Columns and rows past `m` are zero.
+struct Work<T: Real, const R: usize, const C: usize> {
     /// `H̃ᵀ` at the current iterate.
-    ht: SMatrix<T, MAX_STATE, C>,
+    ht: SMatrix<T, R, C>,
     /// Residual `r = z ⊖ h(x̂ ⊕ δx)` at the current iterate.
     r: SVector<T, C>,
     /// `U`, `S` and `K` at the current iterate.
-    g: Gain<T, C>,
+    g: Gain<T, R, C>,
     /// `S⁻¹` (for the NIS at the prior).
     s_inv: SMatrix<T, C, C>,
     /// The current correction `δx` (the first `n` entries; the rest zero).
-    dx: SVector<T, MAX_STATE>,
+    dx: SVector<T, R>,
     /// `R` padded to `C × C` with the identity.
     noise: SMatrix<T, C, C>,
     /// The number of active rows, `M`.
@@ -281,13 +287,13 @@ struct Work<T: Real, const C: usize> {
 /// The gain part of the working set: kept together so that the iterated update saves and
 /// restores it as one block (one copy each way instead of three).
 #[derive(Clone, Copy)]
-struct Gain<T: Real, const C: usize> {
+struct Gain<T: Real, const R: usize, const C: usize> {
     /// `U = P H̃ᵀ`.
-    u: SMatrix<T, MAX_STATE, C>,
+    u: SMatrix<T, R, C>,
     /// `S = H̃ P H̃ᵀ + R` (identity past `m`).
     s: SMatrix<T, C, C>,
     /// `K = U S⁻¹`.
-    k: SMatrix<T, MAX_STATE, C>,
+    k: SMatrix<T, R, C>,
 }
 
 /// The first `len` entries of `s` (all of `s` if shorter; no caller asks for more).
@@ -336,10 +342,25 @@ where
 {
     let rows = Padded::<Mo, M>(model);
     let noise = model.noise();
-    if M <= CORE_ROWS {
-        update_core::<T, S, N, CORE_ROWS>(x, p, &rows, noise.as_slice(), M, opts)
-    } else {
-        update_core::<T, S, N, M>(x, p, &rows, noise.as_slice(), M, opts)
+    let noise = noise.as_slice();
+    // The working set's storage rows: `MAX_STATE` when built for size (one type for both
+    // filters, so one compiled copy of the shared steps), `N` otherwise (each filter's frame
+    // only as large as its own state: the attitude-only filter's update needs 6 rows, not 15).
+    #[cfg(estimator_compact)]
+    {
+        if M <= CORE_ROWS {
+            update_core::<T, S, N, MAX_STATE, CORE_ROWS>(x, p, &rows, noise, M, opts)
+        } else {
+            update_core::<T, S, N, MAX_STATE, M>(x, p, &rows, noise, M, opts)
+        }
+    }
+    #[cfg(not(estimator_compact))]
+    {
+        if M <= CORE_ROWS {
+            update_core::<T, S, N, N, CORE_ROWS>(x, p, &rows, noise, M, opts)
+        } else {
+            update_core::<T, S, N, N, M>(x, p, &rows, noise, M, opts)
+        }
     }
 }
 
@@ -348,10 +369,10 @@ where
 /// ([`start`], [`gate_step`], [`step_shared`], [`commit_shared`]), built for size one copy for
 /// both filters (at opt-level 2 or 3 inlined, where `n = N` is a constant).
 #[inline(never)]
-fn update_core<T, S, const N: usize, const C: usize>(
+fn update_core<T, S, const N: usize, const R: usize, const C: usize>(
     x: &mut S,
     p: &mut SMatrix<T, N, N>,
-    model: &dyn Rows<T, S, N, C>,
+    model: &dyn Rows<T, S, N, R, C>,
     noise: &[T],
     m: usize,
     opts: &UpdateOptions<T>,
@@ -360,7 +381,7 @@ where
     T: Real,
     S: ErrorState<T, N>,
 {
-    let mut w = Work::<T, C> {
+    let mut w = Work::<T, R, C> {
         ht: SMatrix::zeros(),
         r: SVector::zeros(),
         g: Gain {
@@ -394,10 +415,10 @@ where
 
 /// The checks before any work: the options, and `R` (`noise`, `m × m` column-major, padded
 /// into `w.noise`) symmetric positive definite.
-fn start<T: Real, const C: usize>(
+fn start<T: Real, const R: usize, const C: usize>(
     opts: &UpdateOptions<T>,
     noise: &[T],
-    w: &mut Work<T, C>,
+    w: &mut Work<T, R, C>,
 ) -> Result<(), EskfError> {
     if opts.max_iterations == 0 || !opts.step_tolerance.is_finite() {
         return Err(EskfError::InvalidOption);
@@ -418,12 +439,12 @@ fn start<T: Real, const C: usize>(
 /// see its range), then `δx₁ = K₀ r₀` into `w.dx`. Returns
 /// `Rejected`, or `Accepted` with the NIS (its iteration count is set by the caller).
 #[cfg_attr(not(estimator_compact), inline(always))]
-fn gate_step<T: Real, const C: usize>(
+fn gate_step<T: Real, const R: usize, const C: usize>(
     p: &[T],
     n: usize,
     m: usize,
     opts: &UpdateOptions<T>,
-    w: &mut Work<T, C>,
+    w: &mut Work<T, R, C>,
 ) -> Result<UpdateOutcome<T>, EskfError> {
     gain_into(p, n, w)?;
     let nis = nis(&w.s_inv, &w.r);
@@ -474,10 +495,10 @@ pub(crate) fn mat_vec<T: Real>(a: &[T], x: &[T], out: &mut [T]) {
 /// instead of three, and this frame is on the update's deepest path either way.
 #[cfg_attr(estimator_compact, inline(always))]
 #[cfg_attr(not(estimator_compact), inline(never))]
-fn linearize_into<T, S, const N: usize, const C: usize>(
-    model: &dyn Rows<T, S, N, C>,
+fn linearize_into<T, S, const N: usize, const R: usize, const C: usize>(
+    model: &dyn Rows<T, S, N, R, C>,
     x: &S,
-    w: &mut Work<T, C>,
+    w: &mut Work<T, R, C>,
     first: bool,
 ) -> Result<(), EskfError>
 where
@@ -496,9 +517,9 @@ where
 /// The rows just linearized: finite (else `NonFinite`), and after the first linearization
 /// turned into the chart Jacobian ([`chart_jacobian`]).
 #[cfg_attr(not(estimator_compact), inline(always))]
-fn check_rows<T: Real, const C: usize>(
+fn check_rows<T: Real, const R: usize, const C: usize>(
     n: usize,
-    w: &mut Work<T, C>,
+    w: &mut Work<T, R, C>,
     first: bool,
 ) -> Result<(), EskfError> {
     if !(finite_vec(&w.r) && finite_vec(&w.ht)) {
@@ -537,10 +558,10 @@ pub(crate) fn chart_jacobian<T: Real>(dx: &[T], ht: &mut [T]) {
 /// (column-major), over the `n × C` matrices of the working set (column `c` is entries
 /// `c·n .. c·n + n`), for the `m` active columns only.
 #[inline(always)]
-fn gain_into<T: Real, const C: usize>(
+fn gain_into<T: Real, const R: usize, const C: usize>(
     p: &[T],
     n: usize,
-    w: &mut Work<T, C>,
+    w: &mut Work<T, R, C>,
 ) -> Result<(), EskfError> {
     gain_shared(p, n, w)
 }
@@ -548,10 +569,10 @@ fn gain_into<T: Real, const C: usize>(
 /// The body of [`gain_into`]: one out-of-line copy built for size, inlined at opt-level 2 or 3.
 #[cfg_attr(estimator_compact, inline(never))]
 #[cfg_attr(not(estimator_compact), inline(always))]
-fn gain_shared<T: Real, const C: usize>(
+fn gain_shared<T: Real, const R: usize, const C: usize>(
     p: &[T],
     n: usize,
-    w: &mut Work<T, C>,
+    w: &mut Work<T, R, C>,
 ) -> Result<(), EskfError> {
     let (m, r_noise, ht) = (w.m, &w.noise, w.ht.as_slice());
     let (u, s, s_inv_out, k) = (
@@ -697,12 +718,12 @@ pub(crate) fn distance<T: Real>(a: &[T], b: &[T]) -> T {
 /// (whose `K`, `U`, `S` are restored). Returns the number of linearizations used.
 #[cfg_attr(estimator_compact, inline(always))]
 #[cfg_attr(not(estimator_compact), inline(never))]
-fn iterate<T, S, const N: usize, const C: usize>(
+fn iterate<T, S, const N: usize, const R: usize, const C: usize>(
     x: &S,
     p: &SMatrix<T, N, N>,
-    model: &dyn Rows<T, S, N, C>,
+    model: &dyn Rows<T, S, N, R, C>,
     opts: &UpdateOptions<T>,
-    w: &mut Work<T, C>,
+    w: &mut Work<T, R, C>,
 ) -> u8
 where
     T: Real,
@@ -727,11 +748,11 @@ where
 /// `K` and `δx` as they were) when the linearization, the gain or the step failed, else whether
 /// `‖δx_{k+1} − δx_k‖ < tol`. For the `n × n` covariance `p` (column-major).
 #[cfg_attr(not(estimator_compact), inline(always))]
-fn step_shared<T: Real, const C: usize>(
+fn step_shared<T: Real, const R: usize, const C: usize>(
     p: &[T],
     n: usize,
     opts: &UpdateOptions<T>,
-    w: &mut Work<T, C>,
+    w: &mut Work<T, R, C>,
     linearized: bool,
 ) -> Option<bool> {
     if !linearized {
@@ -741,7 +762,7 @@ fn step_shared<T: Real, const C: usize>(
     let saved = w.g;
     let ok = gain_into(p, n, w).is_ok();
     // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
-    let mut next = SVector::<T, MAX_STATE>::zeros();
+    let mut next = SVector::<T, R>::zeros();
     let next = next.as_mut_slice().get_mut(..n).unwrap_or_default();
     let prev = head(w.dx.as_slice(), n);
     gauss_newton_step(w.ht.as_slice(), w.g.k.as_slice(), &w.r, w.m, prev, next);
@@ -766,10 +787,10 @@ fn step_shared<T: Real, const C: usize>(
 /// by both filters.
 #[cfg_attr(estimator_compact, inline(always))]
 #[cfg_attr(not(estimator_compact), inline(never))]
-fn commit<T, S, const N: usize, const C: usize>(
+fn commit<T, S, const N: usize, const R: usize, const C: usize>(
     x: &mut S,
     p: &mut SMatrix<T, N, N>,
-    w: &mut Work<T, C>,
+    w: &mut Work<T, R, C>,
 ) -> Result<(), EskfError>
 where
     T: Real,
@@ -787,13 +808,13 @@ where
 /// correction `δx`. Writes `p` only when `state_ok` and every check passes.
 #[cfg_attr(estimator_compact, inline(never))]
 #[cfg_attr(not(estimator_compact), inline(always))]
-fn commit_shared<T: Real, const C: usize>(
+fn commit_shared<T: Real, const R: usize, const C: usize>(
     p: &mut [T],
     n: usize,
-    w: &mut Work<T, C>,
+    w: &mut Work<T, R, C>,
     state_ok: bool,
 ) -> Result<(), EskfError> {
-    if !(3..=MAX_STATE).contains(&n) {
+    if !(3..=R).contains(&n) {
         return Err(EskfError::NumericalFailure); // no filter has such a state
     }
     let (m, u, k, s) = (w.m, w.g.u.as_mut_slice(), w.g.k.as_slice(), &w.g.s);
@@ -827,7 +848,7 @@ fn commit_shared<T: Real, const C: usize>(
     let ok = positive_finite::<T>;
     let two = T::lit(2.0);
     let mut diag_ok = true;
-    let mut top = [Vector3::<T>::zeros(); MAX_STATE];
+    let mut top = [Vector3::<T>::zeros(); R];
     for (j, (t, pc)) in top.iter_mut().zip(p.chunks_exact(n.max(1))).enumerate() {
         let mut c0 = Vector3::new(at(pc, 0), at(pc, 1), at(pc, 2));
         let mut d = T::zero();
@@ -843,11 +864,11 @@ fn commit_shared<T: Real, const C: usize>(
         }
         *t = super::imu::mv(&gr, &c0);
     }
-    let [t0, t1, t2, ..] = top;
-    let c00 = super::imu::mm(
-        &Matrix3::from_columns(&[t0, t1, t2]),
-        &super::imu::tr33(&gr),
-    );
+    // `R ≥ n ≥ 3` (checked above): the first three always exist.
+    let Some(t012) = top.first_chunk::<3>() else {
+        return Err(EskfError::NumericalFailure);
+    };
+    let c00 = super::imu::mm(&Matrix3::from_columns(t012), &super::imu::tr33(&gr));
     let c00 = super::imu::sym(&c00);
     let diag_ok = diag_ok && (0..3).all(|i| ok(at(c00.as_slice(), 4 * i)));
     if !(state_ok && diag_ok) {
@@ -879,10 +900,10 @@ fn commit_shared<T: Real, const C: usize>(
 /// mirroring its upper half leaves it as written: the same matrix as mirroring rows 3.. and
 /// writing `top` and `c00` both ways, with one store per entry instead of two.
 #[inline(always)]
-pub(crate) fn write_rows<T: Real>(
+pub(crate) fn write_rows<T: Real, const R: usize>(
     p: &mut [T],
     n: usize,
-    top: &mut [Vector3<T>; MAX_STATE],
+    top: &mut [Vector3<T>; R],
     c00: &Matrix3<T>,
 ) {
     for (t, c) in top.iter_mut().zip(c00.as_slice().chunks_exact(3)) {

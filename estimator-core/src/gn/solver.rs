@@ -373,9 +373,14 @@ where
     S: Manifold<T, N>,
     P: Problem<T, S, N, K> + ?Sized,
 {
-    let mut out = Solution::placeholder(initial);
-    solve_into(problem, options, &mut out)?;
-    Ok(out)
+    // Solved in the returned value (no copy of the solution into the `Result`).
+    let mut out = Ok(Solution::placeholder(initial));
+    if let Ok(s) = &mut out {
+        if let Err(e) = solve_into(problem, options, s) {
+            out = Err(e);
+        }
+    }
+    out
 }
 
 impl<T: Real, S: Copy, const N: usize> Solution<T, S, N> {

@@ -750,8 +750,9 @@ fn damped_step<T: Real>(
 }
 
 /// `‖ξ‖`, `ξᵀAξ` and `ξᵀg` for the column-major `n × n` matrix `a` (`n` the length of `step`):
-/// one copy of the code for every dimension.
-#[inline(never)]
+/// one copy of the code for every dimension. Built for size it is left to the inliner: its one
+/// caller, [`damped_step`], then keeps the step and the matrix in registers.
+#[cfg_attr(not(estimator_compact), inline(never))]
 fn step_stats<T: Real>(a: &[T], g: &[T], step: &[T]) -> StepStats<T> {
     use linalg::dot;
     let n = step.len();

@@ -610,7 +610,8 @@ where
 ///
 /// # Errors
 /// As [`solve`], for the failures that happen during the iteration.
-#[inline(never)]
+// Built for size, left to the inliner: its one caller is `drive`.
+#[cfg_attr(not(estimator_compact), inline(never))]
 fn iterate<T: Real>(
     run: &mut dyn Candidate<T>,
     options: &SolverOptions<T>,

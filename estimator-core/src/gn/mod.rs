@@ -92,8 +92,10 @@ pub(crate) fn all_positive<T: crate::Real>(xs: &[T]) -> bool {
     xs.iter().all(|&x| crate::scalar::positive_finite(x))
 }
 
-/// `true` when every `x` is finite and `x ≥ 0` (`false` for NaN); see [`all_positive`].
-#[inline(never)]
+/// `true` when every `x` is finite and `x ≥ 0` (`false` for NaN); see [`all_positive`]. Its
+/// one caller is [`SolverOptions::is_valid`], itself out of
+/// line: built for size it is left to the inliner.
+#[cfg_attr(not(estimator_compact), inline(never))]
 pub(crate) fn all_non_negative<T: crate::Real>(xs: &[T]) -> bool {
     xs.iter().all(|&x| crate::scalar::non_negative_finite(x))
 }

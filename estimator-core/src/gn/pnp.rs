@@ -322,10 +322,14 @@ fn inlier_mask<T: Real>(
     let mut words = [0u32; 4];
     let pairs = problem.world_points.iter().zip(problem.pixels);
     for (k, (p, z)) in pairs.enumerate() {
-        let uv = problem
+        // The pixel as the solver's residual forms it ([`reprojection_error`]): one copy of the
+        // projection code (the unused Jacobian is dropped when inlined).
+        let projected = problem
             .camera
-            .project(&camera_point(&r, &t, p), problem.min_depth)
-            .ok_or(SolveError::PointBehindCamera)?;
+            .project_jac(&camera_point(&r, &t, p), problem.min_depth);
+        let Some((uv, _)) = &projected else {
+            return Err(SolveError::PointBehindCamera);
+        };
         let e = Vector2::new(
             (uv.x - z.x) * problem.inv_sigma,
             (uv.y - z.y) * problem.inv_sigma,

@@ -362,3 +362,83 @@ fn reprojection_error_is_the_full_product_up_to_zero_signs() {
     reprojection_cases::<f32>();
     reprojection_cases::<f64>();
 }
+
+/// [`linalg::cholesky_in_place`] with its former up-front test of the diagonal (every `A[j, j]`
+/// positive, else [`SolveError::NotPositiveDefinite`] before any column is touched).
+fn cholesky_with_diagonal_test<T: Real>(a: &mut [T], n: usize) -> Result<(), SolveError> {
+    if n > 0 && crate::scalar::all_finite(a) {
+        let diagonal_positive = (0..n).all(|j| a.get(j * n + j).is_some_and(|&d| d > T::zero()));
+        if !diagonal_positive {
+            return Err(SolveError::NotPositiveDefinite);
+        }
+    }
+    linalg::cholesky_in_place(a, n)
+}
+
+/// Symmetric matrices of sizes 1 to 6: Gram matrices (positive definite), the same with a
+/// diagonal entry made zero, `−0`, negative, tiny or non-finite, and arbitrary symmetric ones;
+/// the factorization without the diagonal test gives the same result and, on success, the same
+/// bits.
+fn cholesky_cases<T: Real>() {
+    let mut rng = Lcg(17);
+    let specials = every_class();
+    let (mut ok, mut refused) = (0, 0);
+    for i in 0..3000 {
+        let n = 1 + i % 6;
+        let mut a = [T::zero(); 36];
+        let a = &mut a[..n * n];
+        if i % 3 == 0 {
+            // Arbitrary symmetric.
+            for r in 0..n {
+                for c in 0..=r {
+                    let x = T::lit(rng.next());
+                    a[c * n + r] = x;
+                    a[r * n + c] = x;
+                }
+            }
+        } else {
+            // Gram matrix `Σ vₖ vₖᵀ` of `n + 2` random vectors, the last one `1e-3` long
+            // (mostly positive definite, some nearly singular).
+            let mut v = [[0.0f64; 6]; 8];
+            for (k, vk) in v.iter_mut().enumerate().take(n + 2) {
+                for x in vk.iter_mut().take(n) {
+                    *x = rng.next() * if k == n + 1 { 1e-3 } else { 1.0 };
+                }
+            }
+            for r in 0..n {
+                for c in 0..n {
+                    let s: f64 = v.iter().take(n + 2).map(|vk| vk[r] * vk[c]).sum();
+                    a[c * n + r] = T::lit(s);
+                }
+            }
+        }
+        let j = i % n;
+        match i % 7 {
+            1 => a[j * n + j] = T::zero(),
+            2 => a[j * n + j] = T::lit(-0.0),
+            3 => a[j * n + j] = T::lit(-rng.next().abs()),
+            4 => a[j * n + j] = T::lit(1e-300),
+            5 => a[j * n + j] = T::lit(specials[i % specials.len()]),
+            _ => {}
+        }
+        let mut before = [T::zero(); 36];
+        let before = &mut before[..n * n];
+        before.copy_from_slice(a);
+        let want = cholesky_with_diagonal_test(before, n);
+        let got = linalg::cholesky_in_place(a, n);
+        assert_eq!(got, want, "{i}");
+        if got.is_ok() {
+            assert!(same(a, before), "{i}");
+            ok += 1;
+        } else {
+            refused += 1;
+        }
+    }
+    assert!(ok > 500 && refused > 500, "{ok} {refused}");
+}
+
+#[test]
+fn cholesky_without_the_diagonal_test_is_the_same() {
+    cholesky_cases::<f32>();
+    cholesky_cases::<f64>();
+}

@@ -75,9 +75,8 @@ pub(super) fn unit<T: Real>(v: &Vector3<T>) -> Option<Vector3<T>> {
     positive_finite(n).then_some(u)
 }
 
-/// `(v / ‖v‖, ‖v‖)`, whatever the norm (one copy of the code for [`unit`] and the rays of
-/// [`triangulate`](super::triangulate)).
-#[cfg_attr(estimator_compact, inline(never))]
+/// `(v / ‖v‖, ‖v‖)`, whatever the norm (for [`unit`] and the rays of
+/// [`triangulate`](super::triangulate); small enough to be left to the inliner).
 pub(super) fn normalized<T: Real>(v: &Vector3<T>) -> (Vector3<T>, T) {
     let n = v.norm_squared().sqrt_rn();
     (Vector3::new(v.x / n, v.y / n, v.z / n), n)

@@ -373,9 +373,14 @@ where
     S: Manifold<T, N>,
     P: Problem<T, S, N, K> + ?Sized,
 {
-    let mut out = Solution::placeholder(initial);
-    solve_into(problem, options, &mut out)?;
-    Ok(out)
+    // Solved in the returned value (no copy of the solution into the `Result`).
+    let mut out = Ok(Solution::placeholder(initial));
+    if let Ok(s) = &mut out {
+        if let Err(e) = solve_into(problem, options, s) {
+            out = Err(e);
+        }
+    }
+    out
 }
 
 impl<T: Real, S: Copy, const N: usize> Solution<T, S, N> {
@@ -605,7 +610,8 @@ where
 ///
 /// # Errors
 /// As [`solve`], for the failures that happen during the iteration.
-#[inline(never)]
+// Built for size, left to the inliner: its one caller is `drive`.
+#[cfg_attr(not(estimator_compact), inline(never))]
 fn iterate<T: Real>(
     run: &mut dyn Candidate<T>,
     options: &SolverOptions<T>,
@@ -745,8 +751,9 @@ fn damped_step<T: Real>(
 }
 
 /// `‖ξ‖`, `ξᵀAξ` and `ξᵀg` for the column-major `n × n` matrix `a` (`n` the length of `step`):
-/// one copy of the code for every dimension.
-#[inline(never)]
+/// one copy of the code for every dimension. Built for size it is left to the inliner: its one
+/// caller, [`damped_step`], then keeps the step and the matrix in registers.
+#[cfg_attr(not(estimator_compact), inline(never))]
 fn step_stats<T: Real>(a: &[T], g: &[T], step: &[T]) -> StepStats<T> {
     use linalg::dot;
     let n = step.len();

@@ -189,8 +189,9 @@ pub(crate) fn substitute<T: Real>(l: &[T], n: usize, b: &mut [T]) {
 }
 
 /// `x ← (L Lᵀ)⁻¹`, symmetrized, for the factor `l` (both column-major `n × n`); see
-/// [`Factor::inverse`].
-#[inline(never)]
+/// [`Factor::inverse`]. Out of line at opt-level 2/3; built for size, LLVM decides (it has one
+/// caller per firmware that solves, and inlining it there is smaller than the call).
+#[cfg_attr(not(estimator_compact), inline(never))]
 pub(crate) fn inverse_in_place<T: Real>(l: &[T], n: usize, x: &mut [T]) -> Result<(), SolveError> {
     if n == 0 {
         return Ok(());

@@ -38,17 +38,6 @@ pub(crate) fn jacobian<T: Real, const M: usize, const N: usize>(
     h
 }
 
-/// The `3 × N` Jacobian that is `b` in columns `0..3` and zero elsewhere: the block written by
-/// the filters' block store (one out-of-line copy for every shape when built for size) instead
-/// of a block loop per shape. The models write it in place, into their result's zeroed
-/// Jacobian (no copy of it); this function is that construction, for the tests.
-#[cfg(test)]
-pub(crate) fn attitude_jacobian<T: Real, const N: usize>(b: &Matrix3<T>) -> SMatrix<T, 3, N> {
-    let mut h = SMatrix::<T, 3, N>::zeros();
-    set_blk_rc(&mut h, 0, 0, b);
-    h
-}
-
 /// The linearization of a three-row model that sees only the attitude, from its residual and
 /// attitude block: one copy per filter shared by the direction models ([`Magnetometer`],
 /// [`GravityDirection`]).

@@ -327,35 +327,9 @@ fn error_vector<T: Real, const N: usize>(s: &[T]) -> SVector<T, N> {
 /// 4. Inject `x⁺ = x̂ ⊕ δx` (seed eq. 4.5) and reset `P ← G P Gᵀ`,
 ///    `G = blockdiag(J_r(δθ), I)` (the new error `e⁺ = log(exp(δθ)⁻¹ exp(e)) ≈ J_r(δθ)(e − δθ)`).
 ///
-/// This wrapper and [`update_rows`] are the only per-model code.
+/// This wrapper is the only per-model code: it picks the core's row capacity ([`CORE_ROWS`])
+/// and calls the core, which pads the model's rows and noise to it.
 pub(crate) fn update<T, S, Mo, const N: usize, const M: usize>(
-    x: &mut S,
-    p: &mut SMatrix<T, N, N>,
-    model: &Mo,
-    opts: &UpdateOptions<T>,
-) -> Result<UpdateOutcome<T>, EskfError>
-where
-    T: Real,
-    S: ErrorState<T, N>,
-    Mo: Measurement<T, S, N, M>,
-{
-    // The working set's storage rows: `MAX_STATE` when built for size (one type for both
-    // filters, so one compiled copy of the shared steps), `N` otherwise (each filter's frame
-    // only as large as its own state: the attitude-only filter's update needs 6 rows, not 15).
-    #[cfg(estimator_compact)]
-    {
-        update_rows::<T, S, Mo, N, M, MAX_STATE>(x, p, model, opts)
-    }
-    #[cfg(not(estimator_compact))]
-    {
-        update_rows::<T, S, Mo, N, M, N>(x, p, model, opts)
-    }
-}
-
-/// [`update`] with `R` storage rows: picks the core's row capacity ([`CORE_ROWS`], or `M` for
-/// a larger model) and calls the core, which pads the model's rows and noise to it.
-#[inline(always)]
-fn update_rows<T, S, Mo, const N: usize, const M: usize, const R: usize>(
     x: &mut S,
     p: &mut SMatrix<T, N, N>,
     model: &Mo,
@@ -368,10 +342,25 @@ where
 {
     let rows = Padded::<Mo, M>(model);
     let noise = model.noise();
-    if M <= CORE_ROWS {
-        update_core::<T, S, N, R, CORE_ROWS>(x, p, &rows, noise.as_slice(), M, opts)
-    } else {
-        update_core::<T, S, N, R, M>(x, p, &rows, noise.as_slice(), M, opts)
+    let noise = noise.as_slice();
+    // The working set's storage rows: `MAX_STATE` when built for size (one type for both
+    // filters, so one compiled copy of the shared steps), `N` otherwise (each filter's frame
+    // only as large as its own state: the attitude-only filter's update needs 6 rows, not 15).
+    #[cfg(estimator_compact)]
+    {
+        if M <= CORE_ROWS {
+            update_core::<T, S, N, MAX_STATE, CORE_ROWS>(x, p, &rows, noise, M, opts)
+        } else {
+            update_core::<T, S, N, MAX_STATE, M>(x, p, &rows, noise, M, opts)
+        }
+    }
+    #[cfg(not(estimator_compact))]
+    {
+        if M <= CORE_ROWS {
+            update_core::<T, S, N, N, CORE_ROWS>(x, p, &rows, noise, M, opts)
+        } else {
+            update_core::<T, S, N, N, M>(x, p, &rows, noise, M, opts)
+        }
     }
 }
 

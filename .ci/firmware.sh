@@ -2,7 +2,9 @@
 # Firmware proof for estimator-core (issue 6), called by .ci/run as `bash .ci/firmware.sh`.
 #
 #  1. installs what it needs (thumbv7em-none-eabihf target, qemu-system-arm, LLVM binutils);
-#  2. computes the expected values on the host (firmware/host-check, f64 and f32);
+#  2. notes whether the committed stream (src/stream.rs, cut from host-sim datasets) is what
+#     today's host-sim generates; computes the expected values on the host (firmware/host-check,
+#     f64 and f32);
 #  3. builds the demo and runs it under QEMU (mps2-an386, Cortex-M4F) with the instruction-count
 #     plugin: a wrong result makes QEMU exit non-zero and fails CI;
 #  4. the link-time no-panic check at opt-level 3 and "s" (on failure, the panic call sites);
@@ -39,6 +41,14 @@ qemu-system-arm --version | sed -n 1p
 
 step "instruction-count plugin"
 gcc -O2 -Wall -shared -fPIC -o "$OUT/libicount.so" qemu-plugin/icount.c
+
+step "embedded stream: src/stream.rs against what today's host-sim generates"
+if bash tools/make_stream.sh "$OUT/stream.rs" && diff -q src/stream.rs "$OUT/stream.rs" > /dev/null; then
+  echo "src/stream.rs is what host-sim generates today"
+else
+  echo "note: src/stream.rs (committed, generated once) differs from what today's host-sim gives;"
+  echo "the demo runs on the committed stream. To refresh it: bash firmware/tools/make_stream.sh"
+fi
 
 step "expected values: the scenario on the host (f64 reference and f32), from today's estimator-core"
 HOST=$(rustc -vV | sed -n 's/^host: //p')

@@ -1,6 +1,8 @@
 //! Prints `firmware/src/expected.rs`: the scenario run on the host in f64 (the reference, with
 //! the tolerances the firmware allows) and in f32 (what the firmware should reproduce almost
 //! bit for bit). `cargo run --release --target x86_64-unknown-linux-gnu > ../src/expected.rs`.
+//! The scenario's data is `../src/stream.rs` (cut from host-sim datasets by
+//! `../tools/make_stream.sh`).
 
 #[path = "../../src/scenario.rs"]
 #[allow(dead_code)]
@@ -31,6 +33,7 @@ fn emit(name: &str, doc: &str, o: &Outcome<f32>) -> String {
     writeln!(s, "    pnp_q: {},", arr(o.pnp_q)).unwrap();
     writeln!(s, "    pnp_t: {},", arr(o.pnp_t)).unwrap();
     writeln!(s, "    truth_errors: {},", arr(o.truth_errors)).unwrap();
+    writeln!(s, "    truth_bounds: {},", arr(o.truth_bounds)).unwrap();
     writeln!(s, "    failure: {},", o.failure).unwrap();
     writeln!(s, "}};").unwrap();
     s
@@ -57,6 +60,7 @@ fn main() {
         pnp_q: narrow(o64.pnp_q),
         pnp_t: narrow(o64.pnp_t),
         truth_errors: narrow(o64.truth_errors),
+        truth_bounds: narrow(o64.truth_bounds),
         failure: o64.failure,
     };
     print!(

@@ -1,0 +1,290 @@
+#!/usr/bin/env python3
+"""Cuts the firmware demo's embedded stream out of host-sim datasets and prints src/stream.rs.
+
+  make_stream.py INS_DATASET AHRS_DATASET CAMERA_DATASET > src/stream.rs
+
+Each argument is a folder in the EuRoC layout written by `host-sim simulate` (CONTRACT.md,
+"Dataset folder"); `tools/make_stream.sh` makes the three and calls this script. What it takes:
+
+* INS (15 states): IMU, magnetometer and GNSS samples of WINDOW_S seconds from START_S, with the
+  ground truth at both ends and the sensors' parameters (IMU noise densities, the magnetometer's
+  reference field and sigma, the GNSS lever arm).
+* AHRS (attitude only): IMU and magnetometer of the same window of its own dataset.
+* PnP: the first camera frame at or after START_S, PNP_POINTS of its observations spread over
+  the frame (every k-th in file order), their landmarks, the camera's intrinsics, pixel sigma and
+  `T_BS`, and the body's true pose at that frame.
+
+Every number is written as an `f32` literal that reads back as the same `f32` (the value rounded
+to `f32` once, printed with the fewest digits that round-trip). Measurements carry the index of
+the IMU sample with the same timestamp: the demo applies them after integrating up to it.
+"""
+import csv
+import math
+import os
+import re
+import struct
+import sys
+
+START_S = 10.0
+WINDOW_S = 2.0
+PNP_POINTS = 20
+
+
+def f32(x):
+    """The f32 nearest to x, as a Rust literal that parses back to it."""
+    v = struct.unpack("<f", struct.pack("<f", float(x)))[0]
+    if v == 0.0:
+        return "-0.0" if math.copysign(1.0, v) < 0 else "0.0"
+    for digits in range(6, 10):
+        s = "%.*g" % (digits, v)
+        if struct.unpack("<f", struct.pack("<f", float(s)))[0] == v:
+            break
+    if "e" in s:
+        mant, exp = s.split("e")
+        if "." not in mant:
+            mant += ".0"
+        s = "%se%d" % (mant, int(exp))
+    elif "." not in s:
+        s += ".0"
+    return s
+
+
+def arr(values):
+    return "[" + ", ".join(f32(v) for v in values) + "]"
+
+
+def rows(path):
+    """Data rows of a CSV file (header skipped), as lists of strings."""
+    with open(path, newline="") as f:
+        r = csv.reader(f)
+        next(r)
+        return [row for row in r if row]
+
+
+def yaml_value(path, key):
+    """A scalar or a flow list `[a, b, ...]` of a flat YAML key (host-sim's sensor.yaml)."""
+    text = open(path).read()
+    m = re.search(r"^\s*%s:\s*(.+)$" % re.escape(key), text, re.M)
+    if not m:
+        sys.exit("make_stream: %s has no %s" % (path, key))
+    v = m.group(1).strip()
+    if v.startswith("["):
+        return [float(x) for x in v.strip("[]").split(",")]
+    return float(v)
+
+
+def ns(seconds):
+    return int(round(seconds * 1e9))
+
+
+def window(ds):
+    """IMU rows with timestamps in [START_S, START_S + WINDOW_S] (inclusive), and both ends (ns)."""
+    imu = rows(os.path.join(ds, "imu0", "data.csv"))
+    t0 = ns(START_S)  # timestamps as written: host-sim's datasets start at 1 s
+    t1 = t0 + ns(WINDOW_S)
+    sel = [r for r in imu if t0 <= int(r[0]) <= t1]
+    if not sel or int(sel[0][0]) != t0 or int(sel[-1][0]) != t1:
+        sys.exit("make_stream: %s has no IMU samples at both ends of the window" % ds)
+    return sel, t0, t1
+
+
+def imu_index(imu, t):
+    """Index of the IMU sample with timestamp t (measurements are applied after it)."""
+    for i, r in enumerate(imu):
+        if int(r[0]) == t:
+            return i
+    return None
+
+
+def truth_at(ds, t):
+    for r in rows(os.path.join(ds, "state_groundtruth_estimate0", "data.csv")):
+        if int(r[0]) == t:
+            v = [float(x) for x in r[1:]]
+            # p(3) q wxyz(4) v(3) bg(3) ba(3)
+            return {"p": v[0:3], "q": v[3:7], "v": v[7:10], "bg": v[10:13], "ba": v[13:16]}
+    sys.exit("make_stream: %s has no ground truth at %d ns" % (ds, t))
+
+
+def truth_rs(name, tr):
+    return (
+        "pub const %s: Truth = Truth {\n"
+        "    attitude_wxyz: %s,\n    velocity: %s,\n    position: %s,\n"
+        "    gyro_bias: %s,\n    accel_bias: %s,\n};\n"
+        % (name, arr(tr["q"]), arr(tr["v"]), arr(tr["p"]), arr(tr["bg"]), arr(tr["ba"]))
+    )
+
+
+def imu_block(ds, imu, t0, t1):
+    y = os.path.join(ds, "imu0", "sensor.yaml")
+    rate = yaml_value(y, "rate_hz")
+    noise = [
+        yaml_value(y, k)
+        for k in (
+            "gyroscope_noise_density",
+            "gyroscope_random_walk",
+            "accelerometer_noise_density",
+            "accelerometer_random_walk",
+        )
+    ]
+    out = []
+    out.append("/// Time between IMU samples, s (%g Hz).\npub const DT: f32 = %s;\n" % (rate, f32(1.0 / rate)))
+    out.append(
+        "/// IMU noise (`imu0/sensor.yaml`, Kalibr units): gyroscope noise density and random walk,\n"
+        "/// accelerometer noise density and random walk.\npub const IMU_NOISE: [f32; 4] = %s;\n"
+        % arr(noise)
+    )
+    out.append(
+        "/// IMU samples at `t0 + k·DT` (k = 0..=%d): gyroscope (rad/s) then accelerometer (m/s²),\n"
+        "/// body frame, instantaneous values.\npub const IMU: [[f32; 6]; %d] = [\n" % (len(imu) - 1, len(imu))
+    )
+    for r in imu:
+        out.append("    %s,\n" % arr(float(x) for x in r[1:7]))
+    out.append("];\n")
+    m = os.path.join(ds, "mag0")
+    mags = []
+    for r in rows(os.path.join(m, "data.csv")):
+        t = int(r[0])
+        if t0 < t <= t1:
+            mags.append((imu_index(imu, t), [float(x) for x in r[1:4]]))
+    if any(i is None for i, _ in mags):
+        sys.exit("make_stream: a magnetometer sample of %s falls between IMU samples" % ds)
+    ref = yaml_value(os.path.join(m, "sensor.yaml"), "reference_field")
+    sigma = yaml_value(os.path.join(m, "sensor.yaml"), "sigma")
+    out.append(
+        "/// Magnetometer reference field (world, µT) and white noise per axis (µT).\n"
+        "pub const MAG_REFERENCE: [f32; 3] = %s;\npub const MAG_SIGMA: f32 = %s;\n" % (arr(ref), f32(sigma))
+    )
+    out.append(
+        "/// Magnetometer samples (body, µT), each with the index of the IMU sample of the same time.\n"
+        "pub const MAG: [(usize, [f32; 3]); %d] = [\n" % len(mags)
+    )
+    for i, v in mags:
+        out.append("    (%d, %s),\n" % (i, arr(v)))
+    out.append("];\n")
+    return out
+
+
+def ins_rs(ds):
+    imu, t0, t1 = window(ds)
+    out = ["/// The 15-state filter's stream: `host-sim simulate --scenario default --seed 1`, %g–%g s.\n"
+           % (t0 * 1e-9, t1 * 1e-9), "#[rustfmt::skip]\npub mod ins {\n    use super::{GnssFix, Truth};\n"]
+    body = imu_block(ds, imu, t0, t1)
+    g = os.path.join(ds, "gnss0")
+    lever = yaml_value(os.path.join(g, "sensor.yaml"), "lever_arm")
+    fixes = []
+    for r in rows(os.path.join(g, "data.csv")):
+        t = int(r[0])
+        if t0 < t <= t1:
+            v = [float(x) for x in r[1:9]]
+            fixes.append((imu_index(imu, t), v))
+    if any(i is None for i, _ in fixes):
+        sys.exit("make_stream: a GNSS fix of %s falls between IMU samples" % ds)
+    body.append("/// GNSS antenna lever arm (body, m).\npub const GNSS_LEVER_ARM: [f32; 3] = %s;\n" % arr(lever))
+    body.append(
+        "/// GNSS fixes, each with the index of the IMU sample of the same time.\n"
+        "pub const GNSS: [GnssFix; %d] = [\n" % len(fixes)
+    )
+    for i, v in fixes:
+        body.append(
+            "    GnssFix { imu_index: %d, position: %s, velocity: %s, sigma_p: %s, sigma_v: %s },\n"
+            % (i, arr(v[0:3]), arr(v[3:6]), f32(v[6]), f32(v[7]))
+        )
+    body.append("];\n")
+    body.append("/// Ground truth at the first and the last IMU sample.\n")
+    body.append(truth_rs("TRUTH_START", truth_at(ds, t0)))
+    body.append(truth_rs("TRUTH_END", truth_at(ds, t1)))
+    out += ["    " + line if line.strip() else line for line in "".join(body).splitlines(True)]
+    out.append("}\n")
+    return out
+
+
+def ahrs_rs(ds):
+    imu, t0, t1 = window(ds)
+    out = ["/// The attitude-only filter's stream: `host-sim simulate --scenario handheld_ahrs --seed 1`,\n"
+           "/// %g–%g s.\n" % (t0 * 1e-9, t1 * 1e-9), "#[rustfmt::skip]\npub mod ahrs {\n    use super::Truth;\n"]
+    body = imu_block(ds, imu, t0, t1)
+    body.append("/// Ground truth at the first and the last IMU sample.\n")
+    body.append(truth_rs("TRUTH_START", truth_at(ds, t0)))
+    body.append(truth_rs("TRUTH_END", truth_at(ds, t1)))
+    out += ["    " + line if line.strip() else line for line in "".join(body).splitlines(True)]
+    out.append("}\n")
+    return out
+
+
+def pnp_rs(ds):
+    c = os.path.join(ds, "cam0")
+    y = os.path.join(c, "sensor.yaml")
+    intr = yaml_value(y, "intrinsics")
+    sigma = yaml_value(y, "sigma_px")
+    tbs = yaml_value(y, "data")
+    if len(tbs) != 16:
+        sys.exit("make_stream: T_BS of %s is not 4x4" % y)
+    obs = rows(os.path.join(c, "observations.csv"))
+    t = min(int(r[0]) for r in obs if int(r[0]) >= ns(START_S))
+    frame = [r for r in obs if int(r[0]) == t]
+    if len(frame) < PNP_POINTS:
+        sys.exit("make_stream: the frame at %d ns of %s has %d < %d observations" % (t, ds, len(frame), PNP_POINTS))
+    step = len(frame) // PNP_POINTS
+    pick = frame[::step][:PNP_POINTS]
+    lm = {int(r[0]): [float(x) for x in r[1:4]] for r in rows(os.path.join(c, "landmarks.csv"))}
+    tr = truth_at(ds, t)
+    out = ["/// The PnP problem: `host-sim simulate --scenario camera --seed 1`, the frame at %g s.\n" % (t * 1e-9),
+           "#[rustfmt::skip]\npub mod pnp {\n    use super::Truth;\n"]
+    body = [
+        "/// Pinhole intrinsics `[fx, fy, cx, cy]` (px) and pixel noise (px).\n",
+        "pub const INTRINSICS: [f32; 4] = %s;\npub const SIGMA_PX: f32 = %s;\n" % (arr(intr), f32(sigma)),
+        "/// `T_BS`, body from camera: rotation (row-major) and translation (m).\n",
+        "pub const BODY_FROM_CAMERA_R: [f32; 9] = %s;\n" % arr(tbs[0:3] + tbs[4:7] + tbs[8:11]),
+        "pub const BODY_FROM_CAMERA_T: [f32; 3] = %s;\n" % arr([tbs[3], tbs[7], tbs[11]]),
+        "/// Landmarks (world, m) and their observed pixels (px); landmark ids\n/// %s.\n"
+        % ", ".join(r[1] for r in pick),
+        "pub const LANDMARKS: [[f32; 3]; %d] = [\n" % PNP_POINTS,
+    ]
+    for r in pick:
+        body.append("    %s,\n" % arr(lm[int(r[1])]))
+    body.append("];\npub const PIXELS: [[f32; 2]; %d] = [\n" % PNP_POINTS)
+    for r in pick:
+        body.append("    %s,\n" % arr([float(r[2]), float(r[3])]))
+    body.append("];\n/// The body's true state at the frame.\n")
+    body.append(truth_rs("TRUTH", tr))
+    out += ["    " + line if line.strip() else line for line in "".join(body).splitlines(True)]
+    out.append("}\n")
+    return out
+
+
+def main():
+    if len(sys.argv) != 4:
+        sys.exit(__doc__)
+    ins, ahrs, cam = sys.argv[1:4]
+    head = [
+        "// The demo's embedded stream, cut out of host-sim datasets. GENERATED by\n",
+        "// `bash firmware/tools/make_stream.sh` (host-sim simulate, then tools/make_stream.py):\n",
+        "// do not edit by hand. Every number is the dataset's value rounded to f32.\n",
+        "// Data, not code: a true velocity may happen to be -π m/s.\n",
+        "#![allow(clippy::approx_constant)]\n\n",
+        "/// A true state from `state_groundtruth_estimate0/data.csv`: attitude `q_RS` (world from\n",
+        "/// body, `[w, x, y, z]`), velocity and position (world), gyroscope and accelerometer biases.\n",
+        "#[derive(Clone, Copy, Debug)]\n",
+        "pub struct Truth {\n",
+        "    pub attitude_wxyz: [f32; 4],\n",
+        "    pub velocity: [f32; 3],\n",
+        "    pub position: [f32; 3],\n",
+        "    pub gyro_bias: [f32; 3],\n",
+        "    pub accel_bias: [f32; 3],\n",
+        "}\n\n",
+        "/// A GNSS fix (`gnss0/data.csv`): position (world, m), velocity (world, m/s), their 1-σ.\n",
+        "#[derive(Clone, Copy, Debug)]\n",
+        "pub struct GnssFix {\n",
+        "    /// The IMU sample with the same timestamp: the fix is applied after it.\n",
+        "    pub imu_index: usize,\n",
+        "    pub position: [f32; 3],\n",
+        "    pub velocity: [f32; 3],\n",
+        "    pub sigma_p: f32,\n",
+        "    pub sigma_v: f32,\n",
+        "}\n\n",
+    ]
+    sys.stdout.write("".join(head + ins_rs(ins) + ["\n"] + ahrs_rs(ahrs) + ["\n"] + pnp_rs(cam)))
+
+
+if __name__ == "__main__":
+    main()

@@ -24,6 +24,7 @@ import os
 import re
 import struct
 import sys
+import textwrap
 
 START_S = 10.0
 WINDOW_S = 2.0
@@ -164,10 +165,32 @@ def imu_block(ds, imu, t0, t1):
     return out
 
 
+def module(doc, name, uses, body):
+    """`pub mod name { use super::{uses}; body }` behind `doc`, its body indented, unformatted."""
+    text = " ".join(line[4:] for line in doc.splitlines())
+    doc = "".join("/// %s\n" % line for line in textwrap.wrap(text, 90, break_on_hyphens=False))
+    out = [doc, "#[rustfmt::skip]\npub mod %s {\n    use super::%s;\n" % (name, uses)]
+    out += ["    " + line if line.strip() else line for line in "".join(body).splitlines(True)]
+    out.append("}\n")
+    return out
+
+
+def ends(ds, t0, t1):
+    """The ground truth at both ends of the window."""
+    return [
+        "/// Ground truth at the first and the last IMU sample.\n",
+        truth_rs("TRUTH_START", truth_at(ds, t0)),
+        truth_rs("TRUTH_END", truth_at(ds, t1)),
+    ]
+
+
+def origin(ds, what):
+    return "/// %s: `host-sim simulate --scenario %s --seed 1`, %s.\n" % (
+        what, os.path.basename(os.path.normpath(ds)), "%s")
+
+
 def ins_rs(ds):
     imu, t0, t1 = window(ds)
-    out = ["/// The 15-state filter's stream: `host-sim simulate --scenario default --seed 1`, %g–%g s.\n"
-           % (t0 * 1e-9, t1 * 1e-9), "#[rustfmt::skip]\npub mod ins {\n    use super::{GnssFix, Truth};\n"]
     body = imu_block(ds, imu, t0, t1)
     g = os.path.join(ds, "gnss0")
     lever = yaml_value(os.path.join(g, "sensor.yaml"), "lever_arm")
@@ -175,8 +198,7 @@ def ins_rs(ds):
     for r in rows(os.path.join(g, "data.csv")):
         t = int(r[0])
         if t0 < t <= t1:
-            v = [float(x) for x in r[1:9]]
-            fixes.append((imu_index(imu, t), v))
+            fixes.append((imu_index(imu, t), [float(x) for x in r[1:9]]))
     if any(i is None for i, _ in fixes):
         sys.exit("make_stream: a GNSS fix of %s falls between IMU samples" % ds)
     body.append("/// GNSS antenna lever arm (body, m).\npub const GNSS_LEVER_ARM: [f32; 3] = %s;\n" % arr(lever))
@@ -190,25 +212,16 @@ def ins_rs(ds):
             % (i, arr(v[0:3]), arr(v[3:6]), f32(v[6]), f32(v[7]))
         )
     body.append("];\n")
-    body.append("/// Ground truth at the first and the last IMU sample.\n")
-    body.append(truth_rs("TRUTH_START", truth_at(ds, t0)))
-    body.append(truth_rs("TRUTH_END", truth_at(ds, t1)))
-    out += ["    " + line if line.strip() else line for line in "".join(body).splitlines(True)]
-    out.append("}\n")
-    return out
+    body += ends(ds, t0, t1)
+    doc = origin(ds, "The 15-state filter's stream") % ("%g–%g s" % (t0 * 1e-9, t1 * 1e-9))
+    return module(doc, "ins", "{GnssFix, Truth}", body)
 
 
 def ahrs_rs(ds):
     imu, t0, t1 = window(ds)
-    out = ["/// The attitude-only filter's stream: `host-sim simulate --scenario handheld_ahrs --seed 1`,\n"
-           "/// %g–%g s.\n" % (t0 * 1e-9, t1 * 1e-9), "#[rustfmt::skip]\npub mod ahrs {\n    use super::Truth;\n"]
-    body = imu_block(ds, imu, t0, t1)
-    body.append("/// Ground truth at the first and the last IMU sample.\n")
-    body.append(truth_rs("TRUTH_START", truth_at(ds, t0)))
-    body.append(truth_rs("TRUTH_END", truth_at(ds, t1)))
-    out += ["    " + line if line.strip() else line for line in "".join(body).splitlines(True)]
-    out.append("}\n")
-    return out
+    body = imu_block(ds, imu, t0, t1) + ends(ds, t0, t1)
+    doc = origin(ds, "The attitude-only filter's stream") % ("%g–%g s" % (t0 * 1e-9, t1 * 1e-9))
+    return module(doc, "ahrs", "Truth", body)
 
 
 def pnp_rs(ds):
@@ -228,8 +241,6 @@ def pnp_rs(ds):
     pick = frame[::step][:PNP_POINTS]
     lm = {int(r[0]): [float(x) for x in r[1:4]] for r in rows(os.path.join(c, "landmarks.csv"))}
     tr = truth_at(ds, t)
-    out = ["/// The PnP problem: `host-sim simulate --scenario camera --seed 1`, the frame at %g s.\n" % (t * 1e-9),
-           "#[rustfmt::skip]\npub mod pnp {\n    use super::Truth;\n"]
     body = [
         "/// Pinhole intrinsics `[fx, fy, cx, cy]` (px) and pixel noise (px).\n",
         "pub const INTRINSICS: [f32; 4] = %s;\npub const SIGMA_PX: f32 = %s;\n" % (arr(intr), f32(sigma)),
@@ -247,9 +258,8 @@ def pnp_rs(ds):
         body.append("    %s,\n" % arr([float(r[2]), float(r[3])]))
     body.append("];\n/// The body's true state at the frame.\n")
     body.append(truth_rs("TRUTH", tr))
-    out += ["    " + line if line.strip() else line for line in "".join(body).splitlines(True)]
-    out.append("}\n")
-    return out
+    doc = origin(ds, "The PnP problem") % ("the frame at %g s" % (t * 1e-9))
+    return module(doc, "pnp", "Truth", body)
 
 
 def main():

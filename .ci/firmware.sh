@@ -7,7 +7,8 @@
 #     f64 and f32);
 #  3. builds the demo and runs it under QEMU (mps2-an386, Cortex-M4F) with the instruction-count
 #     plugin: a wrong result makes QEMU exit non-zero and fails CI;
-#  4. the link-time no-panic check at opt-level 3 and "s" (on failure, the panic call sites);
+#  4. the link-time no-panic check at opt-level 3 and "s" (on failure, the panic call sites),
+#     and that its harness names every public function of estimator-core;
 #  5. no f64 soft-float routine in the f32 binaries;
 #  6. instruction counts, peak stack, size_of and flash against firmware/budgets.txt (opt-level 3)
 #     and firmware/budgets-s.txt (the stack at opt-level "s").
@@ -99,6 +100,9 @@ done
 cat "$OUT/demo-3.txt"
 
 step "no-panic check (link fails if any panic path is reachable)"
+# The check proves what the harness calls: every public function must be named in it.
+python3 tools/api_coverage.py ../estimator-core/src src/bin/nopanic.rs \
+  || fail "a public function of estimator-core is not called by src/bin/nopanic.rs"
 nopanic() { # profile, extra cargo args...
   local profile=$1 name=$2
   shift 2

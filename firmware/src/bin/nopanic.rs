@@ -137,6 +137,7 @@ fn lie<T: Real>(x: &Seed<T>) {
     keep(&So3::<T>::from_wxyz(e, f, g, h));
     let r = So3::<T>::from_unit_quaternion(UnitQuaternion::new_unchecked(q));
     keep(&(r.quaternion(), r.cast::<f32>(), r.rotation_matrix()));
+    keep(&r.renormalize());
     keep(&So3::<T>::from_rotation_matrix(&m3));
     group::<T, So3<T>>(&r, &So3::exp(&w), &v, &w, &m3, g);
     let t = Se3::<T>::from_parts(r, w);
@@ -146,6 +147,7 @@ fn lie<T: Real>(x: &Seed<T>) {
     group::<T, Se3<T>>(&t, &Se3::exp(&xi), &(xi * g), &v, &m4, g);
     keep(&skew(&v));
     keep(&h.sincos());
+    keep(&h.arctan2(a));
 }
 
 #[inline(never)]
@@ -408,7 +410,11 @@ fn api<T: Real>() {
 #[entry]
 fn main() -> ! {
     api::<f32>();
+    // The f32 kernels behind `Real` (public for users who want them directly). `Real::to_f64` is
+    // left out: it is the one entry point that is f64 by design (host tools and tests).
     keep(&estimator_core::scalar::sincos_f32(bb(0.5)));
+    keep(&estimator_core::scalar::atan2_f32(bb(0.5), bb(-0.25)));
+    keep(&estimator_core::scalar::sqrt_f32(bb(0.5)));
     // Self-test of the check itself: a reachable panic must make the link fail.
     #[cfg(feature = "selftest-panic")]
     {

@@ -28,9 +28,10 @@ use core::mem::size_of;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use estimator_core::eskf::{
-    Ahrs, AhrsState, EskfError, Ins, InsState, Measurement, UpdateOptions, UpdateOutcome,
+    Ahrs, AhrsState, EskfError, FilterConfig, Ins, InsState, Measurement, UpdateOptions,
+    UpdateOutcome,
 };
-use estimator_core::gn::{solve_pnp, PnpSolution, SolveError};
+use estimator_core::gn::{self, solve_pnp, PnpSolution, SolveError};
 use estimator_core::lie::{LieGroup, Se3, So3};
 use nalgebra::{Vector3, Vector6};
 
@@ -488,6 +489,37 @@ fn main() -> ! {
     hprintln!(
         "size_of NormalEquations<f32,6> {}",
         size_of::<estimator_core::gn::NormalEquations<f32, 6>>()
+    );
+    // The options, outcomes and solutions a caller holds next to the filters and the solver.
+    hprintln!("size_of AhrsState<f32> {}", size_of::<AhrsState<f32>>());
+    hprintln!(
+        "size_of FilterConfig<f32> {}",
+        size_of::<FilterConfig<f32>>()
+    );
+    hprintln!(
+        "size_of UpdateOptions<f32> {}",
+        size_of::<UpdateOptions<f32>>()
+    );
+    hprintln!(
+        "size_of UpdateOutcome<f32> {}",
+        size_of::<UpdateOutcome<f32>>()
+    );
+    hprintln!(
+        "size_of SolverOptions<f32> {}",
+        size_of::<gn::SolverOptions<f32>>()
+    );
+    hprintln!(
+        "size_of Solution<f32,Se3<f32>,6> {}",
+        size_of::<gn::Solution<f32, Se3<f32>, 6>>()
+    );
+    hprintln!("size_of Factor<f32,6> {}", size_of::<gn::Factor<f32, 6>>());
+    hprintln!(
+        "size_of Triangulation<f32> {}",
+        size_of::<gn::Triangulation<f32>>()
+    );
+    hprintln!(
+        "size_of RotationSolution<f32> {}",
+        size_of::<gn::RotationSolution<f32>>()
     );
 
     if c.failures == 0 {

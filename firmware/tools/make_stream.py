@@ -89,12 +89,19 @@ def window(ds):
     return sel, t0, t1
 
 
-def imu_index(imu, t):
-    """Index of the IMU sample with timestamp t (measurements are applied after it)."""
-    for i, r in enumerate(imu):
-        if int(r[0]) == t:
-            return i
-    return None
+def samples(folder, what, imu, t0, t1, columns):
+    """Rows of `folder/data.csv` with timestamps in (t0, t1], each as (the index of the IMU
+    sample with the same timestamp, its first `columns` values): the demo applies a measurement
+    after integrating up to that sample."""
+    index = {int(r[0]): i for i, r in enumerate(imu)}
+    out = []
+    for r in rows(os.path.join(folder, "data.csv")):
+        t = int(r[0])
+        if t0 < t <= t1:
+            if t not in index:
+                sys.exit("make_stream: a %s in %s falls between IMU samples" % (what, folder))
+            out.append((index[t], [float(x) for x in r[1 : 1 + columns]]))
+    return out
 
 
 def truth_at(ds, t):
@@ -142,13 +149,7 @@ def imu_block(ds, imu, t0, t1):
         out.append("    %s,\n" % arr(float(x) for x in r[1:7]))
     out.append("];\n")
     m = os.path.join(ds, "mag0")
-    mags = []
-    for r in rows(os.path.join(m, "data.csv")):
-        t = int(r[0])
-        if t0 < t <= t1:
-            mags.append((imu_index(imu, t), [float(x) for x in r[1:4]]))
-    if any(i is None for i, _ in mags):
-        sys.exit("make_stream: a magnetometer sample of %s falls between IMU samples" % ds)
+    mags = samples(m, "magnetometer sample", imu, t0, t1, 3)
     ref = yaml_value(os.path.join(m, "sensor.yaml"), "reference_field")
     sigma = yaml_value(os.path.join(m, "sensor.yaml"), "sigma")
     out.append(
@@ -194,13 +195,7 @@ def ins_rs(ds):
     body = imu_block(ds, imu, t0, t1)
     g = os.path.join(ds, "gnss0")
     lever = yaml_value(os.path.join(g, "sensor.yaml"), "lever_arm")
-    fixes = []
-    for r in rows(os.path.join(g, "data.csv")):
-        t = int(r[0])
-        if t0 < t <= t1:
-            fixes.append((imu_index(imu, t), [float(x) for x in r[1:9]]))
-    if any(i is None for i, _ in fixes):
-        sys.exit("make_stream: a GNSS fix of %s falls between IMU samples" % ds)
+    fixes = samples(g, "GNSS fix", imu, t0, t1, 8)
     body.append("/// GNSS antenna lever arm (body, m).\npub const GNSS_LEVER_ARM: [f32; 3] = %s;\n" % arr(lever))
     body.append(
         "/// GNSS fixes, each with the index of the IMU sample of the same time.\n"

@@ -17,9 +17,9 @@
 //! covariance; PnP starts from the true pose displaced by 0.2 m and 0.1 rad.
 
 use estimator_core::eskf::{
-    AccelerometerAtRest, Ahrs, AhrsState, BaroAltitude, CameraLandmark, FilterConfig, Gate,
-    GateProbability, GnssPosition, GnssVelocity, GravityDirection, Heading, ImuNoise, ImuSample,
-    Ins, InsState, Magnetometer, UpdateOptions, ZeroVelocity,
+    AccelerometerAtRest, Ahrs, AhrsState, BaroAltitude, CameraLandmark, FilterConfig, GnssPosition,
+    GnssVelocity, GravityDirection, Heading, ImuNoise, ImuSample, Ins, InsState, Magnetometer,
+    UpdateOptions, ZeroVelocity,
 };
 use estimator_core::gn::{solve_pnp, PinholeCamera, PnpOptions};
 use estimator_core::lie::{LieGroup, Se3, So3};
@@ -279,7 +279,7 @@ fn tally<T: Real>(
 fn ins<T: Scalar>(out: &mut Outcome<T>) -> Option<Ins<T>> {
     use stream::ins as s;
     let cfg = config::<T>(&s::IMU_NOISE);
-    let options = UpdateOptions::ekf(Gate::Probability(GateProbability::P999));
+    let options = UpdateOptions::default();
     let (Some(r0), Some(r1)) = (attitude::<T>(&s::TRUTH_START), attitude::<T>(&s::TRUTH_END))
     else {
         out.failure = 1;
@@ -364,7 +364,7 @@ fn ins<T: Scalar>(out: &mut Outcome<T>) -> Option<Ins<T>> {
 fn ahrs<T: Scalar>(out: &mut Outcome<T>) -> Option<Ahrs<T>> {
     use stream::ahrs as s;
     let cfg = config::<T>(&s::IMU_NOISE);
-    let options = UpdateOptions::ekf(Gate::Probability(GateProbability::P999));
+    let options = UpdateOptions::default();
     let (Some(r0), Some(r1)) = (attitude::<T>(&s::TRUTH_START), attitude::<T>(&s::TRUTH_END))
     else {
         out.failure = 11;
@@ -491,7 +491,7 @@ fn pnp<T: Scalar>(out: &mut Outcome<T>) -> Option<Pnp<T>> {
 
 /// The benchmark inputs at the end of the stream (see [`Workload`]).
 fn workload<T: Scalar>(ins: Ins<T>, ahrs: Ahrs<T>, p: Pnp<T>) -> Workload<T> {
-    let options = UpdateOptions::ekf(Gate::Probability(GateProbability::P999));
+    let options = UpdateOptions::default();
     let x = *ins.state();
     let cfg = config::<T>(&stream::ins::IMU_NOISE);
     let n = stream::ins::IMU.len();

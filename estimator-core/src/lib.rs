@@ -24,6 +24,7 @@
 #![warn(missing_docs)]
 
 pub mod eskf;
+mod kernels;
 pub mod gn;
 pub mod lie;
 pub mod scalar;

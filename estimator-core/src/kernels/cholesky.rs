@@ -1,0 +1,182 @@
+//! The Cholesky factor `A = L Lᵀ` of a small symmetric positive-definite matrix, its solves and
+//! its inverse, over column-major storage with the dimension as a run-time number (one compiled
+//! copy serves the filters' 1…6-row innovations and the solver's 3×3 and 6×6 normal equations).
+//!
+//! The factor is the left-looking ("gaxpy") column algorithm of Golub & Van Loan, *Matrix
+//! Computations*, §4.2: column `j` loses `L_jk · L_{j.., k}` for every `k < j`, then
+//! `L_jj = √d_j` and `L_{j+1.., j} /= L_jj`. A pivot `d_j` that is zero, negative or NaN is
+//! refused, and so is one that is numerically zero: `d_j ≤ τ·A_jj`, where `d_j / A_jj` is the
+//! fraction of the variance of variable `j` that the previous variables do not explain, and `τ`
+//! is the caller's relative pivot tolerance.
+
+use super::finite::all_finite;
+use super::slice::{axpy, dot, symmetrize};
+use crate::Real;
+
+/// `A = L Lᵀ` in place on the column-major `n × n` storage `a`: only the lower triangle is
+/// read, and it becomes `L`. `false` (with `a` partly overwritten) when an entry of the lower
+/// triangle is not finite or a pivot `d_j` is not above `relative_pivot · A_jj` (see the module
+/// docs; `relative_pivot = 0` refuses only pivots `≤ 0` and NaN).
+#[inline(never)]
+#[must_use]
+pub(crate) fn factor_in_place<T: Real>(a: &mut [T], n: usize, relative_pivot: T) -> bool {
+    if a.len() != n * n {
+        return false;
+    }
+    if !all_finite(a) {
+        return false;
+    }
+    for j in 0..n {
+        let Some((before, rest)) = a.split_at_mut_checked(j * n) else {
+            return false;
+        };
+        let Some(col_j) = rest.get_mut(j..n) else {
+            return false;
+        };
+        let a_jj = col_j.first().copied().unwrap_or_else(T::zero);
+        for col_k in before.chunks_exact(n) {
+            let Some(col_k) = col_k.get(j..) else {
+                continue;
+            };
+            let l_jk = col_k.first().copied().unwrap_or_else(T::zero);
+            axpy(col_j, -l_jk, col_k);
+        }
+        let Some((diagonal, below)) = col_j.split_first_mut() else {
+            return false;
+        };
+        let d = *diagonal;
+        // Written so that a NaN pivot (every comparison false) is refused.
+        if !(d > T::zero() && d > relative_pivot * a_jj) {
+            return false;
+        }
+        let l_jj = d.sqrt_rn();
+        *diagonal = l_jj;
+        for e in below {
+            *e /= l_jj;
+        }
+    }
+    true
+}
+
+/// `b ← (L Lᵀ)⁻¹ b` for the factor `l` (column-major `n × n`, lower triangle): forward
+/// substitution `L y = b` by columns, then back substitution `Lᵀ x = y` by dot products.
+#[inline(never)]
+pub(crate) fn solve_in_place<T: Real>(l: &[T], n: usize, b: &mut [T]) {
+    if n == 0 {
+        return;
+    }
+    for (i, col) in l.chunks_exact(n).enumerate().take(n) {
+        let diag = col.get(i).copied().unwrap_or_else(T::one);
+        let Some(b_i) = b.get_mut(i) else { break };
+        let y_i = *b_i / diag;
+        *b_i = y_i;
+        if let (Some(rest), Some(below)) = (b.get_mut(i + 1..), col.get(i + 1..)) {
+            axpy(rest, -y_i, below);
+        }
+    }
+    for i in (0..n).rev() {
+        let Some(col) = l.get(i * n..i * n + n) else {
+            continue;
+        };
+        let s = match (col.get(i + 1..), b.get(i + 1..)) {
+            (Some(x), Some(y)) => dot(x, y),
+            _ => T::zero(),
+        };
+        let diag = col.get(i).copied().unwrap_or_else(T::one);
+        if let Some(b_i) = b.get_mut(i) {
+            *b_i = (*b_i - s) / diag;
+        }
+    }
+}
+
+/// `X ← (L Lᵀ)⁻¹` for the factor `l` (both column-major `n × n`), solved column by column of
+/// the identity and symmetrized, `(X + Xᵀ)/2`, against round-off. `false` when an entry of the
+/// result is not finite.
+#[inline(never)]
+#[must_use]
+pub(crate) fn inverse_into<T: Real>(l: &[T], n: usize, x: &mut [T]) -> bool {
+    if n == 0 {
+        return true;
+    }
+    for (c, col) in x.chunks_exact_mut(n).enumerate() {
+        for (r, v) in col.iter_mut().enumerate() {
+            *v = if r == c { T::one() } else { T::zero() };
+        }
+        solve_in_place(l, n, col);
+    }
+    symmetrize(x, n);
+    all_finite(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_support::Lcg;
+    use nalgebra::{DMatrix, DVector};
+
+    fn spd(rng: &mut Lcg, n: usize) -> DMatrix<f64> {
+        let b = DMatrix::from_fn(n, n, |_, _| rng.next());
+        &b * b.transpose() + DMatrix::identity(n, n) * 0.1
+    }
+
+    /// Backward stability of Cholesky (Higham Thm 10.3): `L Lᵀ = A + ΔA`,
+    /// `|ΔA| ≤ γ_{n+1} |L||Lᵀ|`; checked entry by entry.
+    #[test]
+    fn factor_reproduces_a_within_the_backward_error_bound() {
+        let mut rng = Lcg(11);
+        for n in 1..=8 {
+            for _ in 0..50 {
+                let a = spd(&mut rng, n);
+                let mut l = a.clone();
+                assert!(factor_in_place(l.as_mut_slice(), n, 0.0));
+                let l = l.lower_triangle();
+                let k = (n + 1) as f64 * f64::EPSILON;
+                let gamma = k / (1.0 - k);
+                let bound = (l.abs() * l.transpose().abs()) * gamma;
+                let err = (&l * l.transpose() - &a).abs();
+                assert!(err.iter().zip(bound.iter()).all(|(e, b)| e <= b), "n = {n}");
+            }
+        }
+    }
+
+    /// The solve and the inverse against nalgebra's Cholesky, to `κ(A)·n·ε` relative error.
+    #[test]
+    fn solve_and_inverse_agree_with_nalgebra() {
+        let mut rng = Lcg(12);
+        for n in 1..=8 {
+            let a = spd(&mut rng, n);
+            let mut l = a.clone();
+            assert!(factor_in_place(l.as_mut_slice(), n, 0.0));
+            let chol = a.clone().cholesky().expect("spd");
+            let svd = a.clone().svd(false, false);
+            let kappa = svd.singular_values.max() / svd.singular_values.min();
+            let tol = kappa * 8.0 * n as f64 * f64::EPSILON;
+
+            let b = DVector::from_fn(n, |_, _| rng.next());
+            let mut x = b.clone();
+            solve_in_place(l.as_slice(), n, x.as_mut_slice());
+            let expected = chol.solve(&b);
+            assert!((&x - &expected).norm() <= tol * expected.norm());
+
+            let mut inv = DMatrix::zeros(n, n);
+            assert!(inverse_into(l.as_slice(), n, inv.as_mut_slice()));
+            assert_eq!(inv, inv.transpose());
+            let expected = chol.inverse();
+            assert!((&inv - &expected).norm() <= tol * expected.norm());
+        }
+    }
+
+    #[test]
+    fn factor_refuses_indefinite_singular_and_non_finite() {
+        let indefinite = [1.0, 2.0, 2.0, 1.0];
+        assert!(!factor_in_place(&mut indefinite.clone(), 2, 0.0));
+        // Rank one: the second pivot is zero up to rounding, below 16·2·ε of A_11.
+        let singular = [1.0, 1.0, 1.0, 1.0 + 1e-17];
+        assert!(!factor_in_place(&mut singular.clone(), 2, 32.0 * f64::EPSILON));
+        for bad in [f64::NAN, f64::INFINITY] {
+            assert!(!factor_in_place(&mut [1.0, bad, bad, 1.0], 2, 0.0));
+        }
+        assert!(!factor_in_place(&mut [f64::NAN], 1, 0.0));
+        assert!(!factor_in_place(&mut [1.0, 0.0, 0.0], 2, 0.0)); // wrong length
+    }
+}

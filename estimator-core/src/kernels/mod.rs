@@ -1,0 +1,28 @@
+//! Hand-written small-matrix routines over fixed storage: the one home of every loop that
+//! `lie`, `eskf` and `gn` would otherwise write by hand.
+//!
+//! Why they exist: nalgebra's generic expressions are the first choice everywhere else, but a
+//! few operations need what nalgebra does not give on a microcontroller — an index that can
+//! never panic (`fixed_view` asserts its bounds), one compiled copy for every run-time
+//! dimension (the Cholesky factor of a 3×3 innovation and of a 6×6 information matrix), or a
+//! 3×3 product unrolled for a generic scalar.
+//!
+//! Inline policy, stated once: a routine of a few operations per entry is `#[inline(always)]`
+//! (it is cheaper inlined than called, on a Cortex-M4F as on x86); a routine with a loop over a
+//! run-time dimension is `#[inline(never)]` (one copy serves every size); everything else is
+//! left to the compiler. No other module of the crate carries an inline attribute.
+//!
+//! Every routine has a reference test here that compares it with the nalgebra expression it
+//! stands for, within a bound derived from the floating-point error of the operation
+//! (`γ_k = k ε / (1 − k ε)` for a sum of `k` products, Higham, *Accuracy and Stability of
+//! Numerical Algorithms*, §3.1), never bit for bit.
+//!
+//! Storage is nalgebra's: column-major, entry `(i, j)` of an `R × C` matrix at `j·R + i`.
+
+pub(crate) mod block;
+pub(crate) mod cholesky;
+pub(crate) mod finite;
+pub(crate) mod mat3;
+pub(crate) mod slice;
+
+pub(crate) use finite::{all_finite, non_negative_finite, positive_finite};

@@ -86,7 +86,11 @@ fn suite<T: Real>(c: &mut Criterion, tag: &str) {
             if n.is_multiple_of(1000) {
                 a = a_start;
             }
-            let r = a.predict(black_box(&g), T::lit(0.005));
+            let r = a.predict(black_box(&ImuSample {
+                gyro: g,
+                accel: Vector3::zeros(),
+                dt: T::lit(0.005),
+            }));
             black_box(r)
         })
     });

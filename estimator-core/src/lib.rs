@@ -24,8 +24,8 @@
 #![warn(missing_docs)]
 
 pub mod eskf;
-mod kernels;
 pub mod gn;
+mod kernels;
 pub mod lie;
 pub mod scalar;
 #[cfg(test)]

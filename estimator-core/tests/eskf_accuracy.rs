@@ -193,8 +193,12 @@ pub fn run_ahrs<T: Real>(seed: u64) -> AhrsRun {
     let (mut att2, mut n, mut inside, mut total) = (0.0, 0usize, 0usize, 0usize);
     for k in 1..=(RUN / DT) as usize {
         let s = sim.step();
-        f.predict(&cast_model_f64::<T>(&s.gyro), T::lit(DT))
-            .expect("predict");
+        f.predict(&ImuSample {
+            gyro: cast_model_f64::<T>(&s.gyro),
+            accel: cast_model_f64::<T>(&s.accel),
+            dt: T::lit(DT),
+        })
+        .expect("predict");
         if k % 4 == 0 {
             let m = sim.mag(MAG_SIGMA);
             f.update(
@@ -362,7 +366,7 @@ fn zupt_heading_and_gravity_at_rest() {
     for k in 1..=6000 {
         let s = sim.step();
         f.predict(&s).expect("predict");
-        a.predict(&s.gyro, s.dt).expect("predict");
+        a.predict(&s).expect("predict");
         if k % 10 == 0 {
             assert!(f
                 .update(&ZeroVelocity::new(0.01), &opts)

@@ -109,7 +109,7 @@ fn ahrs_nees_within_chi_square_bounds() {
         let opts = UpdateOptions::ekf(Gate::Off);
         for k in 1..=STEPS {
             let s = sim.step();
-            f.predict(&s.gyro, s.dt).expect("predict");
+            f.predict(&s).expect("predict");
             if k % 4 == 0 {
                 let m = sim.mag(0.5);
                 f.update(&Magnetometer::new(m, mag_reference(), 0.5), &opts)

@@ -396,7 +396,7 @@ fn ahrs<T: Scalar>(out: &mut Outcome<T>) -> Option<Ahrs<T>> {
             out.failure = 13;
             return None;
         };
-        if f.predict(&imu.gyro, dt).is_err() {
+        if f.predict(&imu).is_err() {
             out.failure = 13;
         }
         let now = k + 1;

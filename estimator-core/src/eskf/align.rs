@@ -9,9 +9,9 @@
 //!   `(u, h_w, u × h_w)`: `R = W Bᵀ`.
 //! * Initial gyro bias: the mean angular rate `ω̄` (the body does not rotate).
 
+use super::config::FilterConfig;
 use super::error::EskfError;
-use super::imu::{axpy, finite, mm, tr33};
-use super::models::{add3, div3, dot3, neg3, norm3};
+use crate::kernels::{all_finite, mat3};
 use crate::lie::So3;
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
@@ -43,22 +43,21 @@ fn mean<T: Real>(xs: &[Vector3<T>]) -> Result<Vector3<T>, EskfError> {
     let mut sum = Vector3::zeros();
     let mut n = T::zero();
     for x in xs {
-        if !finite(x) {
+        if !all_finite(x.as_slice()) {
             return Err(EskfError::NonFinite);
         }
-        sum = add3(&sum, x);
+        sum += x;
         n += T::one();
     }
-    Ok(div3(&sum, n))
+    Ok(sum / n)
 }
 
 /// The unit vector along the part of `v` orthogonal to the unit `u`, if any.
 fn horizontal<T: Real>(v: &Vector3<T>, u: &Vector3<T>) -> Option<Vector3<T>> {
-    // `v − u (u·v)` as `v + u·(−u·v)`: the same bits (negation is exact).
-    let h = axpy(v, u, -dot3(u, v));
-    let n = norm3(&h);
-    if n > T::lit(1e-6) * norm3(v) && n > T::zero() {
-        Some(div3(&h, n))
+    let h = mat3::axpy(v, -u.dot(v), u);
+    let n = h.norm();
+    if n > T::lit(1e-6) * v.norm() && n > T::zero() {
+        Some(h / n)
     } else {
         None
     }
@@ -70,16 +69,9 @@ fn level_axis<T: Real>(u: &Vector3<T>) -> Option<Vector3<T>> {
     horizontal(&Vector3::x(), u).or_else(|| horizontal(&Vector3::y(), u))
 }
 
-/// The triad `[u, h, u × h]` (columns); the cross product written out as nalgebra's `cross`
-/// (the same products and differences), without its generic code.
-#[cfg_attr(estimator_compact, inline(never))]
-pub(crate) fn triad<T: Real>(u: &Vector3<T>, h: &Vector3<T>) -> Matrix3<T> {
-    let c = Vector3::new(
-        u.y * h.z - u.z * h.y,
-        u.z * h.x - u.x * h.z,
-        u.x * h.y - u.y * h.x,
-    );
-    Matrix3::new(u.x, h.x, c.x, u.y, h.y, c.y, u.z, h.z, c.z)
+/// The triad `[u, h, u × h]` (columns).
+fn triad<T: Real>(u: &Vector3<T>, h: &Vector3<T>) -> Matrix3<T> {
+    Matrix3::from_columns(&[*u, *h, u.cross(h)])
 }
 
 /// Static alignment from samples at rest.
@@ -96,52 +88,41 @@ pub fn align_at_rest<T: Real>(
     mag: Option<&MagnetometerWindow<'_, T>>,
     rest_tolerance: T,
 ) -> Result<Alignment<T>, EskfError> {
-    // The means read inside their `Result`s, not moved out of them (no copies at opt-level "s").
-    let (f, w) = (mean(accel), mean(gyro));
-    let (f, w) = match (&f, &w) {
-        (Ok(f), Ok(w)) => (f, w),
-        (Err(e), _) | (_, Err(e)) => return Err(*e),
-    };
-    if !(finite(gravity) && rest_tolerance.is_finite()) {
+    let (f, w) = (mean(accel)?, mean(gyro)?);
+    if !(all_finite(gravity.as_slice()) && rest_tolerance.is_finite()) {
         return Err(EskfError::NonFinite);
     }
-    let (nf, ng) = (norm3(f), norm3(gravity));
+    let (nf, ng) = (f.norm(), gravity.norm());
     if !(nf > T::zero() && ng > T::zero()) {
         return Err(EskfError::ZeroNorm);
     }
     if (nf - ng).abs() > rest_tolerance {
         return Err(EskfError::NotAtRest);
     }
-    let ub = div3(f, nf);
-    let uw = div3(&neg3(gravity), ng);
-    // Matched in place (not moved into new bindings): no copy of the pair at opt-level "s".
+    let ub = f / nf;
+    let uw = -gravity / ng;
     let pair = match mag {
         Some(m) => {
-            let mb = mean(m.samples);
-            let mb = match &mb {
-                Ok(mb) => mb,
-                Err(e) => return Err(*e),
-            };
-            if !finite(&m.reference) {
+            let mb = mean(m.samples)?;
+            if !all_finite(m.reference.as_slice()) {
                 return Err(EskfError::NonFinite);
             }
-            (horizontal(mb, &ub), horizontal(&m.reference, &uw))
+            (horizontal(&mb, &ub), horizontal(&m.reference, &uw))
         }
         None => (level_axis(&ub), level_axis(&uw)),
     };
-    let (Some(hb), Some(hw)) = &pair else {
+    let (Some(hb), Some(hw)) = pair else {
         return Err(EskfError::ZeroNorm);
     };
-    let from_mag = mag.is_some();
     // R = W Bᵀ, W = [u_w, h_w, u_w × h_w], B = [u_b, h_b, u_b × h_b] (columns).
-    let attitude = So3::from_rotation_matrix(&mm(&triad(&uw, hw), &tr33(&triad(&ub, hb))));
-    let Some(attitude) = &attitude else {
-        return Err(EskfError::NonFinite);
-    };
+    let w_triad = triad(&uw, &hw);
+    let b_triad = triad(&ub, &hb);
+    let attitude = So3::from_rotation_matrix(&mat3::mul(&w_triad, &b_triad.transpose()))
+        .ok_or(EskfError::NonFinite)?;
     Ok(Alignment {
-        attitude: *attitude,
-        gyro_bias: *w,
-        heading_from_magnetometer: from_mag,
+        attitude,
+        gyro_bias: w,
+        heading_from_magnetometer: mag.is_some(),
     })
 }
 
@@ -185,21 +166,8 @@ impl<T: Real> InitialSigmas<T> {
         let t2 = self.tilt * self.tilt;
         let y2 = self.yaw * self.yaw;
         // Σ_w = σ_t² I + (σ_ψ² − σ_t²) u uᵀ.
-        // Written out entry by entry: `I t2 + (u uᵀ) d`, the same products and sums.
-        let (d, o) = (y2 - t2, T::zero() * t2);
-        let e = |a: T, b: T, i: T| i + a * b * d;
-        let sw = Matrix3::new(
-            e(up.x, up.x, t2),
-            e(up.x, up.y, o),
-            e(up.x, up.z, o),
-            e(up.y, up.x, o),
-            e(up.y, up.y, t2),
-            e(up.y, up.z, o),
-            e(up.z, up.x, o),
-            e(up.z, up.y, o),
-            e(up.z, up.z, t2),
-        );
-        mm(&mm(&tr33(&r), &sw), &r)
+        let sw = Matrix3::from_diagonal_element(t2) + up * up.transpose() * (y2 - t2);
+        mat3::mul(&mat3::mul(&r.transpose(), &sw), &r)
     }
 }
 
@@ -208,12 +176,12 @@ impl<T: Real> InitialSigmas<T> {
 pub(crate) fn prior_attitude_covariance<T: Real>(
     alignment: &Alignment<T>,
     sigmas: &InitialSigmas<T>,
-    config: &super::imu::FilterConfig<T>,
-) -> Result<nalgebra::Matrix3<T>, EskfError> {
-    let gn = norm3(&config.gravity);
-    if !super::imu::greater(gn, T::zero()) {
+    config: &FilterConfig<T>,
+) -> Result<Matrix3<T>, EskfError> {
+    let gn = config.gravity.norm();
+    if !(gn > T::zero()) {
         return Err(EskfError::ZeroNorm);
     }
-    let up = div3(&neg3(&config.gravity), gn);
+    let up = -config.gravity / gn;
     Ok(sigmas.attitude_covariance(&alignment.attitude, &up))
 }

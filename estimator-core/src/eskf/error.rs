@@ -62,7 +62,7 @@ impl core::fmt::Display for EskfError {
 pub enum UpdateOutcome<T: Real> {
     /// The measurement passed the gate and was fused.
     Accepted {
-        /// Normalized innovation squared `rᵀ S⁻¹ r` at the prior (seed Remark 4.2: the squared
+        /// Normalized innovation squared `rᵀ S⁻¹ r` at the prior (the squared
         /// Mahalanobis distance of the innovation).
         nis: T,
         /// Gauss-Newton iterations performed (1 for the plain EKF update).

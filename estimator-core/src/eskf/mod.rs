@@ -1,13 +1,23 @@
 //! On-manifold error-state Kalman filter: a 15-state inertial navigator ([`Ins`]) and an
-//! attitude-only AHRS ([`Ahrs`]), with chi-square gating, Joseph-form updates, iterated
-//! (Gauss-Newton) updates and typed outcomes. Allocation-free and panic-free.
+//! attitude-only AHRS ([`Ahrs`]), one generic implementation ([`Filter`]), with chi-square
+//! gating, Joseph-form updates, iterated (Gauss-Newton) updates and typed outcomes.
+//! Allocation-free and panic-free.
+//!
+//! Equations cite *Lie Groups and Smooth Manifolds for Robotic State Estimation* ("the
+//! paper") by number, each restated where it is used.
+//!
+//! # Layout
+//!
+//! `state.rs` (the nominal states and `⊕`), `config.rs` (IMU samples, noise, configuration),
+//! `predict.rs` (the prediction), `update/` (gain, gate, commit), `models/` (one file per
+//! sensor), `align.rs` (start-up), `filter.rs` (the filter the user holds).
 //!
 //! # State and error
 //!
 //! Nominal state `x = (R, v, p, b_g, b_a)`: `R ∈ SO(3)` world-from-body ([`crate::lie::So3`]),
 //! velocity `v` and position `p` in the world frame (ENU, z up), gyro and accelerometer biases in
 //! the body frame. Error state `δx = (δθ, δv, δp, δb_g, δb_a) ∈ R¹⁵` with the attitude error on the
-//! right (seed eq. 4.5, the crate's convention):
+//! right (the paper's eq. 4.5, `a ⊕ τ = a·exp(τ^)`, the crate's convention):
 //!
 //! ```text
 //! R = R̂ · exp(δθ^),   v = v̂ + δv,   p = p̂ + δp,   b_g = b̂_g + δb_g,   b_a = b̂_a + δb_a
@@ -16,7 +26,7 @@
 //! so `x = x̂ ⊕ δx` ([`ErrorState::oplus`]). The attitude-only state is `(R, b_g)` with
 //! `δx = (δθ, δb_g) ∈ R⁶`.
 //!
-//! # Prediction ([`Ins::predict`], [`Ahrs::predict`])
+//! # Prediction ([`Filter::predict`])
 //!
 //! One IMU sample `(ω_m, f_m, dt)`, held constant over `dt`; `ω = ω_m − b_g`, `f = f_m − b_a`,
 //! `a = R f + g` (`g = [0, 0, −9.81]` by default):
@@ -51,23 +61,24 @@
 //! The AHRS uses the `(δθ, δb_g)` corner: `F = [ΔRᵀ, −J_r dt; 0, I]`,
 //! `Q = diag(σ_g² dt I, σ_bg² dt I)`.
 //!
-//! # Measurement update ([`Ins::update`], [`Ahrs::update`])
+//! # Measurement update ([`Filter::update`])
 //!
 //! A model ([`Measurement`]) gives the residual `r = z ⊖ h(x̂)` and the right Jacobian
-//! `H = ∂h(x̂ ⊕ δx)/∂δx` (seed eq. 4.3 and Def. 4.6), and its noise `R`. Then
+//! `H = ∂h(x̂ ⊕ δx)/∂δx`, with `h(x̂ ⊕ δx) ≈ h(x̂) + H δx` (the paper's eq. 4.3 and
+//! Definition 4.6), and its noise `R`. Then
 //!
 //! ```text
 //! S   = H P Hᵀ + R
-//! NIS = rᵀ S⁻¹ r                        squared Mahalanobis distance (seed eq. 4.1, Remark 4.2)
+//! NIS = rᵀ S⁻¹ r                        squared Mahalanobis distance ‖e‖²_Σ = eᵀΣ⁻¹e (eq. 4.1)
 //! gate: NIS ≤ χ²_m(p), else Rejected { nis } and nothing changes
-//! K   = P Hᵀ S⁻¹,  δx = K r            the minimizer of seed eq. 4.4 with the prior added
+//! K   = P Hᵀ S⁻¹,  δx = K r            the minimizer of eq. 4.4 with the prior ‖δx‖²_P added
 //! P⁺  = (I − KH) P (I − KH)ᵀ + K R Kᵀ  Joseph form, evaluated as P − KUᵀ − UKᵀ + KSKᵀ, U = P Hᵀ
 //!                                       = P + V Kᵀ + K Vᵀ, V = ½KS − U (exactly symmetric, in place)
-//! x⁺  = x̂ ⊕ δx                          injection (seed eq. 4.5)
+//! x⁺  = x̂ ⊕ δx                          injection (eq. 4.5)
 //! P⁺ ← G P⁺ Gᵀ,  G = blockdiag(J_r(δθ), I)   reset to the error about x⁺
 //! ```
 //!
-//! The iterated update ([`UpdateOptions::iterated`]) is Gauss-Newton on the manifold (seed §4) for
+//! The iterated update ([`UpdateOptions::iterated`]) is Gauss-Newton on the manifold (the paper's §4) for
 //! `‖δx‖²_P + ‖z ⊖ h(x̂ ⊕ δx)‖²_R`: at `x_k = x̂ ⊕ δx_k` the model is linearized again,
 //! `H̃_k = H_k · blockdiag(J_r(δθ_k), I)` and `δx_{k+1} = K_k (r_k + H̃_k δx_k)`, until
 //! `‖δx_{k+1} − δx_k‖ < tol` or the iteration cap. The gate uses the NIS at the prior.
@@ -76,7 +87,7 @@
 //!
 //! | model | `h(x)` | nonzero blocks of `H` |
 //! |---|---|---|
-//! | [`GnssPosition`] | `p + R ℓ` | `δθ: −R[ℓ]×` (seed Thm 5.1 / Ex. 5.2), `δp: I` |
+//! | [`GnssPosition`] | `p + R ℓ` | `δθ: −R[ℓ]×` (action Jacobian, Theorem 5.1 / Example 5.2), `δp: I` |
 //! | [`GnssVelocity`] | `v` | `δv: I` |
 //! | [`ZeroVelocity`] | `v` (z = 0) | `δv: I` |
 //! | [`BaroAltitude`] | `p_z + offset` | `δp: [0 0 1]` |
@@ -84,27 +95,22 @@
 //! | [`GravityDirection`] | `Rᵀ u` (u up) vs `f_m/‖f_m‖` | `δθ: [Rᵀ u]×` |
 //! | [`AccelerometerAtRest`] | `Rᵀ(−g) + b_a` | `δθ: [Rᵀ(−g)]×`, `δb_a: I` |
 //! | [`Heading`] | `atan2(R₂₁, R₁₁)` | `δθ: (c_x ∂c_y − c_y ∂c_x)/(c_x²+c_y²)`, `∂(R e₁) = −R[e₁]×` |
-//! | [`CameraLandmark`] | `π(T_cw ℓ)` (seed `z_ij = π(T_i p_j)`) | `δθ: J_π R_bcᵀ [q]×`, `δp: −J_π R_bcᵀ Rᵀ` |
+//! | [`CameraLandmark`] | `π(T_cw ℓ)` (the paper's `z_ij = π(T_i p_j)`, §4) | `δθ: J_π R_bcᵀ [q]×`, `δp: −J_π R_bcᵀ Rᵀ` |
 //!
 //! # Start-up
 //!
 //! [`align_at_rest`] gives tilt from the mean specific force, heading from the magnetometer when
-//! present, and the gyro bias from the mean rate; [`Ins::from_alignment`] /
-//! [`Ahrs::from_alignment`] start from it, [`Ins::new`] / [`Ahrs::new`] from a given state and
-//! covariance.
+//! present, and the gyro bias from the mean rate; `Ins::from_alignment` /
+//! `Ahrs::from_alignment` start from it, [`Filter::new`] from a given state and covariance.
 //!
 //! # Resources
 //!
-//! `size_of::<Ins<f32>>()` is 996 bytes (state 64, `P` as a full 15 × 15 `f32` 900, configuration
-//! 32); `Ahrs<f32>` is 204 bytes. No scratch space is stored. Each update runs in non-inlined
-//! phases (linearize, gain, iterate, commit) sharing one small working set (sized for 15
-//! states in both filters), so no `N × N` temporary exists during an update. The update is
-//! compiled once per scalar type and filter, not once per measurement model: every model with up
-//! to three rows goes through one shared core (`&dyn`, padded to three rows; see `update.rs`),
-//! so adding models costs only their own `linearize`; built for size, the steps that do not
-//! touch the state (gain, gate, Gauss-Newton step, covariance) are one copy for both filters.
-//! Peak stack measured on a Cortex-M4F (f32, opt-level 3, painted): 984 bytes for the 15-state
-//! predict, 1,608 bytes for a GNSS or magnetometer update, 1,700 for an AHRS update.
+//! `size_of::<Ins<f32>>()` is 996 bytes (state 64, `P` as a full 15 × 15 `f32` 900,
+//! configuration 32); `Ahrs<f32>` is 204 bytes. No scratch space is stored. An update runs in
+//! separate phases (linearize, gain and gate, iterate, commit) over one small working set on
+//! the stack, so no `N × N` temporary exists during an update, and it is compiled once per
+//! scalar type and filter, not once per measurement model: every model with up to three rows
+//! goes through one core, its rows padded to three (`update/mod.rs`).
 //!
 //! # Edges
 //!
@@ -114,27 +120,24 @@
 //! filter is bit-for-bit unchanged. A gated-out measurement returns
 //! `Ok(`[`UpdateOutcome::Rejected`]`)` and also changes nothing.
 
-mod ahrs;
 mod align;
+mod config;
+mod covariance;
 mod error;
-mod gate;
-mod imu;
-mod ins;
+mod filter;
 mod models;
-#[cfg(test)]
-mod rewrites;
+mod predict;
 mod state;
 mod update;
 
-pub use ahrs::Ahrs;
 pub use align::{align_at_rest, Alignment, InitialSigmas, MagnetometerWindow};
+pub use config::{FilterConfig, ImuNoise, ImuSample};
 pub use error::{EskfError, UpdateOutcome};
-pub use gate::{Gate, GateProbability, CHI_SQUARE_TABLE};
-pub use imu::{FilterConfig, ImuNoise, ImuSample};
-pub use ins::Ins;
+pub use filter::{Ahrs, Filter, Ins};
 pub use models::{
     AccelerometerAtRest, BaroAltitude, CameraLandmark, GnssPosition, GnssVelocity,
     GravityDirection, Heading, Magnetometer, PinholeIntrinsics, ZeroVelocity,
 };
 pub use state::{AhrsState, ErrorState, InsState};
+pub use update::gate::{Gate, GateProbability, CHI_SQUARE_TABLE};
 pub use update::{Linearization, Measurement, UpdateOptions};

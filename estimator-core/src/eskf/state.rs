@@ -1,13 +1,18 @@
-//! Nominal states, their `⊕`, and the traits the generic update works on.
+//! Nominal states and their `⊕`.
 
-use super::imu::finite_vec;
+use super::config::{FilterConfig, ImuSample};
+use super::error::EskfError;
+use crate::kernels::all_finite;
 use crate::lie::{LieGroup, So3};
 use crate::Real;
-use nalgebra::{Matrix3x4, SVector, Vector3};
+use nalgebra::{SMatrix, SVector, Vector3};
 
 /// A nominal state with an `N`-dimensional error state whose first three components are the
-/// right attitude error `δθ` (`R = R̂·exp(δθ^)`, seed eq. 4.5) and whose other components are
-/// additive (`x = x̂ + δx`).
+/// right attitude error `δθ` (`R = R̂·exp(δθ^)`, the right `⊕` of *Lie Groups and Smooth
+/// Manifolds for Robotic State Estimation*, eq. 4.5: `a ⊕ τ = a·exp(τ^)`) and whose other
+/// components are additive (`x = x̂ + δx`).
+///
+/// Sealed: implemented by [`InsState`] (`N = 15`) and [`AhrsState`] (`N = 6`).
 pub trait ErrorState<T: Real, const N: usize>: Copy + sealed::Sealed {
     /// `x ⊕ δx`: `R ← R·exp(δθ^)`, every other block `+ δ`.
     #[must_use]
@@ -20,6 +25,18 @@ pub trait ErrorState<T: Real, const N: usize>: Copy + sealed::Sealed {
     /// The attitude `R` (world from body).
     #[must_use]
     fn attitude(&self) -> &So3<T>;
+
+    /// Propagates the state and its error covariance `P` over one IMU sample (the prediction
+    /// step; equations in the [`crate::eskf`] module docs). Writes `self` and `p` only on `Ok`.
+    ///
+    /// # Errors
+    /// [`EskfError::NonFinite`], [`EskfError::NonPositiveDt`], [`EskfError::DtTooLarge`].
+    fn propagate(
+        &mut self,
+        p: &mut SMatrix<T, N, N>,
+        imu: &ImuSample<T>,
+        config: &FilterConfig<T>,
+    ) -> Result<(), EskfError>;
 }
 
 pub(crate) mod sealed {
@@ -60,54 +77,6 @@ impl<T: Real> InsState<T> {
     }
 }
 
-impl<T: Real> ErrorState<T, 15> for InsState<T> {
-    fn oplus(&self, dx: &SVector<T, 15>) -> Self {
-        Self {
-            attitude: self.attitude.rplus(&seg(dx, 0)).normalize(),
-            velocity: plus_seg(&self.velocity, dx, 3),
-            position: plus_seg(&self.position, dx, 6),
-            gyro_bias: plus_seg(&self.gyro_bias, dx, 9),
-            accel_bias: plus_seg(&self.accel_bias, dx, 12),
-        }
-    }
-
-    fn is_finite(&self) -> bool {
-        // The four vectors side by side: one check (see `finite_vec`).
-        self.attitude.is_finite()
-            && finite_vec(&Matrix3x4::from_columns(&[
-                self.velocity,
-                self.position,
-                self.gyro_bias,
-                self.accel_bias,
-            ]))
-    }
-
-    fn attitude(&self) -> &So3<T> {
-        &self.attitude
-    }
-}
-
-/// Entries `k..k + 3` of `dx` (zero past the end, which no caller reaches): read from the
-/// storage, without nalgebra's generic row view.
-pub(crate) fn seg<T: Real, const N: usize>(dx: &SVector<T, N>, k: usize) -> Vector3<T> {
-    match dx.as_slice().get(k..k + 3) {
-        Some(&[a, b, c]) => Vector3::new(a, b, c),
-        _ => Vector3::zeros(),
-    }
-}
-
-/// `v + dx[k..k + 3]`, entry by entry (the same sums as `v + dx.fixed_rows::<3>(k)`): the
-/// segment read here, the sum by the shared out-of-line [`add3`](super::models::add3) (one
-/// copy for both states).
-#[inline(always)]
-pub(crate) fn plus_seg<T: Real, const N: usize>(
-    v: &Vector3<T>,
-    dx: &SVector<T, N>,
-    k: usize,
-) -> Vector3<T> {
-    super::models::add3(v, &seg(dx, k))
-}
-
 /// The attitude-only nominal state `x = (R, b_g)`, error `δx = (δθ, δb_g) ∈ R⁶`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AhrsState<T: Real> {
@@ -128,19 +97,69 @@ impl<T: Real> AhrsState<T> {
     }
 }
 
-impl<T: Real> ErrorState<T, 6> for AhrsState<T> {
-    fn oplus(&self, dx: &SVector<T, 6>) -> Self {
+/// Entries `k..k + 3` of `dx` (zero past the end, which no caller reaches).
+fn segment<T: Real, const N: usize>(dx: &SVector<T, N>, k: usize) -> Vector3<T> {
+    match dx.as_slice().get(k..k + 3) {
+        Some(&[a, b, c]) => Vector3::new(a, b, c),
+        _ => Vector3::zeros(),
+    }
+}
+
+impl<T: Real> ErrorState<T, 15> for InsState<T> {
+    fn oplus(&self, dx: &SVector<T, 15>) -> Self {
         Self {
-            attitude: self.attitude.rplus(&seg(dx, 0)).normalize(),
-            gyro_bias: plus_seg(&self.gyro_bias, dx, 3),
+            attitude: self.attitude.rplus(&segment(dx, 0)).normalize(),
+            velocity: self.velocity + segment(dx, 3),
+            position: self.position + segment(dx, 6),
+            gyro_bias: self.gyro_bias + segment(dx, 9),
+            accel_bias: self.accel_bias + segment(dx, 12),
         }
     }
 
     fn is_finite(&self) -> bool {
-        self.attitude.is_finite() && finite_vec(&self.gyro_bias)
+        self.attitude.is_finite()
+            && all_finite(self.velocity.as_slice())
+            && all_finite(self.position.as_slice())
+            && all_finite(self.gyro_bias.as_slice())
+            && all_finite(self.accel_bias.as_slice())
     }
 
     fn attitude(&self) -> &So3<T> {
         &self.attitude
+    }
+
+    fn propagate(
+        &mut self,
+        p: &mut SMatrix<T, 15, 15>,
+        imu: &ImuSample<T>,
+        config: &FilterConfig<T>,
+    ) -> Result<(), EskfError> {
+        super::predict::predict_ins(self, p, imu, config)
+    }
+}
+
+impl<T: Real> ErrorState<T, 6> for AhrsState<T> {
+    fn oplus(&self, dx: &SVector<T, 6>) -> Self {
+        Self {
+            attitude: self.attitude.rplus(&segment(dx, 0)).normalize(),
+            gyro_bias: self.gyro_bias + segment(dx, 3),
+        }
+    }
+
+    fn is_finite(&self) -> bool {
+        self.attitude.is_finite() && all_finite(self.gyro_bias.as_slice())
+    }
+
+    fn attitude(&self) -> &So3<T> {
+        &self.attitude
+    }
+
+    fn propagate(
+        &mut self,
+        p: &mut SMatrix<T, 6, 6>,
+        imu: &ImuSample<T>,
+        config: &FilterConfig<T>,
+    ) -> Result<(), EskfError> {
+        super::predict::predict_ahrs(self, p, imu, config)
     }
 }

@@ -15,13 +15,20 @@ pub(crate) fn block<T: Real, const R: usize, const C: usize>(
     i: usize,
     j: usize,
 ) -> Matrix3<T> {
+    block_in(m.as_slice(), R, i, j)
+}
+
+/// Block `(i, j)` of the column-major matrix with `rows` rows stored in `s` (zero outside it).
+#[inline(always)]
+#[must_use]
+pub(crate) fn block_in<T: Real>(s: &[T], rows: usize, i: usize, j: usize) -> Matrix3<T> {
     let mut out = Matrix3::zeros();
-    if 3 * i + 3 > R {
+    if 3 * i + 3 > rows {
         return out;
     }
     for (c, dst) in out.as_mut_slice().chunks_exact_mut(3).enumerate() {
-        let s = R * (3 * j + c) + 3 * i;
-        if let Some(src) = m.as_slice().get(s..s + 3) {
+        let start = rows * (3 * j + c) + 3 * i;
+        if let Some(src) = s.get(start..start + 3) {
             dst.copy_from_slice(src);
         }
     }
@@ -78,7 +85,10 @@ mod tests {
         let m = SMatrix::<f64, 9, 6>::from_fn(|r, c| (10 * r + c) as f64);
         for i in 0..3 {
             for j in 0..2 {
-                assert_eq!(block(&m, i, j), m.fixed_view::<3, 3>(3 * i, 3 * j).into_owned());
+                assert_eq!(
+                    block(&m, i, j),
+                    m.fixed_view::<3, 3>(3 * i, 3 * j).into_owned()
+                );
                 let mut w = m;
                 let v = Matrix3::from_fn(|r, c| -((r + 3 * c) as f64));
                 set_block(&mut w, i, j, &v);

@@ -172,7 +172,11 @@ mod tests {
         assert!(!factor_in_place(&mut indefinite.clone(), 2, 0.0));
         // Rank one: the second pivot is zero up to rounding, below 16·2·ε of A_11.
         let singular = [1.0, 1.0, 1.0, 1.0 + 1e-17];
-        assert!(!factor_in_place(&mut singular.clone(), 2, 32.0 * f64::EPSILON));
+        assert!(!factor_in_place(
+            &mut singular.clone(),
+            2,
+            32.0 * f64::EPSILON
+        ));
         for bad in [f64::NAN, f64::INFINITY] {
             assert!(!factor_in_place(&mut [1.0, bad, bad, 1.0], 2, 0.0));
         }

@@ -223,3 +223,12 @@ pub fn chi2_wh(k: f64, z: f64) -> f64 {
     let c = 2.0 / (9.0 * k);
     k * (1.0 - c + z * c.sqrt()).powi(3)
 }
+
+/// An IMU sample with only a gyro reading (what the attitude-only filter's prediction reads).
+pub fn gyro_only<T: estimator_core::Real>(gyro: Vector3<T>, dt: T) -> ImuSample<T> {
+    ImuSample {
+        gyro,
+        accel: Vector3::zeros(),
+        dt,
+    }
+}

@@ -411,7 +411,7 @@ fn run_benchmarks(w: &scenario::Workload<f32>) -> Updates {
     updates.bench(&mut i, "ins_update_magnetometer", ins, &w.ins_mag, opts);
     let mut ahrs = w.ahrs;
     bench(&mut i, "ahrs_predict", || {
-        let _ = black_box(black_box(&mut ahrs).predict(black_box(&w.imu.gyro), w.imu.dt));
+        let _ = black_box(black_box(&mut ahrs).predict(black_box(&w.imu)));
     });
     let ahrs = &w.ahrs;
     updates.bench(&mut i, "ahrs_update_magnetometer", ahrs, &w.ahrs_mag, opts);

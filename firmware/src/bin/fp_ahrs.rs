@@ -8,7 +8,7 @@ mod footprint;
 
 use cortex_m_rt::entry;
 use estimator_core::eskf::{
-    Ahrs, AhrsState, FilterConfig, GravityDirection, Magnetometer, UpdateOptions,
+    Ahrs, AhrsState, FilterConfig, GravityDirection, ImuSample, Magnetometer, UpdateOptions,
 };
 use footprint::{input, input3, keep};
 use nalgebra::{SMatrix, Vector3};
@@ -25,7 +25,11 @@ fn main() -> ! {
     let options = UpdateOptions::default();
     let reference = Vector3::new(0.2, 0.0, -0.4);
     loop {
-        keep(&ahrs.predict(&input3(0), input(7)));
+        keep(&ahrs.predict(&ImuSample {
+            gyro: input3(0),
+            accel: input3(1),
+            dt: input(7),
+        }));
         keep(&ahrs.update(&GravityDirection::new(input3(1), input(7)), &options));
         keep(&ahrs.update(&Magnetometer::new(input3(2), reference, input(7)), &options));
         keep(ahrs.state());

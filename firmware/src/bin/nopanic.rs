@@ -276,7 +276,11 @@ fn ahrs<T: Real>(x: &Seed<T>, config: &FilterConfig<T>, opts: &UpdateOptions<T>)
         ahrs.config(),
         ahrs.sigmas(),
     ));
-    keep(&ahrs.predict(&v, g));
+    keep(&ahrs.predict(&ImuSample {
+        gyro: v,
+        accel: v,
+        dt: g,
+    }));
     macro_rules! ahrs_update {
         ($m:expr) => {{
             let m = $m;

@@ -169,13 +169,14 @@ impl<T: Real> Filter<T> {
         accel: &Vector3<f64>,
         dt: f64,
     ) -> Result<(), EskfError> {
+        let imu = ImuSample {
+            gyro: lit3(gyro),
+            accel: lit3(accel),
+            dt: T::lit(dt),
+        };
         match self {
-            Filter::Ins(f) => f.predict(&ImuSample {
-                gyro: lit3(gyro),
-                accel: lit3(accel),
-                dt: T::lit(dt),
-            }),
-            Filter::Ahrs(f) => f.predict(&lit3(gyro), T::lit(dt)),
+            Filter::Ins(f) => f.predict(&imu),
+            Filter::Ahrs(f) => f.predict(&imu),
         }
     }
 }

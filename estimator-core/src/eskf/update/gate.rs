@@ -1,7 +1,8 @@
 //! Chi-square gate on the normalized innovation squared.
 //!
 //! For a Gaussian innovation `r ~ N(0, S)` of dimension `m`, `NIS = rᵀ S⁻¹ r` (the squared
-//! Mahalanobis distance, seed eq. 4.1 / Remark 4.2) is chi-square with `m` degrees of freedom. The
+//! Mahalanobis distance of *Lie Groups and Smooth Manifolds for Robotic State Estimation*,
+//! eq. 4.1 / Remark 4.2) is chi-square with `m` degrees of freedom. The
 //! gate accepts when `NIS ≤ χ²_m(p)`. Quantiles for `m = 1..6` are tabulated (exact to 6
 //! significant digits); above 6 the Wilson–Hilferty approximation
 //! `χ²_m(p) ≈ m (1 − 2/(9m) + z_p √(2/(9m)))³` (relative error below 0.5 % for `m > 6` at these
@@ -30,15 +31,25 @@ pub const CHI_SQUARE_TABLE: [[f64; 3]; 6] = [
     [12.591_587, 16.811_894, 22.457_744],
 ];
 
+/// Standard-normal quantiles `z_p` for 0.95, 0.99, 0.999.
+const Z_SCORES: [f64; 3] = [1.644_853_6, 2.326_347_9, 3.090_232_3];
+
+/// `χ²` of row `R` (`R + 1` degrees of freedom), column `col` of [`CHI_SQUARE_TABLE`]. The row
+/// is a constant, so each arm is `T::lit` of a constant, folded at compile time: no run-time
+/// `f64` to `f32` conversion (software floating point on a Cortex-M4F).
+fn table_entry<T: Real, const R: usize>(col: usize) -> T {
+    match col {
+        0 => T::lit(CHI_SQUARE_TABLE[R][0]),
+        1 => T::lit(CHI_SQUARE_TABLE[R][1]),
+        _ => T::lit(CHI_SQUARE_TABLE[R][2]),
+    }
+}
+
 impl GateProbability {
     /// Standard-normal quantile `z_p`.
     #[must_use]
     pub fn z_score(self) -> f64 {
-        match self {
-            Self::P95 => 1.644_853_6,
-            Self::P99 => 2.326_347_9,
-            Self::P999 => 3.090_232_3,
-        }
+        Z_SCORES[self.column()]
     }
 
     fn column(self) -> usize {
@@ -55,30 +66,15 @@ impl GateProbability {
         if dof == 0 {
             return T::zero();
         }
-        // Each `T::lit` takes a literal, so it folds to a `T` constant: no run-time f64 → f32
-        // conversion (soft-float on a Cortex-M4F). Same numbers as `CHI_SQUARE_TABLE`, row
-        // `dof − 1`, column `p`; one `match` on the flat index, which the compiler turns into a
-        // table of constants.
         if dof <= 6 {
-            return match (dof - 1) * 3 + self.column() {
-                0 => T::lit(3.841_459),
-                1 => T::lit(6.634_897),
-                2 => T::lit(10.827_566),
-                3 => T::lit(5.991_465),
-                4 => T::lit(9.210_340),
-                5 => T::lit(13.815_511),
-                6 => T::lit(7.814_728),
-                7 => T::lit(11.344_867),
-                8 => T::lit(16.266_236),
-                9 => T::lit(9.487_729),
-                10 => T::lit(13.276_704),
-                11 => T::lit(18.466_827),
-                12 => T::lit(11.070_498),
-                13 => T::lit(15.086_272),
-                14 => T::lit(20.515_006),
-                15 => T::lit(12.591_587),
-                16 => T::lit(16.811_894),
-                _ => T::lit(22.457_744),
+            let c = self.column();
+            return match dof {
+                1 => table_entry::<T, 0>(c),
+                2 => table_entry::<T, 1>(c),
+                3 => table_entry::<T, 2>(c),
+                4 => table_entry::<T, 3>(c),
+                5 => table_entry::<T, 4>(c),
+                _ => table_entry::<T, 5>(c),
             };
         }
         // `dof` as a `T` without an integer-to-f64 conversion (software on a Cortex-M4F).
@@ -88,9 +84,9 @@ impl GateProbability {
         }
         let c = T::lit(2.0 / 9.0) / m;
         let z = match self {
-            Self::P95 => T::lit(1.644_853_6),
-            Self::P99 => T::lit(2.326_347_9),
-            Self::P999 => T::lit(3.090_232_3),
+            Self::P95 => T::lit(Z_SCORES[0]),
+            Self::P99 => T::lit(Z_SCORES[1]),
+            Self::P999 => T::lit(Z_SCORES[2]),
         };
         let base = T::one() - c + z * c.sqrt_rn();
         m * base * base * base

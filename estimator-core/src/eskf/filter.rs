@@ -1,0 +1,205 @@
+//! The error-state filter: one generic implementation behind [`Ins`] and [`Ahrs`].
+
+use super::align::{prior_attitude_covariance, Alignment, InitialSigmas};
+use super::config::{FilterConfig, ImuSample};
+use super::covariance::{check_start, sigmas};
+use super::error::{EskfError, UpdateOutcome};
+use super::state::{AhrsState, ErrorState, InsState};
+use super::update::{update, Measurement, UpdateOptions};
+use crate::kernels::block::{add_scaled_identity, set_block};
+use crate::Real;
+use nalgebra::{SMatrix, SVector, Vector3};
+
+/// The on-manifold error-state Kalman filter over the nominal state `S` with an
+/// `N`-dimensional error state: the state, its full `N × N` covariance `P` and the
+/// configuration, and no scratch space.
+///
+/// Use it through [`Ins`] (`x = (R, v, p, b_g, b_a)`, `N = 15`) or [`Ahrs`] (`x = (R, b_g)`,
+/// `N = 6`). Every method that takes outside data returns a `Result`; on `Err`, and on a
+/// gated-out measurement, the filter is unchanged bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Filter<T: Real, S, const N: usize> {
+    state: S,
+    covariance: SMatrix<T, N, N>,
+    config: FilterConfig<T>,
+}
+
+/// The 15-state inertial filter, `x = (R, v, p, b_g, b_a)`, `δx ∈ R¹⁵`
+/// (`size_of::<Ins<f32>>()` is 996 bytes).
+///
+/// ```
+/// use estimator_core::eskf::{FilterConfig, GnssPosition, ImuSample, Ins, InsState, UpdateOptions};
+/// use nalgebra::{SMatrix, Vector3};
+///
+/// let p0 = SMatrix::<f32, 15, 15>::identity() * 0.01;
+/// let mut ins = Ins::new(InsState::identity(), p0, FilterConfig::default()).unwrap();
+/// // At rest and level for one second at 200 Hz: the accelerometer reads +g up.
+/// let imu = ImuSample { gyro: Vector3::zeros(), accel: Vector3::new(0.0, 0.0, 9.81), dt: 0.005 };
+/// for _ in 0..200 {
+///     ins.predict(&imu).unwrap();
+/// }
+/// let fix = GnssPosition::new(Vector3::zeros(), Vector3::zeros(), 0.5);
+/// ins.update(&fix, &UpdateOptions::default()).unwrap();
+/// assert!(ins.state().position.norm() < 0.01);
+/// assert!(ins.sigmas()[6] < 0.5); // east position σ, m
+/// ```
+pub type Ins<T> = Filter<T, InsState<T>, 15>;
+
+/// The attitude-only filter (AHRS), `x = (R, b_g)`, `δx = (δθ, δb_g) ∈ R⁶`, aided by
+/// [`GravityDirection`](super::GravityDirection), [`Magnetometer`](super::Magnetometer) and
+/// [`Heading`](super::Heading). Its prediction reads only the gyro and `dt` of an
+/// [`ImuSample`].
+///
+/// ```
+/// use estimator_core::eskf::{Ahrs, AhrsState, FilterConfig, GravityDirection, ImuSample, UpdateOptions};
+/// use nalgebra::{SMatrix, Vector3};
+///
+/// let p0 = SMatrix::<f32, 6, 6>::identity() * 1e-3;
+/// let mut ahrs = Ahrs::new(AhrsState::identity(), p0, FilterConfig::default()).unwrap();
+/// // Turning about z at 0.5 rad/s for one second at 100 Hz.
+/// let imu = ImuSample { gyro: Vector3::new(0.0, 0.0, 0.5), accel: Vector3::new(0.0, 0.0, 9.81), dt: 0.01 };
+/// for _ in 0..100 {
+///     ahrs.predict(&imu).unwrap();
+///     ahrs.update(&GravityDirection::new(imu.accel, 0.05), &UpdateOptions::default()).unwrap();
+/// }
+/// let (_, _, yaw) = ahrs.state().attitude.quaternion().euler_angles();
+/// assert!((yaw - 0.5).abs() < 1e-3);
+/// ```
+pub type Ahrs<T> = Filter<T, AhrsState<T>, 6>;
+
+impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
+    /// From a given state and covariance.
+    ///
+    /// # Errors
+    /// A non-finite state, `P` not symmetric positive definite, or an invalid configuration
+    /// ([`FilterConfig::validate`]).
+    pub fn new(
+        state: S,
+        covariance: SMatrix<T, N, N>,
+        config: FilterConfig<T>,
+    ) -> Result<Self, EskfError> {
+        check_start(&state, &covariance, &config)?;
+        Ok(Self {
+            state,
+            covariance,
+            config,
+        })
+    }
+
+    /// The nominal state.
+    #[must_use]
+    pub fn state(&self) -> &S {
+        &self.state
+    }
+
+    /// The error-state covariance `P`.
+    #[must_use]
+    pub fn covariance(&self) -> &SMatrix<T, N, N> {
+        &self.covariance
+    }
+
+    /// The configuration.
+    #[must_use]
+    pub fn config(&self) -> &FilterConfig<T> {
+        &self.config
+    }
+
+    /// `√diag(P)`, the 1-σ of each error-state component.
+    #[must_use]
+    pub fn sigmas(&self) -> SVector<T, N> {
+        sigmas(&self.covariance)
+    }
+
+    /// Propagates with one IMU sample: nominal integration and `P⁺ = F P Fᵀ + Q` (equations in
+    /// the [`crate::eskf`] module docs).
+    ///
+    /// # Errors
+    /// [`EskfError::NonFinite`], [`EskfError::NonPositiveDt`], [`EskfError::DtTooLarge`]; the
+    /// filter is then unchanged.
+    pub fn predict(&mut self, imu: &ImuSample<T>) -> Result<(), EskfError> {
+        self.state
+            .propagate(&mut self.covariance, imu, &self.config)
+    }
+
+    /// Fuses one measurement: gate, Joseph form, optional Gauss-Newton iterations, injection
+    /// through `⊕`, reset ([`crate::eskf`] module docs). Returns the outcome with its NIS; a
+    /// `Rejected` outcome leaves the filter unchanged.
+    ///
+    /// # Errors
+    /// Invalid options, a noise that is not symmetric positive definite, the model's own
+    /// errors, or a numerical failure; the filter is then unchanged.
+    pub fn update<Mo, const M: usize>(
+        &mut self,
+        model: &Mo,
+        options: &UpdateOptions<T>,
+    ) -> Result<UpdateOutcome<T>, EskfError>
+    where
+        Mo: Measurement<T, S, N, M>,
+    {
+        update(&mut self.state, &mut self.covariance, model, options)
+    }
+}
+
+impl<T: Real> Filter<T, InsState<T>, 15> {
+    /// From a static [`Alignment`] at `position` (velocity zero, accelerometer bias zero), with
+    /// the initial uncertainties `sigmas` (attitude covariance from
+    /// [`InitialSigmas::attitude_covariance`]).
+    ///
+    /// # Errors
+    /// As [`Filter::new`], and [`EskfError::ZeroNorm`] for a zero gravity.
+    pub fn from_alignment(
+        alignment: &Alignment<T>,
+        position: Vector3<T>,
+        sigmas: &InitialSigmas<T>,
+        config: FilterConfig<T>,
+    ) -> Result<Self, EskfError> {
+        config.validate()?;
+        let state = InsState {
+            attitude: alignment.attitude,
+            velocity: Vector3::zeros(),
+            position,
+            gyro_bias: alignment.gyro_bias,
+            accel_bias: Vector3::zeros(),
+        };
+        let mut p = SMatrix::<T, 15, 15>::zeros();
+        set_block(
+            &mut p,
+            0,
+            0,
+            &prior_attitude_covariance(alignment, sigmas, &config)?,
+        );
+        let sq = |s: T| s * s;
+        add_scaled_identity(&mut p, 1, 1, sq(sigmas.velocity));
+        add_scaled_identity(&mut p, 2, 2, sq(sigmas.position));
+        add_scaled_identity(&mut p, 3, 3, sq(sigmas.gyro_bias));
+        add_scaled_identity(&mut p, 4, 4, sq(sigmas.accel_bias));
+        Self::new(state, p, config)
+    }
+}
+
+impl<T: Real> Filter<T, AhrsState<T>, 6> {
+    /// From a static [`Alignment`], with `sigmas.tilt`, `sigmas.yaw`, `sigmas.gyro_bias`.
+    ///
+    /// # Errors
+    /// As [`Filter::new`], and [`EskfError::ZeroNorm`] for a zero gravity.
+    pub fn from_alignment(
+        alignment: &Alignment<T>,
+        sigmas: &InitialSigmas<T>,
+        config: FilterConfig<T>,
+    ) -> Result<Self, EskfError> {
+        config.validate()?;
+        let mut p = SMatrix::<T, 6, 6>::zeros();
+        set_block(
+            &mut p,
+            0,
+            0,
+            &prior_attitude_covariance(alignment, sigmas, &config)?,
+        );
+        add_scaled_identity(&mut p, 1, 1, sigmas.gyro_bias * sigmas.gyro_bias);
+        let state = AhrsState {
+            attitude: alignment.attitude,
+            gyro_bias: alignment.gyro_bias,
+        };
+        Self::new(state, p, config)
+    }
+}

@@ -1,0 +1,112 @@
+//! The accelerometer as a gravity sensor: its direction (both filters), or the whole specific
+//! force of a body at rest with the accelerometer bias (15-state filter).
+
+use super::{in_body, isotropic, three_rows};
+use crate::eskf::update::{Linearization, Measurement};
+use crate::eskf::{ErrorState, EskfError, InsState};
+use crate::kernels::all_finite;
+use crate::Real;
+use nalgebra::{Matrix3, Vector3};
+
+/// Accelerometer gravity direction (tilt aiding, for a body near rest):
+/// `z = f_m/‖f_m‖`, `h(x) = Rᵀ u` with `u` the world up direction, `H = [[Rᵀ u]×, 0, …]`.
+/// For both filters.
+///
+/// The model neglects the accelerometer bias and any non-gravitational acceleration; both are
+/// time-correlated errors (`‖b_a‖/g`, `‖a‖/g` radians), so `σ` must cover them, or repeated
+/// updates make the filter overconfident. In the 15-state filter, which estimates `b_a`, prefer
+/// [`AccelerometerAtRest`] or [`ZeroVelocity`](super::ZeroVelocity) at rest.
+///
+/// ```
+/// use estimator_core::eskf::{Ahrs, AhrsState, FilterConfig, GravityDirection, UpdateOptions};
+/// use nalgebra::{SMatrix, Vector3};
+///
+/// let mut ahrs = Ahrs::new(AhrsState::identity(), SMatrix::identity() * 0.01, FilterConfig::<f32>::default()).unwrap();
+/// // Level: the accelerometer reads +g along body z.
+/// ahrs.update(&GravityDirection::new(Vector3::new(0.0, 0.0, 9.81), 0.02), &UpdateOptions::default()).unwrap();
+/// assert!(ahrs.sigmas()[0] < 0.03 && ahrs.sigmas()[1] < 0.03); // roll and pitch observed
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GravityDirection<T: Real> {
+    /// Measured specific force `f_m`, body frame (normalized inside).
+    pub accel: Vector3<T>,
+    /// World direction the accelerometer reads at rest (`−g/‖g‖`, `[0, 0, 1]` in ENU).
+    pub up: Vector3<T>,
+    /// `R` on the unit direction (rad², small-angle).
+    pub noise: Matrix3<T>,
+}
+
+impl<T: Real> GravityDirection<T> {
+    /// ENU up `[0, 0, 1]`, isotropic noise `σ² I` (σ in radians of tilt).
+    #[must_use]
+    pub fn new(accel: Vector3<T>, sigma: T) -> Self {
+        Self {
+            accel,
+            up: Vector3::z(),
+            noise: isotropic(sigma),
+        }
+    }
+}
+
+impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for GravityDirection<T> {
+    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
+        if !(all_finite(self.accel.as_slice()) && all_finite(self.up.as_slice())) {
+            return Err(EskfError::NonFinite);
+        }
+        let (na, nu) = (self.accel.norm(), self.up.norm());
+        if !(na > T::zero() && nu > T::zero()) {
+            return Err(EskfError::ZeroNorm);
+        }
+        let (predicted, d_attitude) = in_body(x.attitude(), &(self.up / nu));
+        let residual = self.accel / na - predicted;
+        Ok(three_rows(residual, &[(0, &d_attitude)], &[]))
+    }
+
+    fn noise(&self) -> Matrix3<T> {
+        self.noise
+    }
+}
+
+/// The accelerometer of a body at rest (15-state filter): `h(x) = Rᵀ(−g) + b_a`,
+/// `H = [[Rᵀ(−g)]×, 0, 0, 0, I]`. Unlike [`GravityDirection`] it models the accelerometer bias,
+/// so repeated updates at rest stay consistent (tilt and horizontal bias are separated only as
+/// far as the data allow).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AccelerometerAtRest<T: Real> {
+    /// Measured specific force `f_m`, body frame, m/s².
+    pub accel: Vector3<T>,
+    /// World gravity `g` (`[0, 0, −9.81]`).
+    pub gravity: Vector3<T>,
+    /// `R`, (m/s²)².
+    pub noise: Matrix3<T>,
+}
+
+impl<T: Real> AccelerometerAtRest<T> {
+    /// ENU gravity `[0, 0, −9.81]`, isotropic noise `σ² I`.
+    #[must_use]
+    pub fn new(accel: Vector3<T>, sigma: T) -> Self {
+        Self {
+            accel,
+            gravity: Vector3::new(T::zero(), T::zero(), T::lit(-9.81)),
+            noise: isotropic(sigma),
+        }
+    }
+}
+
+impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
+    fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
+        if !(all_finite(self.accel.as_slice()) && all_finite(self.gravity.as_slice())) {
+            return Err(EskfError::NonFinite);
+        }
+        if self.accel.norm_squared() <= T::zero() {
+            return Err(EskfError::ZeroNorm);
+        }
+        let (predicted, d_attitude) = in_body(&x.attitude, &-self.gravity);
+        let residual = self.accel - (predicted + x.accel_bias);
+        Ok(three_rows(residual, &[(0, &d_attitude)], &[12]))
+    }
+
+    fn noise(&self) -> Matrix3<T> {
+        self.noise
+    }
+}

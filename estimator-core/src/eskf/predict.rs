@@ -1,0 +1,206 @@
+//! The prediction step: nominal integration of one IMU sample and the block-sparse covariance
+//! propagation `P⁺ = F P Fᵀ + Q` (equations in the [`crate::eskf`] module docs).
+
+use super::config::{check_dt, FilterConfig, ImuSample};
+use super::error::EskfError;
+use super::state::{AhrsState, ErrorState, InsState};
+use crate::kernels::block::{add_scaled_identity, block, block_in, set_block};
+use crate::kernels::{all_finite, mat3};
+use crate::lie::{skew, LieGroup, So3};
+use crate::Real;
+use nalgebra::{Matrix3, SMatrix};
+
+/// The nonzero blocks of the block rows θ, v, p (0, 1, 2) of the 15-state `F` (block indices
+/// θ=0, v=1, p=2, b_g=3, b_a=4):
+///
+/// ```text
+/// F00 = ΔRᵀ,  F03 = −J_r(ω dt) dt,
+/// F10 = A = −R[f]× dt,  F11 = I,  F14 = B = −R dt,
+/// F20 = ½ A dt,  F21 = I dt,  F22 = I,  F24 = ½ B dt,
+/// ```
+///
+/// with `A = B [f]×`. Block rows 3 and 4 are identity rows.
+struct FRows<T: Real> {
+    f00: Matrix3<T>,
+    f03: Matrix3<T>,
+    b: Matrix3<T>,
+    fx: Matrix3<T>,
+    dt: T,
+}
+
+impl<T: Real> FRows<T> {
+    /// Block rows 0..2 of `F Q` for block column `j` of the 15-row matrix stored in `q`:
+    /// `(F Q)₀ = F00 Q₀ + F03 Q₃` (when `rot`, else left zero), `(F Q)₁ = Q₁ + C`,
+    /// `(F Q)₂ = Q₂ + dt (Q₁ + ½ C)`, with `C = A Q₀ + B Q₄ = B([f]× Q₀ + Q₄)`.
+    fn apply(&self, q: &[T], j: usize, rot: bool, out: &mut [Matrix3<T>; 3]) {
+        let q_blk = |k: usize| block_in(q, 15, k, j);
+        let (q0, q1) = (q_blk(0), q_blk(1));
+        let c = mat3::mul(&self.b, &(mat3::mul(&self.fx, &q0) + q_blk(4)));
+        let [top, v, p] = out;
+        *top = if rot {
+            mat3::mul(&self.f00, &q0) + mat3::mul(&self.f03, &q_blk(3))
+        } else {
+            Matrix3::zeros()
+        };
+        *p = q_blk(2) + (q1 + c * T::lit(0.5)) * self.dt;
+        *v = q1 + c;
+    }
+}
+
+/// The 15-state prediction; writes only after every check passed.
+///
+/// Nominal: `ω = ω_m − b_g`, `f = f_m − b_a`, `a = R f + g`, `ΔR = exp(ω dt)`,
+/// `R⁺ = R ΔR`, `v⁺ = v + a dt`, `p⁺ = p + v dt + ½ a dt²`.
+/// Covariance: `P⁺ = F P Fᵀ + Q` with the nonzero blocks of `F` ([`FRows`]).
+pub(crate) fn predict_ins<T: Real>(
+    x: &mut InsState<T>,
+    p: &mut SMatrix<T, 15, 15>,
+    imu: &ImuSample<T>,
+    cfg: &FilterConfig<T>,
+) -> Result<(), EskfError> {
+    if !(all_finite(imu.gyro.as_slice()) && all_finite(imu.accel.as_slice())) {
+        return Err(EskfError::NonFinite);
+    }
+    let dt = imu.dt;
+    check_dt(dt, cfg.max_dt)?;
+    let half = T::lit(0.5);
+
+    let omega = imu.gyro - x.gyro_bias;
+    let f = imu.accel - x.accel_bias;
+    let (dr, jr) = So3::exp_jac(&(omega * dt));
+    let r = x.attitude.rotation_matrix();
+    let a = mat3::mul_vec(&r, &f) + cfg.gravity;
+    let new_x = InsState {
+        attitude: x.attitude.compose(&dr).renormalize(),
+        velocity: mat3::axpy(&x.velocity, dt, &a),
+        position: mat3::axpy(
+            &mat3::axpy(&x.position, dt, &x.velocity),
+            half * dt * dt,
+            &a,
+        ),
+        gyro_bias: x.gyro_bias,
+        accel_bias: x.accel_bias,
+    };
+
+    let fr = FRows {
+        f00: dr.rotation_matrix().transpose(),
+        f03: jr * -dt,
+        b: r * -dt,
+        fx: skew(&f),
+        dt,
+    };
+    let f_finite = [fr.f00, fr.f03, fr.b, fr.fx]
+        .iter()
+        .all(|m| all_finite(m.as_slice()));
+    // Two passes of one kernel, `FRows::apply` (F's block rows θ, v, p applied to a 15 × 3
+    // block column):
+    // * t = 0..5, F P: block column j = t of P gives M_ij = (F P)_ij, i = 0..2, stored as
+    //   L_ji = M_ijᵀ in L = (F P)ᵀ = P Fᵀ (15 × 9). Rows 3 and 4 of F are identity rows, so
+    //   (F P)_3j = P_3j and (F P)_4j = P_4j need no storage.
+    // * t = 5..8, N = F P Fᵀ = F L: block column i = t − 5 of N is F applied to block column i
+    //   of L. Only the blocks on and below the diagonal are kept (N is symmetric), in place of
+    //   L_ki: block column i of L is read once, and later columns are untouched.
+    let mut l = SMatrix::<T, 15, 9>::zeros();
+    let mut out = [Matrix3::<T>::zeros(); 3];
+    for t in 0..8 {
+        let (src, j) = if t < 5 {
+            (p.as_slice(), t)
+        } else {
+            (l.as_slice(), t - 5)
+        };
+        // Row θ of F L is needed only for N_00 (N_0i, i > 0, lies above the diagonal).
+        fr.apply(src, j, t <= 5, &mut out);
+        for (i, m) in out.iter().enumerate() {
+            if t < 5 {
+                set_block(&mut l, j, i, &m.transpose());
+            } else if i == j {
+                set_block(&mut l, i, j, &((m + m.transpose()) * half));
+            } else if i > j {
+                set_block(&mut l, i, j, m);
+            }
+        }
+    }
+    // F and P are finite, so N = F P Fᵀ can only fail by overflow, and for a positive
+    // semi-definite N, |N_ij| ≤ √(N_ii N_jj): a finite diagonal bounds every entry. The
+    // diagonal of N is the diagonal of L's top 9 × 9.
+    let diagonal_finite = (0..9).all(|k| l.get((k, k)).is_some_and(|d| d.is_finite()));
+    if !(f_finite && new_x.is_finite() && diagonal_finite) {
+        return Err(EskfError::NonFinite);
+    }
+    // The lower blocks N_ki (k ≥ i, i < 3) and their transposes; P_33, P_34, P_44 are
+    // unchanged before Q.
+    for i in 0..3 {
+        for k in i..5 {
+            let n = block(&l, k, i);
+            set_block(p, k, i, &n);
+            if k > i {
+                set_block(p, i, k, &n.transpose());
+            }
+        }
+    }
+    // Q from the continuous-time densities (module docs).
+    let n = &cfg.imu_noise;
+    let qa = n.accelerometer_noise_density * n.accelerometer_noise_density * dt;
+    let qg = n.gyroscope_noise_density * n.gyroscope_noise_density * dt;
+    add_scaled_identity(p, 0, 0, qg);
+    add_scaled_identity(p, 1, 1, qa);
+    add_scaled_identity(p, 1, 2, qa * dt * half);
+    add_scaled_identity(p, 2, 2, qa * dt * dt * T::lit(0.25));
+    let rw = |s: T| s * s * dt;
+    add_scaled_identity(p, 3, 3, rw(n.gyroscope_random_walk));
+    add_scaled_identity(p, 4, 4, rw(n.accelerometer_random_walk));
+    *x = new_x;
+    Ok(())
+}
+
+/// The attitude-only prediction: `R⁺ = R exp((ω_m − b_g) dt)`, `P⁺ = F P Fᵀ + Q`,
+/// `F = [ΔRᵀ, −J_r dt; 0, I]`, `Q = diag(σ_g² dt I, σ_bg² dt I)`. Only the gyro and `dt` of the
+/// sample are read.
+pub(crate) fn predict_ahrs<T: Real>(
+    x: &mut AhrsState<T>,
+    p: &mut SMatrix<T, 6, 6>,
+    imu: &ImuSample<T>,
+    cfg: &FilterConfig<T>,
+) -> Result<(), EskfError> {
+    if !all_finite(imu.gyro.as_slice()) {
+        return Err(EskfError::NonFinite);
+    }
+    let dt = imu.dt;
+    check_dt(dt, cfg.max_dt)?;
+    let (dr, jr) = So3::exp_jac(&((imu.gyro - x.gyro_bias) * dt));
+    // F00 = ΔRᵀ, so F00ᵀ = ΔR.
+    let f00t = dr.rotation_matrix();
+    let f00 = f00t.transpose();
+    let f01 = jr * -dt;
+    let (p00, p01, p11) = (block(p, 0, 0), block(p, 0, 1), block(p, 1, 1));
+    // M0j = F00 P0j + F01 P1j; P⁺00 = M00 F00ᵀ + M01 F01ᵀ; P⁺01 = M01; P⁺11 = P11.
+    let m00 = mat3::mul(&f00, &p00) + mat3::mul(&f01, &p01.transpose());
+    let m01 = mat3::mul(&f00, &p01) + mat3::mul(&f01, &p11);
+    // N00 is symmetric: its upper triangle, mirrored.
+    let n = mat3::mul(&m00, &f00t) + mat3::mul(&m01, &f01.transpose());
+    let n00 = Matrix3::new(
+        n.m11, n.m12, n.m13, n.m12, n.m22, n.m23, n.m13, n.m23, n.m33,
+    );
+    let attitude = x.attitude.compose(&dr).renormalize();
+    if !(all_finite(n00.as_slice()) && all_finite(m01.as_slice()) && attitude.is_finite()) {
+        return Err(EskfError::NonFinite);
+    }
+    set_block(p, 0, 0, &n00);
+    set_block(p, 0, 1, &m01);
+    set_block(p, 1, 0, &m01.transpose());
+    let n = &cfg.imu_noise;
+    add_scaled_identity(
+        p,
+        0,
+        0,
+        n.gyroscope_noise_density * n.gyroscope_noise_density * dt,
+    );
+    add_scaled_identity(
+        p,
+        1,
+        1,
+        n.gyroscope_random_walk * n.gyroscope_random_walk * dt,
+    );
+    x.attitude = attitude;
+    Ok(())
+}

@@ -1,0 +1,137 @@
+//! The gain `K = P H̃ᵀ S⁻¹`, the NIS and gate at the prior, and the Gauss-Newton step of the
+//! iterated update (steps 1–2 of the [module docs](super)).
+
+use super::{UpdateOptions, Work};
+use crate::eskf::error::{EskfError, UpdateOutcome};
+use crate::kernels::cholesky::{factor_in_place, inverse_into};
+use crate::kernels::slice::{axpy, distance, dot};
+use crate::kernels::{all_finite, slice::symmetrize};
+use crate::Real;
+use nalgebra::SVector;
+
+/// `U = P H̃ᵀ`, `S = H̃ U + R`, `S⁻¹`, `K = U S⁻¹` into `w`, for the `n × n` covariance `p`
+/// (column-major), over the `m` active columns of the working set only.
+fn gain_into<T: Real, const N: usize, const C: usize>(
+    p: &[T],
+    w: &mut Work<T, N, C>,
+) -> Result<(), EskfError> {
+    let n = N.max(1);
+    let (m, ht) = (w.m, w.ht.as_slice());
+    let (u, s, k) = (w.g.u.as_mut_slice(), &mut w.g.s, w.g.k.as_mut_slice());
+    // Column c of U = Σ_j P e_j H_cj over the nonzero entries of row c of H only (most models
+    // touch 3–6 of the 15 error components).
+    u.fill(T::zero());
+    for (uc, hc) in u.chunks_exact_mut(n).zip(ht.chunks_exact(n)).take(m) {
+        for (pc, h) in p.chunks_exact(n).zip(hc) {
+            if *h != T::zero() {
+                axpy(uc, *h, pc);
+            }
+        }
+    }
+    // S_ij = R_ij + (row i of H)·(column j of U) for i, j < m; the identity padding stays.
+    s.copy_from(&w.noise);
+    for (j, uc) in u.chunks_exact(n).enumerate().take(m) {
+        for (i, hc) in ht.chunks_exact(n).enumerate().take(m) {
+            if let Some(e) = s.get_mut((i, j)) {
+                *e += dot(hc, uc);
+            }
+        }
+    }
+    symmetrize(s.as_mut_slice(), C);
+    // S⁻¹ from the Cholesky factor (C × C); the columns of K past m stay zero.
+    let mut l = *s;
+    if !(factor_in_place(l.as_mut_slice(), C, T::zero())
+        && inverse_into(l.as_slice(), C, w.s_inv.as_mut_slice()))
+    {
+        return Err(EskfError::SingularInnovation);
+    }
+    k.fill(T::zero());
+    for (kc, sc) in k
+        .chunks_exact_mut(n)
+        .zip(w.s_inv.as_slice().chunks_exact(C.max(1)))
+        .take(m)
+    {
+        for (uc, s) in u.chunks_exact(n).zip(sc).take(m) {
+            axpy(kc, *s, uc);
+        }
+    }
+    if !all_finite(k) {
+        return Err(EskfError::SingularInnovation);
+    }
+    Ok(())
+}
+
+/// The gain at the prior, the NIS and the gate, then `δx₁ = K₀ r₀` into `w.dx`. Returns
+/// `Rejected`, or `Accepted` with the NIS (its iteration count is set by the caller).
+pub(super) fn gate_step<T: Real, const N: usize, const C: usize>(
+    p: &[T],
+    m: usize,
+    opts: &UpdateOptions<T>,
+    w: &mut Work<T, N, C>,
+) -> Result<UpdateOutcome<T>, EskfError> {
+    gain_into(p, w)?;
+    // NIS = rᵀ S⁻¹ r.
+    let mut y = SVector::<T, C>::zeros();
+    mat_vec(w.s_inv.as_slice(), w.r.as_slice(), y.as_mut_slice());
+    let nis = dot(w.r.as_slice(), y.as_slice());
+    if !nis.is_finite() {
+        return Err(EskfError::SingularInnovation);
+    }
+    let threshold = opts.gate.threshold(m);
+    if nis > threshold {
+        return Ok(UpdateOutcome::Rejected { nis, threshold });
+    }
+    mat_vec(w.g.k.as_slice(), w.r.as_slice(), w.dx.as_mut_slice());
+    Ok(UpdateOutcome::Accepted { nis, iterations: 1 })
+}
+
+/// `out = A x` for the column-major `out.len() × x.len()` matrix `a`.
+fn mat_vec<T: Real>(a: &[T], x: &[T], out: &mut [T]) {
+    out.fill(T::zero());
+    for (col, xj) in a.chunks_exact(out.len().max(1)).zip(x) {
+        axpy(out, *xj, col);
+    }
+}
+
+/// One Gauss-Newton step after a re-linearization: the gain there, then
+/// `δx_{k+1} = K_k (r_k + H̃_k δx_k)` into `w.dx`. `None` (with `U`, `S`, `K` and `δx` as they
+/// were) when the gain or the step failed, else whether `‖δx_{k+1} − δx_k‖ < tol`.
+pub(super) fn step<T: Real, const N: usize, const C: usize>(
+    p: &[T],
+    opts: &UpdateOptions<T>,
+    w: &mut Work<T, N, C>,
+) -> Option<bool> {
+    let saved = w.g;
+    let ok = gain_into(p, w).is_ok();
+    // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
+    let n = N.max(1);
+    let mut y = w.r;
+    for (yc, hc) in y.iter_mut().zip(w.ht.as_slice().chunks_exact(n)).take(w.m) {
+        *yc += dot(hc, w.dx.as_slice());
+    }
+    let mut next = SVector::<T, N>::zeros();
+    for (kc, yc) in w.g.k.as_slice().chunks_exact(n).zip(y.iter()).take(w.m) {
+        axpy(next.as_mut_slice(), *yc, kc);
+    }
+    if !(ok && all_finite(next.as_slice())) {
+        w.g = saved;
+        return None;
+    }
+    let converged = distance(next.as_slice(), w.dx.as_slice()) < opts.step_tolerance;
+    w.dx = next;
+    Some(converged)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::mat_vec;
+
+    #[test]
+    fn mat_vec_is_the_matrix_vector_product() {
+        let a = nalgebra::Matrix3x2::new(1.0, 2.0, 3.0, 4.0, 5.0, 6.0);
+        let x = nalgebra::Vector2::new(0.5, -1.0);
+        let mut out = [0.0; 3];
+        mat_vec(a.as_slice(), x.as_slice(), &mut out);
+        assert_eq!(out.as_slice(), (a * x).as_slice());
+    }
+}

@@ -1,0 +1,337 @@
+//! The measurement update: innovation, gate, gain, Joseph-form covariance, iterated
+//! (Gauss-Newton) re-linearization, injection through `⊕` and the covariance reset.
+//!
+//! Equations cite *Lie Groups and Smooth Manifolds for Robotic State Estimation*.
+//!
+//! 1. Linearize at the prior: `r₀ = z ⊖ h(x̂)` and `H₀` with `h(x̂ ⊕ δx) ≈ h(x̂) + H₀ δx`
+//!    (eq. 4.3); `S = H₀ P H₀ᵀ + R`; `NIS = r₀ᵀ S⁻¹ r₀`, the squared Mahalanobis distance
+//!    `‖e‖²_Σ = eᵀ Σ⁻¹ e` of eq. 4.1; gate `NIS ≤ χ²_M(p)` ([`Gate`]) or return `Rejected`.
+//! 2. `δx₁ = K₀ r₀`, `K = P Hᵀ S⁻¹`: the minimizer of eq. 4.4,
+//!    `ξ* = argmin ‖h(a) + H_a ξ − z‖²_Σ`, with the prior `‖δx‖²_P` added. Iterated: at
+//!    `x_k = x̂ ⊕ δx_k` linearize again, `H̃_k = H_k·blockdiag(J_r(δθ_k), I)`,
+//!    `δx_{k+1} = K_k (r_k + H̃_k δx_k)` (Gauss-Newton in the chart at `x̂`), until
+//!    `‖δx_{k+1} − δx_k‖ < tol` or the iteration cap.
+//! 3. Joseph form, expanded so that it costs `O(N²M)` ([`commit`]):
+//!    `P⁺ = (I − KH)P(I − KH)ᵀ + K R Kᵀ = P − K Uᵀ − U Kᵀ + K S Kᵀ = P + V Kᵀ + K Vᵀ`,
+//!    `U = P Hᵀ`, `V = ½ K S − U`.
+//! 4. Inject `x⁺ = x̂ ⊕ δx`, `a ⊕ ξ = a·exp(ξ^)` (eq. 4.5), and reset `P ← G P Gᵀ`,
+//!    `G = blockdiag(J_r(δθ), I)` (the new error `e⁺ = log(exp(δθ)⁻¹ exp(e)) ≈ J_r(δθ)(e − δθ)`).
+//!
+//! Every model with up to [`CORE_ROWS`] rows runs through one compiled core per scalar type and
+//! filter, not one per model: the core sees a model through [`Rows`], its residual and Jacobian
+//! padded with zero rows and its noise with the identity, which leaves every result unchanged
+//! (`S_pad = [[S, 0], [0, I]]`, `K_pad = [K, 0]`, `NIS = rᵀ S⁻¹ r`), and the products whose cost
+//! grows with the rows run over the `M` active rows only. The core's phases are separate
+//! functions sharing one working set ([`Work`]), so their stack frames do not add up.
+
+mod commit;
+mod gain;
+pub(crate) mod gate;
+
+use super::error::{EskfError, UpdateOutcome};
+use super::state::ErrorState;
+use crate::kernels::{all_finite, mat3};
+use crate::lie::{LieGroup, So3};
+use crate::Real;
+use commit::commit;
+use gain::{gate_step, step};
+use gate::{Gate, GateProbability};
+use nalgebra::{SMatrix, SVector, Vector3};
+
+/// A measurement linearized at a state: the residual `r = z ⊖ h(x)` (for a vector measurement
+/// `z − h(x)`; angles wrapped) and `H`, with `h(x ⊕ δx) ≈ h(x) + H δx` (*Lie Groups and Smooth
+/// Manifolds for Robotic State Estimation*, eq. 4.3 and Definition 4.6).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Linearization<T: Real, const N: usize, const M: usize> {
+    /// `r = z ⊖ h(x)`.
+    pub residual: SVector<T, M>,
+    /// `H` (`M × N`), right Jacobian with respect to the error state.
+    pub jacobian: SMatrix<T, M, N>,
+}
+
+/// A fixed-size measurement model `z = h(x) + n`, `n ~ N(0, R)`, for the nominal state `S` with an
+/// `N`-dimensional error state. Implement it for a new sensor (one file in `eskf/models/`).
+pub trait Measurement<T: Real, S, const N: usize, const M: usize> {
+    /// `r = z ⊖ h(x)` and `H` at `x`.
+    ///
+    /// # Errors
+    /// Non-finite data, or a state where `h` is not defined (landmark behind the camera,
+    /// heading at ±90° pitch, ...).
+    fn linearize(&self, x: &S) -> Result<Linearization<T, N, M>, EskfError>;
+
+    /// The noise covariance `R` (must be symmetric positive definite).
+    #[must_use]
+    fn noise(&self) -> SMatrix<T, M, M>;
+}
+
+/// How an update is done: the gate, and the number of Gauss-Newton iterations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UpdateOptions<T: Real> {
+    /// The chi-square gate on the NIS at the prior.
+    pub gate: Gate<T>,
+    /// Iteration cap, `≥ 1`; `1` is the plain (extended) update, more is the iterated update.
+    pub max_iterations: u8,
+    /// The iterated update stops when `‖δx_{k+1} − δx_k‖ <` this.
+    pub step_tolerance: T,
+}
+
+impl<T: Real> Default for UpdateOptions<T> {
+    /// Single-step update gated at 99.9 %.
+    fn default() -> Self {
+        Self::ekf(Gate::Probability(GateProbability::P999))
+    }
+}
+
+impl<T: Real> UpdateOptions<T> {
+    /// The plain single-linearization update with `gate`.
+    #[must_use]
+    pub fn ekf(gate: Gate<T>) -> Self {
+        Self {
+            gate,
+            max_iterations: 1,
+            step_tolerance: T::lit(1e-6),
+        }
+    }
+
+    /// The iterated update (IEKF) with `gate`, at most `max_iterations` linearizations, stopping
+    /// when the step changes by less than `step_tolerance`.
+    #[must_use]
+    pub fn iterated(gate: Gate<T>, max_iterations: u8, step_tolerance: T) -> Self {
+        Self {
+            gate,
+            max_iterations,
+            step_tolerance,
+        }
+    }
+
+    /// `Ok` when the iteration cap is at least 1, the tolerance finite and a threshold gate
+    /// not NaN.
+    fn validate(&self) -> Result<(), EskfError> {
+        if self.max_iterations == 0 || !self.step_tolerance.is_finite() {
+            return Err(EskfError::InvalidOption);
+        }
+        if let Gate::Threshold(t) = self.gate {
+            if !(t.is_finite() || t > T::zero()) {
+                return Err(EskfError::InvalidOption);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Row capacity of the shared update core (see the module docs).
+pub(crate) const CORE_ROWS: usize = 3;
+
+/// A measurement model as the update core sees it: through a row capacity `C ≥ M`.
+///
+/// The core takes `&dyn Rows<T, S, N, C>`, so it is compiled once per `(T, S, N, C)`, not
+/// once per model; only [`Padded::linearize_rows`] is per model.
+trait Rows<T: Real, S, const N: usize, const C: usize> {
+    /// Linearizes at `x` into `w.ht = Hᵀ` (`N × C`; column `c` is row `c` of `H`) and `w.r`;
+    /// the columns and rows past `M` are zero. Nothing else in `w` is written.
+    fn linearize_rows(&self, x: &S, w: &mut Work<T, N, C>) -> Result<(), EskfError>;
+}
+
+/// A model with `M` rows, seen through any capacity `C ≥ M`.
+struct Padded<'a, Mo, const M: usize>(&'a Mo);
+
+impl<T, S, Mo, const N: usize, const M: usize, const C: usize> Rows<T, S, N, C>
+    for Padded<'_, Mo, M>
+where
+    T: Real,
+    Mo: Measurement<T, S, N, M>,
+{
+    fn linearize_rows(&self, x: &S, w: &mut Work<T, N, C>) -> Result<(), EskfError> {
+        let lin = self.0.linearize(x)?;
+        w.ht.fill(T::zero());
+        w.r.fill(T::zero());
+        // Column j of H (M entries) becomes row j of Hᵀ: entry (c, j) of H at c·N + j.
+        let ht = w.ht.as_mut_slice();
+        for (j, h_col) in lin.jacobian.as_slice().chunks_exact(M.max(1)).enumerate() {
+            for (c, v) in h_col.iter().enumerate() {
+                if let Some(e) = ht.get_mut(c * N + j) {
+                    *e = *v;
+                }
+            }
+        }
+        for (d, s) in w.r.iter_mut().zip(lin.residual.iter()) {
+            *d = *s;
+        }
+        Ok(())
+    }
+}
+
+/// The working set of one update, on the caller's stack and filled in place by the phases.
+/// `N × C` matrices hold one column per measurement row; columns and rows past `m` are zero.
+struct Work<T: Real, const N: usize, const C: usize> {
+    /// `H̃ᵀ` at the current iterate.
+    ht: SMatrix<T, N, C>,
+    /// Residual `r = z ⊖ h(x̂ ⊕ δx)` at the current iterate.
+    r: SVector<T, C>,
+    /// `U`, `S` and `K` at the current iterate.
+    g: Gain<T, N, C>,
+    /// `S⁻¹` (for the NIS at the prior).
+    s_inv: SMatrix<T, C, C>,
+    /// The current correction `δx`.
+    dx: SVector<T, N>,
+    /// `R` padded to `C × C` with the identity.
+    noise: SMatrix<T, C, C>,
+    /// The number of active rows, `M`.
+    m: usize,
+}
+
+/// The gain part of the working set, saved and restored as one block by the iterated update.
+#[derive(Clone, Copy)]
+struct Gain<T: Real, const N: usize, const C: usize> {
+    /// `U = P H̃ᵀ`.
+    u: SMatrix<T, N, C>,
+    /// `S = H̃ P H̃ᵀ + R` (identity past `m`).
+    s: SMatrix<T, C, C>,
+    /// `K = U S⁻¹`.
+    k: SMatrix<T, N, C>,
+}
+
+/// The update on `(x, P)` (module docs); `x` and `P` are written only when the result is
+/// `Accepted`. The only per-model code: it picks the core's row capacity and calls the core.
+pub(crate) fn update<T, S, Mo, const N: usize, const M: usize>(
+    x: &mut S,
+    p: &mut SMatrix<T, N, N>,
+    model: &Mo,
+    opts: &UpdateOptions<T>,
+) -> Result<UpdateOutcome<T>, EskfError>
+where
+    T: Real,
+    S: ErrorState<T, N>,
+    Mo: Measurement<T, S, N, M>,
+{
+    let rows = Padded::<Mo, M>(model);
+    let noise = model.noise();
+    if M <= CORE_ROWS {
+        update_core::<T, S, N, CORE_ROWS>(x, p, &rows, noise.as_slice(), M, opts)
+    } else {
+        update_core::<T, S, N, M>(x, p, &rows, noise.as_slice(), M, opts)
+    }
+}
+
+/// Steps 1–4 for a model seen through `C` rows, `m` of them active.
+#[inline(never)]
+fn update_core<T, S, const N: usize, const C: usize>(
+    x: &mut S,
+    p: &mut SMatrix<T, N, N>,
+    model: &dyn Rows<T, S, N, C>,
+    noise: &[T],
+    m: usize,
+    opts: &UpdateOptions<T>,
+) -> Result<UpdateOutcome<T>, EskfError>
+where
+    T: Real,
+    S: ErrorState<T, N>,
+{
+    opts.validate()?;
+    let mut w = Work::<T, N, C> {
+        ht: SMatrix::zeros(),
+        r: SVector::zeros(),
+        g: Gain {
+            u: SMatrix::zeros(),
+            s: SMatrix::zeros(),
+            k: SMatrix::zeros(),
+        },
+        s_inv: SMatrix::zeros(),
+        dx: SVector::zeros(),
+        noise: SMatrix::identity(),
+        m,
+    };
+    // R into the top-left m × m of the identity.
+    for (j, col) in noise.chunks_exact(m.max(1)).enumerate() {
+        for (i, v) in col.iter().enumerate() {
+            if let Some(e) = w.noise.get_mut((i, j)) {
+                *e = *v;
+            }
+        }
+    }
+    if !super::covariance::is_spd(&w.noise) {
+        return Err(EskfError::NoiseNotPositiveDefinite);
+    }
+    linearize_into(model, x, &mut w, true)?;
+    let nis = match gate_step(p.as_slice(), m, opts, &mut w)? {
+        UpdateOutcome::Accepted { nis, .. } => nis,
+        rejected => return Ok(rejected),
+    };
+    let iterations = iterate(x, p, model, opts, &mut w);
+    commit(x, p, &mut w)?;
+    Ok(UpdateOutcome::Accepted { nis, iterations })
+}
+
+/// Linearizes at `x̂ ⊕ δx` (`δx` = `w.dx`; at `x̂` when `first`) into `w.ht`, `w.r`, with the
+/// chart Jacobian `H̃ = H · blockdiag(J_r(δθ), I)` (the Jacobian of `h(x̂ ⊕ δx)` in `δx`, so that
+/// the iterated update is Gauss-Newton in the chart at the prior; `J_r(0) = I`).
+#[inline(never)]
+fn linearize_into<T, S, const N: usize, const C: usize>(
+    model: &dyn Rows<T, S, N, C>,
+    x: &S,
+    w: &mut Work<T, N, C>,
+    first: bool,
+) -> Result<(), EskfError>
+where
+    T: Real,
+    S: ErrorState<T, N>,
+{
+    if first {
+        model.linearize_rows(x, w)?;
+    } else {
+        model.linearize_rows(&x.oplus(&w.dx), w)?;
+    }
+    if !(all_finite(w.r.as_slice()) && all_finite(w.ht.as_slice())) {
+        return Err(EskfError::NonFinite);
+    }
+    if !first {
+        // H̃ᵀ = blockdiag(J_r(δθ)ᵀ, I) Hᵀ: only the attitude rows change.
+        let jrt = So3::right_jacobian(&attitude_part(w.dx.as_slice())).transpose();
+        for col in w.ht.as_mut_slice().chunks_exact_mut(N.max(1)) {
+            if let Some(top) = col.get_mut(0..3) {
+                let v = mat3::mul_vec(&jrt, &attitude_part(top));
+                top.copy_from_slice(v.as_slice());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The Gauss-Newton iterations (step 2 after the first): at `x̂ ⊕ δx_k`,
+/// `δx_{k+1} = K_k (r_k + H̃_k δx_k)`. A failure to re-linearize stops at the last good iterate
+/// (whose `K`, `U`, `S` are restored). Returns the number of linearizations used.
+#[inline(never)]
+fn iterate<T, S, const N: usize, const C: usize>(
+    x: &S,
+    p: &SMatrix<T, N, N>,
+    model: &dyn Rows<T, S, N, C>,
+    opts: &UpdateOptions<T>,
+    w: &mut Work<T, N, C>,
+) -> u8
+where
+    T: Real,
+    S: ErrorState<T, N>,
+{
+    let mut iterations: u8 = 1;
+    while iterations < opts.max_iterations {
+        if linearize_into(model, x, w, false).is_err() {
+            break;
+        }
+        let Some(converged) = step(p.as_slice(), opts, w) else {
+            break;
+        };
+        iterations += 1;
+        if converged {
+            break;
+        }
+    }
+    iterations
+}
+
+/// The attitude part `δθ` (entries 0..3) of an error vector or of a column of `Hᵀ`.
+fn attitude_part<T: Real>(s: &[T]) -> Vector3<T> {
+    match s.get(0..3) {
+        Some(&[a, b, c]) => Vector3::new(a, b, c),
+        _ => Vector3::zeros(),
+    }
+}

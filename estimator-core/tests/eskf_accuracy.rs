@@ -3,6 +3,7 @@
 //! close camera landmark.
 
 mod eskf_common;
+mod support;
 
 use eskf_common::*;
 use estimator_core::eskf::*;

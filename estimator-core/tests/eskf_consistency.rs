@@ -8,6 +8,7 @@
 //! for the AHRS (6 dof) and for the time-averaged NIS of the GNSS updates (3 dof).
 
 mod eskf_common;
+mod support;
 
 use eskf_common::*;
 use estimator_core::eskf::*;
@@ -27,7 +28,7 @@ fn p0() -> SMatrix<f64, 15, 15> {
 }
 
 fn band(dof: f64) -> (f64, f64) {
-    (chi2_wh(dof, -3.29), chi2_wh(dof, 3.29))
+    (chi2_quantile(dof, -3.29), chi2_quantile(dof, 3.29))
 }
 
 #[test]

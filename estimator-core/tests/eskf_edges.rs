@@ -2,6 +2,7 @@
 //! alignment errors; outcomes carry the right NIS.
 
 mod eskf_common;
+mod support;
 use eskf_common::gyro_only;
 
 use estimator_core::eskf::*;

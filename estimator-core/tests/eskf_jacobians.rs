@@ -7,11 +7,13 @@
 //! magnitude.
 
 mod eskf_common;
+mod support;
 
 use eskf_common::{gyro_only, Rng};
 use estimator_core::eskf::*;
 use estimator_core::lie::{LieGroup, Se3, So3};
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
+use support::fd_jacobian;
 
 const EPS: f64 = 1e-3;
 
@@ -38,18 +40,8 @@ where
     S: ErrorState<f64, N>,
     Mo: Measurement<f64, S, N, M>,
 {
-    let r = |dx: SVector<f64, N>| model.linearize(&x.oplus(&dx)).expect("linearize").residual;
-    let mut h = SMatrix::<f64, M, N>::zeros();
-    for i in 0..N {
-        let d = |e: f64| {
-            let mut dx = SVector::<f64, N>::zeros();
-            dx[i] = e;
-            (r(dx) - r(-dx)) / (2.0 * e)
-        };
-        let col = (d(EPS / 2.0) * 4.0 - d(EPS)) / 3.0;
-        h.set_column(i, &(-col));
-    }
-    h
+    let r = |dx: &SVector<f64, N>| model.linearize(&x.oplus(dx)).expect("linearize").residual;
+    -fd_jacobian(r, EPS)
 }
 
 fn check<S, Mo, const N: usize, const M: usize>(name: &str, model: &Mo, x: &S)
@@ -162,16 +154,8 @@ fn ins_predict_matches_dense_f_p_ft() {
             *f.state()
         };
         let base = prop(x);
-        let g = |dx: SVector<f64, 15>| eskf_common::ins_error(&prop(x.oplus(&dx)), &base);
-        let mut f = SMatrix::<f64, 15, 15>::zeros();
-        for i in 0..15 {
-            let d = |e: f64| {
-                let mut dx = SVector::<f64, 15>::zeros();
-                dx[i] = e;
-                (g(dx) - g(-dx)) / (2.0 * e)
-            };
-            f.set_column(i, &((d(EPS / 2.0) * 4.0 - d(EPS)) / 3.0));
-        }
+        let g = |dx: &SVector<f64, 15>| eskf_common::ins_error(&prop(x.oplus(dx)), &base);
+        let f = fd_jacobian(g, EPS);
         let mut filter = Ins::new(x, p, zero_noise()).expect("filter");
         filter.predict(&imu).expect("predict");
         let dense = f * p * f.transpose();
@@ -194,8 +178,8 @@ fn ahrs_predict_matches_dense_f_p_ft() {
             *f.state()
         };
         let base = prop(x);
-        let g = |dx: SVector<f64, 6>| {
-            let s = prop(x.oplus(&dx));
+        let g = |dx: &SVector<f64, 6>| {
+            let s = prop(x.oplus(dx));
             let mut e = SVector::<f64, 6>::zeros();
             e.fixed_rows_mut::<3>(0)
                 .copy_from(&s.attitude.rminus(&base.attitude));
@@ -203,15 +187,7 @@ fn ahrs_predict_matches_dense_f_p_ft() {
                 .copy_from(&(s.gyro_bias - base.gyro_bias));
             e
         };
-        let mut f = SMatrix::<f64, 6, 6>::zeros();
-        for i in 0..6 {
-            let d = |e: f64| {
-                let mut dx = SVector::<f64, 6>::zeros();
-                dx[i] = e;
-                (g(dx) - g(-dx)) / (2.0 * e)
-            };
-            f.set_column(i, &((d(EPS / 2.0) * 4.0 - d(EPS)) / 3.0));
-        }
+        let f = fd_jacobian(g, EPS);
         let mut filter = Ahrs::new(x, p, zero_noise()).expect("filter");
         filter.predict(&gyro_only(w, dt)).expect("predict");
         let dense = f * p * f.transpose();

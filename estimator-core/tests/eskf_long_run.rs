@@ -4,6 +4,7 @@
 //! `cargo test --release -p estimator-core --test eskf_long_run -- --ignored`.
 
 mod eskf_common;
+mod support;
 
 use eskf_common::*;
 use estimator_core::eskf::*;

@@ -9,6 +9,7 @@
 //! every padded row) is exercised.
 
 mod eskf_common;
+mod support;
 
 use eskf_common::Rng;
 use estimator_core::eskf::*;

@@ -1,50 +1,12 @@
-//! Self-contained motion and sensor generator for the eskf tests (f64 truth).
+//! Motion and sensor generator for the eskf tests (f64 truth), on the shared `support`
+//! random stream.
 #![allow(dead_code)]
 
 use estimator_core::eskf::{ImuNoise, ImuSample, InsState};
 use estimator_core::lie::{LieGroup, So3};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
-/// xorshift64* with Box–Muller normals.
-pub struct Rng {
-    s: u64,
-    spare: Option<f64>,
-}
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Self {
-            s: seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1,
-            spare: None,
-        }
-    }
-    pub fn uniform(&mut self) -> f64 {
-        self.s ^= self.s >> 12;
-        self.s ^= self.s << 25;
-        self.s ^= self.s >> 27;
-        let x = self.s.wrapping_mul(0x2545_F491_4F6C_DD1D);
-        ((x >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    pub fn normal(&mut self) -> f64 {
-        if let Some(z) = self.spare.take() {
-            return z;
-        }
-        let (u1, u2) = (self.uniform(), self.uniform());
-        let r = (-2.0 * u1.ln()).sqrt();
-        let t = std::f64::consts::TAU * u2;
-        self.spare = Some(r * t.sin());
-        r * t.cos()
-    }
-    pub fn vec3(&mut self, sigma: f64) -> Vector3<f64> {
-        Vector3::new(self.normal(), self.normal(), self.normal()) * sigma
-    }
-    /// A sample of N(0, P) via Cholesky.
-    pub fn gaussian<const N: usize>(&mut self, p: &SMatrix<f64, N, N>) -> SVector<f64, N> {
-        let l = nalgebra::Cholesky::new(*p).expect("P spd").l();
-        let z = SVector::<f64, N>::from_fn(|_, _| self.normal());
-        l * z
-    }
-}
+pub use crate::support::{chi2_quantile, nees, Rng};
 
 pub const G: f64 = 9.81;
 
@@ -179,11 +141,6 @@ pub fn ins_error(truth: &InsState<f64>, est: &InsState<f64>) -> SVector<f64, 15>
     e
 }
 
-pub fn nees<const N: usize>(e: &SVector<f64, N>, p: &SMatrix<f64, N, N>) -> f64 {
-    let c = nalgebra::Cholesky::new(*p).expect("P spd");
-    e.dot(&c.solve(e))
-}
-
 pub fn angle_deg(a: &So3<f64>, b: &So3<f64>) -> f64 {
     a.rminus(b).norm().to_degrees()
 }
@@ -216,12 +173,6 @@ pub fn ins_state_f64(s: &InsState<f32>) -> InsState<f64> {
 
 pub fn skew_check(m: &Matrix3<f64>) -> f64 {
     (m - m.transpose()).amax()
-}
-
-/// Wilson–Hilferty chi-square quantile for `k` dof at standard-normal quantile `z`.
-pub fn chi2_wh(k: f64, z: f64) -> f64 {
-    let c = 2.0 / (9.0 * k);
-    k * (1.0 - c + z * c.sqrt()).powi(3)
 }
 
 /// An IMU sample with only a gyro reading (what the attitude-only filter's prediction reads).

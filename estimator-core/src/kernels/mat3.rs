@@ -11,19 +11,12 @@ use nalgebra::{Matrix3, Vector3};
 #[inline(always)]
 #[must_use]
 pub(crate) fn mul<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
-    let mut out = Matrix3::zeros();
-    for (oc, bc) in out
-        .as_mut_slice()
-        .chunks_exact_mut(3)
-        .zip(b.as_slice().chunks_exact(3))
-    {
-        if let ([o0, o1, o2], [b0, b1, b2]) = (oc, bc) {
-            *o0 = a.m11 * *b0 + a.m12 * *b1 + a.m13 * *b2;
-            *o1 = a.m21 * *b0 + a.m22 * *b1 + a.m23 * *b2;
-            *o2 = a.m31 * *b0 + a.m32 * *b1 + a.m33 * *b2;
-        }
-    }
-    out
+    let column = |x: T, y: T, z: T| mul_vec(a, &Vector3::new(x, y, z));
+    Matrix3::from_columns(&[
+        column(b.m11, b.m21, b.m31),
+        column(b.m12, b.m22, b.m32),
+        column(b.m13, b.m23, b.m33),
+    ])
 }
 
 /// `a·v`: `(av)_i = a_i1 v_1 + a_i2 v_2 + a_i3 v_3`.

@@ -32,7 +32,7 @@ pub struct Factor<T: Real, const N: usize> {
 }
 
 impl<T: Real, const N: usize> Factor<T, N> {
-    /// Factorizes `a` (only its lower triangle is read).
+    /// Factorizes `a`: `L` comes from its lower triangle; every entry must be finite.
     ///
     /// # Errors
     /// [`SolveError::NonFiniteResidual`] for a non-finite entry; [`SolveError::NotPositiveDefinite`]

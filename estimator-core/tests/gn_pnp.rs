@@ -17,8 +17,8 @@
 mod gn_util;
 
 use estimator_core::gn::{
-    check_point_spread, reprojection_error, solve_pnp, Loss, Method, PinholeCamera, PnpOptions, SolveError, Status,
-    PNP_CAPACITY,
+    check_point_spread, reprojection_error, solve_pnp, Loss, Method, PinholeCamera, PnpOptions,
+    SolveError, Status, PNP_CAPACITY,
 };
 use estimator_core::lie::{LieGroup, Se3, So3};
 use gn_util::*;

@@ -158,8 +158,7 @@ fn triad_starts_from_the_most_perpendicular_pair() {
                 };
                 *v = Vector3::zeros();
                 assert_eq!(
-                    solve_rotation_from_vectors(&bad, None, &SolverOptions::default())
-                        .unwrap_err(),
+                    solve_rotation_from_vectors(&bad, None, &SolverOptions::default()).unwrap_err(),
                     SolveError::DegenerateGeometry
                 );
             }

@@ -116,34 +116,14 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
         P: Problem<T, S, N, K> + ?Sized,
     {
         let mut ne = Self::zeros();
-        ne.rebuild(problem, state, loss)?;
+        ne.accumulate(problem, state, loss)?;
+        finite_sums(ne.information.as_slice(), ne.gradient.as_slice(), ne.cost)?;
         Ok(ne)
     }
 
-    /// [`Self::build`] in place: resets `self` and accumulates every block of `problem` at
-    /// `state` into it. On error `self` holds a partial sum.
-    ///
-    /// # Errors
-    /// As [`Self::build`].
-    pub(crate) fn rebuild<S, P, const K: usize>(
-        &mut self,
-        problem: &P,
-        state: &S,
-        loss: &Loss<T>,
-    ) -> Result<(), SolveError>
-    where
-        P: Problem<T, S, N, K> + ?Sized,
-    {
-        self.accumulate(problem, state, loss)?;
-        finite_sums(
-            self.information.as_slice(),
-            self.gradient.as_slice(),
-            self.cost,
-        )
-    }
-
-    /// [`Self::rebuild`] without the finiteness test (which [`solve_into`] runs in its shared
-    /// part).
+    /// Resets `self` and accumulates every block of `problem` at `state` into it, without the
+    /// finiteness test of [`Self::build`] (which [`solve_into`] runs in its shared part). On
+    /// error `self` holds a partial sum.
     ///
     /// # Errors
     /// The problem's own error.
@@ -413,11 +393,11 @@ fn drive<T: Real>(
     })
 }
 
-/// [`NormalEquations::rebuild`] at the candidate of `run`, into its trial linearization: the
+/// [`NormalEquations::build`] at the candidate of `run`, into its trial linearization: the
 /// problem-specific accumulation, then the shared finiteness test.
 ///
 /// # Errors
-/// As [`NormalEquations::rebuild`].
+/// As [`NormalEquations::build`].
 fn linearize<T: Real>(run: &mut dyn Candidate<T>) -> Result<(), SolveError> {
     run.linearize()?;
     let p = run.parts();

@@ -128,6 +128,28 @@ impl<T: Real> Problem<T, Vector3<T>, 3, 2> for TriProblem<'_, T> {
 /// parallax); [`SolveError::PointBehindCamera`] (the point lies at depth `≤ min_depth` in a view
 /// at the start or the solution); [`SolveError::NotPositiveDefinite`],
 /// [`SolveError::NonFiniteResidual`] from the solver.
+///
+/// # Example
+///
+/// A point seen by two cameras 1 m apart, both looking along `+z`:
+///
+/// ```
+/// use estimator_core::gn::{triangulate, PinholeCamera, SolveError, TriangulationOptions};
+/// use estimator_core::lie::{LieGroup, Se3, So3};
+/// use nalgebra::Vector3;
+///
+/// let camera = PinholeCamera::new(500.0, 500.0, 320.0, 240.0);
+/// let point = Vector3::new(0.5, -0.2, 6.0);
+/// let views = [
+///     Se3::identity(),
+///     Se3::from_parts(So3::identity(), Vector3::new(-1.0, 0.0, 0.0)),
+/// ];
+/// let pixels = views.map(|v| camera.project(&v.act(&point), 1e-3).expect("in front"));
+///
+/// let t = triangulate(&views, &pixels, &camera, &TriangulationOptions::default())?;
+/// assert!((t.point - point).norm() < 1e-9);
+/// # Ok::<(), SolveError>(())
+/// ```
 pub fn triangulate<T: Real>(
     cameras_from_world: &[Se3<T>],
     pixels: &[Vector2<T>],

@@ -1,9 +1,10 @@
 //! Factorization of the small information matrix `A = Hᵀ W H` (size `N × N`, `N` the tangent
 //! dimension), with a typed failure.
 //!
-//! `A = L Lᵀ` (Cholesky) by [`crate::kernels::cholesky`]. On top of a positive pivot, the
-//! factorization requires every variable to carry information of its own: with the `LDLᵀ`
-//! pivot `dᵢ = Lᵢᵢ²`, the part of `Aᵢᵢ` that the previous variables do not explain, it requires
+//! `A = L Lᵀ` (Cholesky) by the crate's left-looking column kernel (Golub & Van Loan, *Matrix
+//! Computations*, §4.2). On top of a positive pivot, the factorization requires every variable
+//! to carry information of its own: with the `LDLᵀ` pivot `dᵢ = Lᵢᵢ²`, the part of `Aᵢᵢ` that
+//! the previous variables do not explain, it requires
 //!
 //! ```text
 //! dᵢ > τ·Aᵢᵢ,   τ = PIVOT_TOLERANCE_EPS · N · ε.

@@ -73,7 +73,7 @@ pub(super) fn unit<T: Real>(v: &Vector3<T>) -> Option<Vector3<T>> {
     positive_finite(n).then_some(u)
 }
 
-/// `(v / ‖v‖, ‖v‖)`, whatever the norm (for [`unit`] and the rays of
+/// `(v / ‖v‖, ‖v‖)`, whatever the norm (for [`unit()`] and the rays of
 /// [`triangulate`](super::triangulate)).
 pub(super) fn normalized<T: Real>(v: &Vector3<T>) -> (Vector3<T>, T) {
     let n = v.norm_squared().sqrt_rn();

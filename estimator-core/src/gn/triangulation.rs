@@ -4,7 +4,7 @@
 //!
 //! * **Start** (closed form): the point closest to all rays in the least-squares sense. The ray
 //!   of view `i` leaves the centre `cᵢ = −Rᵢᵀ tᵢ` along `dᵢ = Rᵢᵀ K⁻¹[u, v, 1]ᵀ / ‖·‖`; with the
-//!   projector `Pᵢ = I − dᵢdᵢᵀ`, `(Σ Pᵢ) p = Σ Pᵢ cᵢ`, a 3×3 system factorized by [`Factor`](super::Factor)
+//!   projector `Pᵢ = I − dᵢdᵢᵀ`, `(Σ Pᵢ) p = Σ Pᵢ cᵢ`, a 3×3 system factorized by [`Factor`]
 //!   (singular for parallel rays).
 //! * **Refinement**: the residual `eᵢ = (K π(Tᵢ p) − zᵢ)/σ` with Jacobian
 //!   `∂eᵢ/∂p = Jπ(xᵢ) Rᵢ / σ` (Theorem 5.1 of *Lie Groups and Smooth Manifolds for Robotic

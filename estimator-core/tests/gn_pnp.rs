@@ -17,8 +17,8 @@
 mod gn_util;
 
 use estimator_core::gn::{
-    reprojection_error, solve_pnp, Loss, Method, PinholeCamera, PnpOptions, SolveError, Status,
-    PNP_CAPACITY,
+    check_point_spread, reprojection_error, solve_pnp, Loss, Method, PinholeCamera, PnpOptions,
+    SolveError, Status, PNP_CAPACITY,
 };
 use estimator_core::lie::{LieGroup, Se3, So3};
 use gn_util::*;
@@ -492,6 +492,58 @@ fn error_degenerate_geometry() {
     let g = perturb(&mut rng, &truth, 10f64.to_radians(), 0.2);
     let s = solve_pnp(&w, &z, &camera(), &g, &PnpOptions::default()).unwrap();
     assert!(pose_error(&s.camera_from_world, &truth).0 < 1e-6);
+}
+
+/// `check_point_spread` on sets of 3 to 8 points at distances `d` from `0` to `1e6` m from the
+/// origin, at the scale `L = max(1, 1e-3·d)`: a cloud of size `L` passes (`tr S / n ≈ L²`, above
+/// the coincidence bound `1e-12·(‖p̄‖² + 1)`); a line of length `≈ n·L` with a transverse spread
+/// of `1e-7·n·L` (`λ₂/λ₁ ≈ 1e-14`, below the collinearity bound `1e-10`) and a cluster of size
+/// `1e-9·max(1, d)` (`tr S / n ≈ 1e-18·max(1, d)²`) are refused, and so are a set with a NaN or
+/// infinite coordinate and the empty set. `f32` at `d ≤ 10` m, where its rounding of the
+/// coordinates (`≈ 1e-6`) stays below the coincidence bound, and without the line: its `I₂`
+/// (a difference of products of size `(tr S)²`) carries a rounding error of about
+/// `ε_f32·(tr S)² ≈ 1e-7·(tr S)²`, above the `1e-10·(tr S)²` bound, so the collinearity test
+/// resolves lines in `f64` only.
+fn point_spread_cases<T: estimator_core::Real>(offsets: &[f64], lines: bool) {
+    let lit = |v: Vector3<f64>| v.map(|x| nalgebra::convert::<f64, T>(x));
+    let mut rng = Rng::new(31);
+    assert_eq!(
+        check_point_spread::<T>(&[]).unwrap_err(),
+        SolveError::DegenerateGeometry
+    );
+    for &offset in offsets {
+        for n in 3..=8 {
+            let origin = rng.unit3() * offset;
+            let dir = rng.unit3();
+            let scale = (1e-3 * offset).max(1.0);
+            let cloud: Vec<_> = (0..n)
+                .map(|_| lit(origin + rng.unit3() * rng.range(0.5, 1.0) * scale))
+                .collect();
+            assert!(check_point_spread(&cloud).is_ok(), "{offset} {n}");
+            let line: Vec<_> = (0..n)
+                .map(|k| lit(origin + (dir * k as f64 + rng.unit3() * 1e-7 * n as f64) * scale))
+                .collect();
+            let point: Vec<_> = (0..n)
+                .map(|_| lit(origin + rng.unit3() * 1e-9 * offset.max(1.0)))
+                .collect();
+            let mut non_finite = cloud.clone();
+            non_finite[n / 2][n % 3] = nalgebra::convert([f64::NAN, f64::INFINITY][n % 2]);
+            let cases = [("line", line), ("cluster", point), ("NaN", non_finite)];
+            for (kind, degenerate) in cases.into_iter().skip(usize::from(!lines)) {
+                assert_eq!(
+                    check_point_spread(&degenerate),
+                    Err(SolveError::DegenerateGeometry),
+                    "{kind} at {offset} m, {n} points"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn point_spread_refuses_collinear_coincident_and_non_finite_sets() {
+    point_spread_cases::<f64>(&[0.0, 1.0, 1e3, 1e6], true);
+    point_spread_cases::<f32>(&[0.0, 1.0, 10.0], false);
 }
 
 #[test]

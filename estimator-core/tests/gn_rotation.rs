@@ -127,6 +127,45 @@ fn exact_pairs_give_exact_rotation() {
     }
 }
 
+/// The TRIAD start pairs the first observation with the one most perpendicular to it: with a
+/// second pair within `1e-9` rad of the first (parallel for TRIAD, whose threshold is
+/// `‖u × v‖ ≤ 1e-6`) and a third one 60° away, the start comes from the third and the solve is
+/// exact to rounding. Zero vectors in any pair, on either side, are refused.
+#[test]
+fn triad_starts_from_the_most_perpendicular_pair() {
+    let mut rng = Rng::new(44);
+    let [down, field] = world_refs();
+    let near_down = So3::exp(&(rng.unit3() * 1e-9)).act(&down);
+    for _ in 0..50 {
+        let truth = rng.rotation();
+        let p: Vec<_> = [down, near_down, field]
+            .iter()
+            .map(|w| VectorPair {
+                body: truth.inverse().act(w),
+                world: *w,
+                sigma: 1e-3,
+            })
+            .collect();
+        let s = solve_rotation_from_vectors(&p, None, &SolverOptions::default()).unwrap();
+        assert!(truth.rminus(&s.world_from_body).norm() <= 1e-12);
+        for k in 0..3 {
+            for world_side in [false, true] {
+                let mut bad = p.clone();
+                let v = if world_side {
+                    &mut bad[k].world
+                } else {
+                    &mut bad[k].body
+                };
+                *v = Vector3::zeros();
+                assert_eq!(
+                    solve_rotation_from_vectors(&bad, None, &SolverOptions::default()).unwrap_err(),
+                    SolveError::DegenerateGeometry
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn rotation_error_paths() {
     let mut rng = Rng::new(43);

@@ -93,6 +93,53 @@ fn factor_refuses_singular_indefinite_and_non_finite() {
     );
 }
 
+/// Every symmetric matrix with a diagonal entry `≤ 0` is refused as not positive definite, one
+/// with a non-finite entry (in either triangle) as non-finite, and one with a diagonal entry `1e-300` coupled to the
+/// others by `O(1)` entries (its pivot leaves a negative Schur complement) as not positive
+/// definite; the same Gram matrices untouched factorize. Sizes 3 and 6, `f32` and `f64`.
+fn factor_classifies_corrupted_gram_matrices<T, const N: usize>(rng: &mut Rng)
+where
+    T: estimator_core::Real + nalgebra::RealField,
+{
+    let lit = |x: f64| nalgebra::convert::<f64, T>(x);
+    for trial in 0..300 {
+        let m = SMatrix::<f64, N, N>::from_fn(|_, _| rng.normal());
+        let gram = m.transpose() * m + SMatrix::<f64, N, N>::identity();
+        let a: SMatrix<T, N, N> = gram.map(lit);
+        assert!(Factor::new(&a).is_ok());
+        let j = trial % N;
+        let mut bad = a;
+        match trial % 6 {
+            0 => bad[(j, j)] = lit(0.0),
+            1 => bad[(j, j)] = lit(-0.0),
+            2 => bad[(j, j)] = lit(-rng.uniform() - 1e-3),
+            3 => {
+                bad[(j, j)] = lit(1e-300);
+                let other = (j + 1) % N;
+                bad[(other, j)] = lit(1.0);
+                bad[(j, other)] = lit(1.0);
+            }
+            4 => bad[(j, (j + N - 1) % N)] = lit([f64::NAN, f64::INFINITY][trial % 2]),
+            _ => bad[(j, j)] = lit([f64::NAN, f64::NEG_INFINITY, f64::INFINITY][trial % 3]),
+        }
+        let want = if trial % 6 >= 4 {
+            SolveError::NonFiniteResidual
+        } else {
+            SolveError::NotPositiveDefinite
+        };
+        assert_eq!(Factor::new(&bad).unwrap_err(), want, "{trial}");
+    }
+}
+
+#[test]
+fn factor_refuses_non_positive_diagonals_and_names_non_finite_entries() {
+    let mut rng = Rng::new(21);
+    factor_classifies_corrupted_gram_matrices::<f64, 3>(&mut rng);
+    factor_classifies_corrupted_gram_matrices::<f64, 6>(&mut rng);
+    factor_classifies_corrupted_gram_matrices::<f32, 3>(&mut rng);
+    factor_classifies_corrupted_gram_matrices::<f32, 6>(&mut rng);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Losses
 // ---------------------------------------------------------------------------------------------
@@ -184,6 +231,21 @@ fn pose_point_problem(rng: &mut Rng) -> (PosePoint, Vec<Block>) {
     });
     blocks.push(Block::Prior { p0: truth.b });
     (truth, blocks)
+}
+
+/// `Product::split` hands `ξ_a` the first `NA` entries of `ξ` and `ξ_b` the next `NB`, exactly
+/// (a copy), and `oplus` moves each factor by its own slice.
+#[test]
+fn product_split_gives_each_factor_its_slice() {
+    let xi = SVector::<f64, 9>::from_fn(|r, _| r as f64 + 0.5);
+    let (a, b) = PosePoint::split(&xi);
+    assert_eq!(a.as_slice(), &xi.as_slice()[..6]);
+    assert_eq!(b.as_slice(), &xi.as_slice()[6..]);
+    let mut rng = Rng::new(22);
+    let x = Product::new(rng.pose(), Vector3::new(1.0, -2.0, 3.0));
+    let moved = Manifold::<f64, 9>::oplus(&x, &xi);
+    assert_eq!(moved.a, x.a.rplus(&a));
+    assert_eq!(moved.b, x.b + b);
 }
 
 /// Every block's Jacobian through `Product::oplus`, by Richardson differences (`h = 1e-3`,

@@ -1,4 +1,6 @@
-//! The pinhole camera `z = K π(x)`, `π(x, y, z) = (x/z, y/z)` (seed §4), and its Jacobian.
+//! The pinhole camera `z = K π(x)`, with the projection `π(x, y, z) = (x/z, y/z)` of section 4
+//! of *Lie Groups and Smooth Manifolds for Robotic State Estimation* (`z_ij = π(T_i p_j)`), and
+//! its Jacobian.
 
 use crate::Real;
 use nalgebra::{Matrix2x3, Vector2, Vector3};
@@ -31,7 +33,6 @@ impl<T: Real> PinholeCamera<T> {
 
     /// `K π(x)` for a point `x` in the camera frame; `None` unless `x.z > min_depth`.
     #[must_use]
-    #[inline]
     pub fn project(&self, x: &Vector3<T>, min_depth: T) -> Option<Vector2<T>> {
         let in_front = x.z > min_depth;
         if !in_front {
@@ -47,8 +48,6 @@ impl<T: Real> PinholeCamera<T> {
     /// `(K π(x), ∂(K π)/∂x)` with
     /// `∂(K π)/∂x = [[fx/z, 0, −fx x/z²], [0, fy/z, −fy y/z²]]`; `None` unless `x.z > min_depth`.
     #[must_use]
-    #[cfg_attr(not(estimator_compact), inline)]
-    #[cfg_attr(estimator_compact, inline(never))]
     pub fn project_jac(&self, x: &Vector3<T>, min_depth: T) -> Option<(Vector2<T>, Matrix2x3<T>)> {
         let in_front = x.z > min_depth;
         if !in_front {

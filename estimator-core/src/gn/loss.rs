@@ -52,7 +52,6 @@ impl<T: Real> Loss<T> {
 
     /// `(ρ(s), ρ'(s))` for a squared whitened residual `s ≥ 0`.
     #[must_use]
-    #[cfg_attr(not(estimator_compact), inline)]
     pub fn evaluate(&self, s: T) -> (T, T) {
         match *self {
             Self::LeastSquares => (s, T::one()),

@@ -5,12 +5,13 @@ use crate::lie::{LieGroup, Se2, Se3, So2, So3};
 use crate::Real;
 use nalgebra::SVector;
 
-/// A state with `N` degrees of freedom and the retraction `⊕` of seed eq. (4.5).
+/// A state with `N` degrees of freedom and the retraction `⊕` of eq. 4.5 of *Lie Groups and
+/// Smooth Manifolds for Robotic State Estimation*, `a ⊕ ξ = a·exp(ξ^)`.
 ///
 /// For a Lie group `a ⊕ ξ = a · exp(ξ^)` (the right perturbation of [`crate::lie`]); for `Rⁿ`,
 /// `a ⊕ ξ = a + ξ`; for a product, each factor takes its own slice of `ξ`.
 pub trait Manifold<T: Real, const N: usize>: Copy {
-    /// `a ⊕ ξ` (seed eq. 4.5).
+    /// `a ⊕ ξ`.
     #[must_use]
     fn oplus(&self, xi: &SVector<T, N>) -> Self;
 
@@ -22,11 +23,9 @@ pub trait Manifold<T: Real, const N: usize>: Copy {
 macro_rules! lie_manifold {
     ($g:ident, $n:literal) => {
         impl<T: Real> Manifold<T, $n> for $g<T> {
-            #[inline]
             fn oplus(&self, xi: &SVector<T, $n>) -> Self {
                 self.rplus(xi)
             }
-            #[inline]
             fn all_finite(&self) -> bool {
                 self.is_finite()
             }
@@ -40,13 +39,11 @@ lie_manifold!(So3, 3);
 lie_manifold!(Se3, 6);
 
 impl<T: Real, const N: usize> Manifold<T, N> for SVector<T, N> {
-    #[inline]
     fn oplus(&self, xi: &SVector<T, N>) -> Self {
         self + xi
     }
-    #[inline]
     fn all_finite(&self) -> bool {
-        crate::scalar::all_finite(self.as_slice())
+        crate::kernels::all_finite(self.as_slice())
     }
 }
 
@@ -74,19 +71,11 @@ impl<A, B, const NA: usize, const NB: usize> Product<A, B, NA, NB> {
     /// `Manifold` impl guarantees `N = NA + NB` at compile time).
     #[must_use]
     pub fn split<T: Real, const N: usize>(xi: &SVector<T, N>) -> (SVector<T, NA>, SVector<T, NB>) {
-        let mut xa = SVector::<T, NA>::zeros();
-        let mut xb = SVector::<T, NB>::zeros();
-        // Slice copies over the common length (the rest stays zero).
-        let xi = xi.as_slice();
-        for (d, &x) in xa.as_mut_slice().iter_mut().zip(xi) {
-            *d = x;
-        }
-        if let Some(rest) = xi.get(NA..) {
-            for (d, &x) in xb.as_mut_slice().iter_mut().zip(rest) {
-                *d = x;
-            }
-        }
-        (xa, xb)
+        let entry = |k: usize| xi.get(k).copied().unwrap_or_else(T::zero);
+        (
+            SVector::from_fn(|r, _| entry(r)),
+            SVector::from_fn(|r, _| entry(NA + r)),
+        )
     }
 }
 
@@ -97,7 +86,6 @@ where
     A: Manifold<T, NA>,
     B: Manifold<T, NB>,
 {
-    #[inline]
     fn oplus(&self, xi: &SVector<T, N>) -> Self {
         const {
             assert!(
@@ -105,14 +93,12 @@ where
                 "Product<A, B, NA, NB> has NA + NB degrees of freedom"
             )
         };
-        // Read where it lies (a destructuring `let` copies both parts).
-        let x = Self::split(xi);
+        let (xa, xb) = Self::split(xi);
         Self {
-            a: self.a.oplus(&x.0),
-            b: self.b.oplus(&x.1),
+            a: self.a.oplus(&xa),
+            b: self.b.oplus(&xb),
         }
     }
-    #[inline]
     fn all_finite(&self) -> bool {
         self.a.all_finite() && self.b.all_finite()
     }

@@ -1,21 +1,24 @@
 //! Fixed-size Gauss-Newton / Levenberg-Marquardt on manifolds, with camera pose from landmark
-//! projections (PnP), triangulation, rotation from vector pairs and robust losses: the seed
-//! paper's section 4 as a solver that fits on a microcontroller.
+//! projections (PnP), triangulation, rotation from vector pairs and robust losses: section 4
+//! ("Optimization for Robotics") of *Lie Groups and Smooth Manifolds for Robotic State
+//! Estimation* as a solver that fits on a microcontroller.
 //!
 //! Everything is generic over `T:`[`Real`](crate::Real) (`f32`, `f64`), sized at compile time
 //! (state dimension `N`, residual dimension `K`), allocation-free and panic-free: every failure is
 //! a [`SolveError`].
 //!
-//! # From the seed paper's equations to the code
+//! # From the paper's equations to the code
 //!
-//! | seed | here |
+//! Equation numbers are those of *Lie Groups and Smooth Manifolds for Robotic State Estimation*.
+//!
+//! | paper | here |
 //! |---|---|
 //! | (4.1) `a* = argmin ‖h(a) − z‖²_Σ`, with `‖e‖²_Σ = eᵀΣ⁻¹e` | [`solve`] minimizes `F(a) = Σᵢ ρ(‖hᵢ(a) − zᵢ‖²_Σᵢ)`; each [`Problem`] block hands the **whitened** error `eᵢ = Σᵢ^{-1/2}(hᵢ(a) − zᵢ)`, so `‖eᵢ‖² = ‖hᵢ(a) − zᵢ‖²_Σᵢ`; `ρ` is a [`Loss`] (`ρ(s) = s` gives (4.1) exactly) |
-//! | Def. 4.6: `f(a ⊕ ξ) ≈ f(a) + F_a ξ`, `F_a` the Jacobian | every block's `Jᵢ = ∂eᵢ/∂ξ` is that right Jacobian (checked against finite differences through `⊕` in the tests) |
+//! | Def. 4.6: `F_a` is the Jacobian of `f` at `a` when `‖f(a) + F_a ξ − f(a·exp(ξ^))‖ / ‖ξ‖ → 0` | every block's `Jᵢ = ∂eᵢ/∂ξ` is that right Jacobian (checked against finite differences through `⊕` in the tests) |
 //! | (4.3) `h(a ⊕ ξ) ≈ h(a) + H_a ξ` | the linearization `eᵢ(a ⊕ ξ) ≈ eᵢ + Jᵢ ξ` passed to [`Problem::linearize`] |
 //! | (4.4) `ξ* = argmin ‖h(a) + H_a ξ − z‖²_Σ`, i.e. `Hᵀ H ξ* = Hᵀ(z − h(a))` | [`NormalEquations`]: `A = Σ wᵢ JᵢᵀJᵢ = HᵀWH`, `g = Σ wᵢ Jᵢᵀeᵢ = −HᵀW(z − h(a))`, summed block by block, no full `H` stored; IRLS weights `wᵢ = ρ'(‖eᵢ‖²)`; solved by Cholesky `A = LLᵀ` ([`Factor`]), `A ξ = −g` (Gauss-Newton) or `(A + λ diag A) ξ = −g` (Levenberg-Marquardt) |
 //! | (4.5) `a ⊕ ξ = a·exp(ξ^)` | the step `a ← a ⊕ ξ` ([`Manifold::oplus`], [`crate::lie::LieGroup::rplus`]) |
-//! | §4, `z = π(T p)` | [`solve_pnp`]: `z = K π(T p)` with [`PinholeCamera`]; the Jacobian is Theorem 5.1's `[R | −R[p]×]` chained with `∂(Kπ)/∂x` ([`reprojection_error`]) |
+//! | §4, `z = π(T p)`; Theorem 5.1, `F_(T,p) = T [H(p), I]` with `H(p) = [−p]×` for the rotation (Example 5.2) | [`solve_pnp`]: `z = K π(T p)` with [`PinholeCamera`]; the Jacobian is `∂(T p)/∂ξ = [R, −R[p]×]` (`ξ = [v; ω]`) chained with `∂(Kπ)/∂x` ([`reprojection_error`]) |
 //!
 //! # Iteration, convergence, covariance
 //!
@@ -50,7 +53,7 @@
 //! # Modules
 //!
 //! * [`solver`]: [`Problem`], [`ResidualBlock`], [`NormalEquations`], [`solve`], options, status.
-//! * [`linalg`]: the Cholesky / `LDLᵀ` factor with a typed failure.
+//! * [`linalg`]: the Cholesky factor with a typed failure and a relative pivot test.
 //! * [`loss`]: Huber and Cauchy as IRLS.
 //! * [`manifold`]: the state trait, Lie groups, `Rⁿ`, products ([`Product`]).
 //! * [`camera`], [`pnp`], [`triangulation`], [`rotation`]: the models.
@@ -61,8 +64,6 @@ pub mod linalg;
 pub mod loss;
 pub mod manifold;
 pub mod pnp;
-#[cfg(test)]
-mod rewrites;
 pub mod rotation;
 pub mod solver;
 pub mod triangulation;
@@ -84,18 +85,8 @@ pub use triangulation::{
     point_reprojection_error, triangulate, Triangulation, TriangulationOptions,
 };
 
-/// `true` when every `x` is finite and `x > 0` (`false` for NaN). One loop shared by the option
-/// checks of every solver, instead of an inlined class test per field (never on a hot path, so
-/// out of line at every opt-level).
-#[inline(never)]
+/// `true` when every `x` is finite and `x > 0` (`false` for NaN): the check of scales, noise
+/// levels and focal lengths in the options of every solver.
 pub(crate) fn all_positive<T: crate::Real>(xs: &[T]) -> bool {
-    xs.iter().all(|&x| crate::scalar::positive_finite(x))
-}
-
-/// `true` when every `x` is finite and `x ≥ 0` (`false` for NaN); see [`all_positive`]. Its
-/// one caller is [`SolverOptions::is_valid`], itself out of
-/// line: built for size it is left to the inliner.
-#[cfg_attr(not(estimator_compact), inline(never))]
-pub(crate) fn all_non_negative<T: crate::Real>(xs: &[T]) -> bool {
-    xs.iter().all(|&x| crate::scalar::non_negative_finite(x))
+    xs.iter().all(|&x| crate::kernels::positive_finite(x))
 }

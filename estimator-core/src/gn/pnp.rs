@@ -1,22 +1,24 @@
-//! Camera pose from landmark projections (PnP): `z_j = K π(T p_j)` (seed §4), solved by the
-//! [`solve`](super::solve) core over `T ∈ SE(3)`.
+//! Camera pose from landmark projections (PnP): `z_j = K π(T p_j)`, the landmark model of
+//! section 4 of *Lie Groups and Smooth Manifolds for Robotic State Estimation*
+//! (`z_ij = π(T_i p_j)`), solved by the [`solve`](super::solve) core over `T ∈ SE(3)`.
 //!
 //! The Jacobian of the pixel with respect to the right perturbation `T ⊕ ξ`, `ξ = [v; ω]`, is the
-//! chain rule of seed Theorem 5.1 (`∂(T p)/∂ξ = [R | −R[p]×]`, [`crate::lie::Se3`]'s `act_jac`)
-//! with the projection's Jacobian ([`PinholeCamera::project_jac`]):
+//! action Jacobian of the paper's Theorem 5.1, `F_(T,p) = T [H(p), I]` with `H(p) = [−p]×` for
+//! the rotation (Example 5.2), i.e. `∂(T p)/∂ξ = [R, −R[p]×]` ([`crate::lie::Se3`]'s
+//! `act_jac`), chained with the projection's Jacobian ([`PinholeCamera::project_jac`]):
 //!
 //! ```text
-//! ∂z/∂ξ = Jπ(x) · [R | −R[p]×],   x = T p.
+//! ∂z/∂ξ = Jπ(x) · [R, −R[p]×],   x = T p.
 //! ```
 //!
-//! It is evaluated as `B = Jπ R` (2×3) and, row by row, `bₖᵀ(−[p]×) = (p × bₖ)ᵀ`, which is the
-//! same product without forming `R[p]×` (the tests compare it with `act_jac` and with finite
+//! It is evaluated as `B = Jπ R` (2×3) and, row by row, `bₖᵀ(−[p]×) = (p × bₖ)ᵀ`, the same
+//! product without forming `R[p]×` (the tests compare it with `act_jac` and with finite
 //! differences).
 
 use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
 use super::{Loss, PinholeCamera, SolveError};
+use crate::kernels::{all_finite, mat3};
 use crate::lie::{LieGroup, Se3};
-use crate::scalar::all_finite;
 use crate::Real;
 use nalgebra::{Matrix2x6, Matrix3, Matrix6, SMatrix, SVector, Vector2, Vector3};
 
@@ -52,7 +54,7 @@ impl<T: Real> Default for PnpOptions<T> {
     /// Levenberg-Marquardt, least squares, `sigma_px = 1`, 30 iterations, the solver's default
     /// tolerances, `min_depth = 1e-3` m, `inlier_chi2 = 9.21`.
     fn default() -> Self {
-        let s = SolverOptions::<T>::defaults_inline();
+        let s = SolverOptions::<T>::default();
         Self {
             method: Method::LevenbergMarquardt,
             loss: Loss::LeastSquares,
@@ -92,11 +94,10 @@ pub struct Inliers {
 }
 
 impl Inliers {
-    /// The 32-bit word `k` of the bitset (bits `32k .. 32k + 31`). Shifts by constants only: on a
-    /// 32-bit core a `u128` shift by a variable amount, or its population count, is a four-word
-    /// routine.
+    /// The 32-bit word `k` of the bitset (bits `32k .. 32k + 31`), by shifts of constant amounts
+    /// (on a 32-bit core a `u128` shift by a variable amount is a call to a four-word routine).
     fn word(&self, k: usize) -> u32 {
-        // Truncating casts on purpose: each keeps one 32-bit word.
+        // Each truncating cast keeps one 32-bit word.
         match k {
             0 => self.bits as u32,
             1 => (self.bits >> 32) as u32,
@@ -164,7 +165,6 @@ pub struct PnpSolution<T: Real> {
 /// rotation matrix of `T` (passed in so a pass over many points forms it once).
 /// `None` unless the depth `x.z > min_depth`.
 #[must_use]
-#[inline]
 pub fn reprojection_error<T: Real>(
     camera: &PinholeCamera<T>,
     r: &Matrix3<T>,
@@ -174,48 +174,21 @@ pub fn reprojection_error<T: Real>(
     inv_sigma: T,
     min_depth: T,
 ) -> Option<(Vector2<T>, Matrix2x6<T>)> {
-    let x = camera_point(r, t, p);
-    let (uv, jp) = camera.project_jac(&x, min_depth)?;
-    // Jπ/σ has zeros at (0, 1) and (1, 0): (Jπ/σ) R from its four other entries only. Without
-    // those products the result may differ from the full product in the sign of a zero (and
-    // stays finite where a non-finite R entry met a zero).
-    let rows = [
-        (jp.m11 * inv_sigma, jp.m13 * inv_sigma, r.row(0)),
-        (jp.m22 * inv_sigma, jp.m23 * inv_sigma, r.row(1)),
-    ];
-    let mut j = Matrix2x6::zeros();
-    for (i, (f, a, ri)) in rows.iter().enumerate() {
-        // Row i of Jπ R (the translation block): f·(row i of R) + a·(row 2 of R), then p × it.
-        // One loop body for both rows.
-        let bi = Vector3::new(
-            *f * ri[0] + *a * r.m31,
-            *f * ri[1] + *a * r.m32,
-            *f * ri[2] + *a * r.m33,
-        );
-        let ci = p.cross(&bi); // bᵀ(−[p]×) = (p × b)ᵀ
-        let mut row = j.row_mut(i);
-        row[0] = bi.x;
-        row[1] = bi.y;
-        row[2] = bi.z;
-        row[3] = ci.x;
-        row[4] = ci.y;
-        row[5] = ci.z;
-    }
-    let e = Vector2::new((uv.x - z.x) * inv_sigma, (uv.y - z.y) * inv_sigma);
+    let (uv, jp) = camera.project_jac(&(mat3::mul_vec(r, p) + t), min_depth)?;
+    // `Jπ = [[fx/z, 0, −fx x/z²], [0, fy/z, −fy y/z²]]`, so row `i` of the translation block
+    // `B = (Jπ/σ) R` is `f_i·(row i of R) + a_i·(row 3 of R)` with `f_i = Jπ_ii/σ`,
+    // `a_i = Jπ_i3/σ`; the rotation block is `bᵢᵀ(−[p]×) = (p × bᵢ)ᵀ`.
+    let r3 = r.row(2).transpose();
+    let b0 = r.row(0).transpose() * (jp.m11 * inv_sigma) + r3 * (jp.m13 * inv_sigma);
+    let b1 = r.row(1).transpose() * (jp.m22 * inv_sigma) + r3 * (jp.m23 * inv_sigma);
+    let (c0, c1) = (p.cross(&b0), p.cross(&b1));
+    #[rustfmt::skip]
+    let j = Matrix2x6::new(
+        b0.x, b0.y, b0.z, c0.x, c0.y, c0.z,
+        b1.x, b1.y, b1.z, c1.x, c1.y, c1.z,
+    );
+    let e = (uv - z) * inv_sigma;
     Some((e, j))
-}
-
-/// `R p + t`: a world point in the camera frame (one copy of the code for every caller in a
-/// build for size).
-#[cfg_attr(not(estimator_compact), inline(always))]
-#[cfg_attr(estimator_compact, inline(never))]
-pub(super) fn camera_point<T: Real>(r: &Matrix3<T>, t: &Vector3<T>, p: &Vector3<T>) -> Vector3<T> {
-    // Row by row, in the order of nalgebra's `r * p + t` (column by column, then `t`).
-    Vector3::new(
-        p.x * r.m11 + p.y * r.m12 + p.z * r.m13 + t.x,
-        p.x * r.m21 + p.y * r.m22 + p.z * r.m23 + t.y,
-        p.x * r.m31 + p.y * r.m32 + p.z * r.m33 + t.z,
-    )
 }
 
 /// The PnP residuals as a [`Problem`] over `Se3` (whitened, `K = 2`).
@@ -241,13 +214,10 @@ impl<T: Real> Problem<T, Se3<T>, 6, 2> for PnpProblem<'_, T> {
         let r = state.rotation().rotation_matrix();
         let t = state.translation();
         for (p, z) in self.world_points.iter().zip(self.pixels) {
-            // Borrowed where it lies (no move out of the `Option`).
-            let block =
-                reprojection_error(&self.camera, &r, &t, p, z, self.inv_sigma, self.min_depth);
-            let Some((e, j)) = &block else {
-                return Err(SolveError::PointBehindCamera);
-            };
-            sink(e, j);
+            let (e, j) =
+                reprojection_error(&self.camera, &r, &t, p, z, self.inv_sigma, self.min_depth)
+                    .ok_or(SolveError::PointBehindCamera)?;
+            sink(&e, &j);
         }
         Ok(())
     }
@@ -273,21 +243,11 @@ pub fn check_point_spread<T: Real>(points: &[Vector3<T>]) -> Result<(), SolveErr
         return Err(SolveError::DegenerateGeometry);
     }
     let count = T::from_usize(n).unwrap_or_else(T::one);
-    let inv_n = T::one() / count;
-    // `Σ p / n` and `p − p̄` component by component (nalgebra's `+=`, `* inv_n` and `-` do the
-    // same operations, entry by entry), with no vector temporaries on the stack.
-    let [mut mx, mut my, mut mz] = [T::zero(); 3];
-    for p in points {
-        mx += p.x;
-        my += p.y;
-        mz += p.z;
-    }
-    let (mx, my, mz) = (mx * inv_n, my * inv_n, mz * inv_n);
-    // The six distinct entries of the symmetric `S` (`d dᵀ` is exactly symmetric), summed in
-    // the order of the points.
+    let mean = points.iter().fold(Vector3::zeros(), |sum, p| sum + p) * (T::one() / count);
+    // The six distinct entries of the symmetric `S`.
     let [mut s11, mut s22, mut s33, mut s12, mut s13, mut s23] = [T::zero(); 6];
     for p in points {
-        let d = Vector3::new(p.x - mx, p.y - my, p.z - mz);
+        let d = p - mean;
         s11 += d.x * d.x;
         s22 += d.y * d.y;
         s33 += d.z * d.z;
@@ -297,7 +257,7 @@ pub fn check_point_spread<T: Real>(points: &[Vector3<T>]) -> Result<(), SolveErr
     }
     let tr = s11 + s22 + s33;
     let i2 = s11 * s22 - s12 * s12 + s11 * s33 - s13 * s13 + s22 * s33 - s23 * s23;
-    let scale = mx * mx + my * my + mz * mz + T::one();
+    let scale = mean.norm_squared() + T::one();
     let spread = tr > T::lit(COINCIDENT_REL) * count * scale;
     let not_collinear = i2 > T::lit(COLLINEAR_REL) * tr * tr;
     if spread && not_collinear {
@@ -322,18 +282,12 @@ fn inlier_mask<T: Real>(
     let mut words = [0u32; 4];
     let pairs = problem.world_points.iter().zip(problem.pixels);
     for (k, (p, z)) in pairs.enumerate() {
-        // The pixel as the solver's residual forms it ([`reprojection_error`]): one copy of the
-        // projection code (the unused Jacobian is dropped when inlined).
-        let projected = problem
+        // The pixel with the arithmetic of the solver's residual ([`reprojection_error`]).
+        let (uv, _) = problem
             .camera
-            .project_jac(&camera_point(&r, &t, p), problem.min_depth);
-        let Some((uv, _)) = &projected else {
-            return Err(SolveError::PointBehindCamera);
-        };
-        let e = Vector2::new(
-            (uv.x - z.x) * problem.inv_sigma,
-            (uv.y - z.y) * problem.inv_sigma,
-        );
+            .project_jac(&(mat3::mul_vec(&r, p) + t), problem.min_depth)
+            .ok_or(SolveError::PointBehindCamera)?;
+        let e = (uv - z) * problem.inv_sigma;
         if e.norm_squared() <= chi2 {
             if let Some(w) = words.get_mut(k / 32) {
                 *w |= 1 << (k % 32);
@@ -354,9 +308,6 @@ fn inlier_mask<T: Real>(
 /// then Cauchy (`options`) from there; when that reaches a lower cost than `best.0` and its
 /// inlier test succeeds, it replaces `best`. Returns the iterations run.
 ///
-/// Out of line so that its second solution does not sit in [`solve_pnp`]'s frame on the common
-/// path (no retry).
-#[inline(never)]
 fn cauchy_retry<T: Real>(
     problem: &PnpProblem<'_, T>,
     guess: &Se3<T>,
@@ -369,11 +320,8 @@ fn cauchy_retry<T: Real>(
         loss: Loss::Huber(k),
         ..*options
     };
-    // One buffer serves both solves: only the Huber state is kept for the second. It starts as
-    // a copy of `best` with the guess as its state (solve_into overwrites the rest on success,
-    // and `c` is dropped on failure): one block copy instead of a fresh placeholder.
-    let mut c = *best.0;
-    c.state = *guess;
+    // One solution serves both solves: the Huber state is the guess of the Cauchy one.
+    let mut c = Solution::placeholder(guess);
     if solve_into(problem, &huber, &mut c).is_err() {
         return 0;
     }
@@ -392,11 +340,12 @@ fn cauchy_retry<T: Real>(
 }
 
 /// Camera pose from landmark projections: minimizes `Σⱼ ρ(‖K π(T pⱼ) − zⱼ‖² / σ²)` over
-/// `T = camera_from_world ∈ SE(3)`, from `camera_from_world_guess` (seed §4, `z = π(T p)`).
+/// `T = camera_from_world ∈ SE(3)`, from `camera_from_world_guess`.
 ///
-/// Steps: validate; accumulate the 6×6 normal equations over the points (seed eq. 4.4), with the
-/// Jacobian of [`reprojection_error`] (Theorem 5.1 chained with `∂π`); Cholesky; `T ← T ⊕ ξ`
-/// (eq. 4.5); then mark inliers by `‖eⱼ‖² ≤ inlier_chi2` at the solution. With a robust loss the
+/// Steps: validate; accumulate the 6×6 normal equations over the points (eq. 4.4 of *Lie Groups
+/// and Smooth Manifolds for Robotic State Estimation*, `Hᵀ H ξ* = Hᵀ(z − h(a))`, here weighted),
+/// with the Jacobian of [`reprojection_error`] (its Theorem 5.1 chained with `∂π`); Cholesky;
+/// `T ← T ⊕ ξ = T·exp(ξ^)` (eq. 4.5); then mark inliers by `‖eⱼ‖² ≤ inlier_chi2` at the solution. With a robust loss the
 /// IRLS weights down-weight gross outliers from the first iteration on (prefer
 /// [`Loss::Cauchy`], whose weight vanishes for large residuals). With Cauchy, a result where
 /// fewer than half the points are inliers triggers one more attempt through a Huber solve of the
@@ -412,6 +361,42 @@ fn cauchy_retry<T: Real>(
 /// * [`SolveError::PointBehindCamera`]: a point at depth `≤ min_depth` at the guess or solution;
 /// * [`SolveError::NotPositiveDefinite`]: singular information (unobservable pose);
 /// * [`SolveError::NonFiniteResidual`]: the iteration produced a non-finite number.
+///
+/// # Example
+///
+/// Twelve landmarks seen from a known pose, and the pose recovered from a guess about 10° and
+/// 0.3 m away:
+///
+/// ```
+/// use estimator_core::gn::{solve_pnp, PinholeCamera, PnpOptions, SolveError};
+/// use estimator_core::lie::{LieGroup, Se3, So3};
+/// use nalgebra::{Vector2, Vector3};
+///
+/// let camera = PinholeCamera::new(500.0, 500.0, 320.0, 240.0);
+/// let truth = Se3::from_parts(
+///     So3::exp(&Vector3::new(0.1, -0.2, 0.05)),
+///     Vector3::new(0.3, -0.1, 4.0),
+/// );
+/// // A 4 × 3 grid of landmarks at three heights, and their exact pixels.
+/// let world: Vec<Vector3<f64>> = (0..12)
+///     .map(|k| Vector3::new((k % 4) as f64 - 1.5, (k / 4) as f64 - 1.0, 0.3 * (k % 3) as f64))
+///     .collect();
+/// let pixels: Vec<Vector2<f64>> = world
+///     .iter()
+///     .map(|p| camera.project(&truth.act(p), 1e-3).expect("in front of the camera"))
+///     .collect();
+///
+/// let guess = Se3::from_parts(
+///     So3::exp(&Vector3::new(0.2, -0.1, -0.05)),
+///     Vector3::new(0.1, 0.1, 3.8),
+/// );
+/// let solution = solve_pnp(&world, &pixels, &camera, &guess, &PnpOptions::default())?;
+///
+/// // `truth ⊖ estimate = [v; ω]`: metres and radians.
+/// assert!(truth.rminus(&solution.camera_from_world).norm() < 1e-9);
+/// assert_eq!(solution.inliers.count(), 12);
+/// # Ok::<(), SolveError>(())
+/// ```
 pub fn solve_pnp<T: Real>(
     world_points: &[Vector3<T>],
     pixels: &[Vector2<T>],
@@ -466,7 +451,7 @@ pub fn solve_pnp<T: Real>(
         step_tolerance: options.step_tolerance,
         cost_tolerance: options.cost_tolerance,
         information_step_tolerance: options.information_step_tolerance,
-        initial_damping: SolverOptions::<T>::defaults_inline().initial_damping,
+        initial_damping: SolverOptions::<T>::default().initial_damping,
     };
     let mut sol = Solution::placeholder(camera_from_world_guess);
     solve_into(&problem, &solver_options, &mut sol)?;

@@ -4,10 +4,12 @@
 //!
 //! Each pair gives a body-frame direction `bᵢ` and its world-frame reference `wᵢ` (both are
 //! normalized; only directions matter). The model is `bᵢ = R⁻¹ wᵢ` with
-//! `R = world_from_body`, the residual `eᵢ = (Rᵀ wᵢ − bᵢ)/σᵢ`. For `R ⊕ δ = R exp(δ)` (seed
-//! eq. 4.5), `(R exp δ)ᵀ w = exp(−δ) Rᵀw ≈ Rᵀw − δ × Rᵀw = Rᵀw + [Rᵀw]× δ`, so
-//! `∂eᵢ/∂δ = [Rᵀ wᵢ]× / σᵢ` (seed Def. 4.6; the action Jacobian of Theorem 5.1 for the inverse
-//! rotation). `σᵢ` is the angular noise of `bᵢ` in radians. The Jacobian's null space is the
+//! `R = world_from_body`, the residual `eᵢ = (Rᵀ wᵢ − bᵢ)/σᵢ`. For `R ⊕ δ = R exp(δ^)` (eq. 4.5
+//! of *Lie Groups and Smooth Manifolds for Robotic State Estimation*),
+//! `(R exp δ^)ᵀ w = exp(−δ^) Rᵀw ≈ Rᵀw − δ × Rᵀw = Rᵀw + [Rᵀw]× δ`, so
+//! `∂eᵢ/∂δ = [Rᵀ wᵢ]× / σᵢ`: the Jacobian of Definition 4.6 (`F_a` with
+//! `‖f(a) + F_a δ − f(a·exp(δ^))‖ / ‖δ‖ → 0`), the action Jacobian `R[−p]×` of Theorem 5.1 and
+//! Example 5.2 for the inverse rotation. `σᵢ` is the angular noise of `bᵢ` in radians. The Jacobian's null space is the
 //! observed direction itself: one pair leaves the rotation about it unobservable, two
 //! non-parallel pairs fix all three angles.
 //!
@@ -17,8 +19,8 @@
 
 use super::solver::{solve_into, Problem, Solution, SolverOptions, Status};
 use super::SolveError;
+use crate::kernels::{all_finite, positive_finite};
 use crate::lie::{skew, LieGroup, So3};
-use crate::scalar::{all_finite, positive_finite};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
@@ -62,39 +64,29 @@ pub fn vector_pair_error<T: Real>(
     inv_sigma: T,
 ) -> (Vector3<T>, Matrix3<T>) {
     let pred = world_from_body.inverse().act(world_unit);
-    let e = Vector3::new(
-        (pred.x - body_unit.x) * inv_sigma,
-        (pred.y - body_unit.y) * inv_sigma,
-        (pred.z - body_unit.z) * inv_sigma,
-    );
-    (e, skew(&pred) * inv_sigma)
+    ((pred - body_unit) * inv_sigma, skew(&pred) * inv_sigma)
 }
 
+/// `v / ‖v‖`; `None` unless `‖v‖` is finite and positive.
 pub(super) fn unit<T: Real>(v: &Vector3<T>) -> Option<Vector3<T>> {
     let (u, n) = normalized(v);
     positive_finite(n).then_some(u)
 }
 
-/// `(v / ‖v‖, ‖v‖)`, whatever the norm (for [`unit`] and the rays of
-/// [`triangulate`](super::triangulate); small enough to be left to the inliner).
+/// `(v / ‖v‖, ‖v‖)`, whatever the norm (for [`unit()`] and the rays of
+/// [`triangulate`](super::triangulate)).
 pub(super) fn normalized<T: Real>(v: &Vector3<T>) -> (Vector3<T>, T) {
     let n = v.norm_squared().sqrt_rn();
-    (Vector3::new(v.x / n, v.y / n, v.z / n), n)
+    (v / n, n)
 }
 
-/// The orthonormal triad `(u, u×v/‖u×v‖, u×(u×v)/‖u×v‖)` of the unit vector `u` and a second
-/// direction `v`, as the columns of a matrix; `None` when they are parallel. Out of line: both
-/// frames of [`triad`] share it.
-#[inline(never)]
+/// The orthonormal triad `(u, s, u × s)`, `s = u×v/‖u×v‖`, of the unit vector `u` and a second
+/// direction `v`, as the columns of a matrix; `None` when they are parallel (`‖u × v‖` at most
+/// `PARALLEL_REL`).
 fn triad_frame<T: Real>(u: &Vector3<T>, v: &Vector3<T>) -> Option<Matrix3<T>> {
-    let n = u.cross(v);
-    let nn = n.norm_squared().sqrt_rn();
+    let (s, nn) = normalized(&u.cross(v));
     let not_parallel = nn > T::lit(PARALLEL_REL);
-    if !not_parallel {
-        return None;
-    }
-    let s = Vector3::new(n.x / nn, n.y / nn, n.z / nn);
-    Some(Matrix3::from_columns(&[*u, s, u.cross(&s)]))
+    not_parallel.then(|| Matrix3::from_columns(&[*u, s, u.cross(&s)]))
 }
 
 /// The TRIAD rotation `W Bᵀ` from two body/world pairs of unit vectors.
@@ -104,41 +96,19 @@ pub(super) fn triad<T: Real>(
     w1: &Vector3<T>,
     w2: &Vector3<T>,
 ) -> Option<So3<T>> {
-    // Each frame read where it lies (`?` on the value would copy it out of the `Option`).
-    let b = triad_frame(b1, b2);
-    let b = b.as_ref()?;
-    let w = triad_frame(w1, w2);
-    let w = w.as_ref()?;
-    So3::from_rotation_matrix(&mul_transpose(w, b))
-}
-
-/// `w bᵀ` for 3×3 matrices as the sum of the outer products of their columns,
-/// `Σₖ wₖ bₖᵀ`, entry `(r, c)` = `(w_r0 b_c0 + w_r1 b_c1) + w_r2 b_c2`: nalgebra's product
-/// `w * b.transpose()` sums the same three products as `p₂ + (p₁ + p₀)`, the same bits for
-/// finite entries (addition is commutative), without the transpose and with a short loop.
-pub(super) fn mul_transpose<T: Real>(w: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
-    let mut out = Matrix3::zeros();
-    let columns = w
-        .as_slice()
-        .chunks_exact(3)
-        .zip(b.as_slice().chunks_exact(3));
-    for (k, (wk, bk)) in columns.enumerate() {
-        for (oc, &bkc) in out.as_mut_slice().chunks_exact_mut(3).zip(bk) {
-            for (o, &wkr) in oc.iter_mut().zip(wk) {
-                // The first product is written, not added to zero (`0 + −0 = +0`).
-                *o = if k == 0 { wkr * bkc } else { *o + wkr * bkc };
-            }
-        }
-    }
-    out
+    let b = triad_frame(b1, b2)?;
+    let w = triad_frame(w1, w2)?;
+    So3::from_rotation_matrix(&(w * b.transpose()))
 }
 
 /// [`triad`] of the unit vectors of two pairs; `None` for a zero vector or parallel directions.
 fn triad_pairs<T: Real>(first: &VectorPair<T>, second: &VectorPair<T>) -> Option<So3<T>> {
-    // Read where they lie (`?` on the values would copy them out of the `Option`s).
-    let (b1, w1) = (unit(&first.body), unit(&first.world));
-    let (b2, w2) = (unit(&second.body), unit(&second.world));
-    triad(b1.as_ref()?, b2.as_ref()?, w1.as_ref()?, w2.as_ref()?)
+    triad(
+        &unit(&first.body)?,
+        &unit(&second.body)?,
+        &unit(&first.world)?,
+        &unit(&second.world)?,
+    )
 }
 
 /// The TRIAD start of [`solve_rotation_from_vectors`]: from the first pair and the pair whose body
@@ -147,9 +117,8 @@ fn triad_pairs<T: Real>(first: &VectorPair<T>, second: &VectorPair<T>) -> Option
 /// # Errors
 /// [`SolveError::DegenerateGeometry`]: fewer than 2 pairs, a zero vector, or parallel directions.
 pub(super) fn triad_start<T: Real>(pairs: &[VectorPair<T>]) -> Result<So3<T>, SolveError> {
-    // Unit vectors of the first pair and of the pair most perpendicular to it (body side). Every
-    // pair's vectors are checked here; the best pair is kept by reference and its unit vectors
-    // formed again (the same bits) instead of carried through the loop.
+    // Every pair's vectors are checked here; the best pair is kept by reference and its unit
+    // vectors formed again by `triad_pairs`.
     let (first, rest) = pairs.split_first().ok_or(SolveError::DegenerateGeometry)?;
     let b1 = unit(&first.body).ok_or(SolveError::DegenerateGeometry)?;
     let mut best: Option<(T, &VectorPair<T>)> = None;
@@ -175,11 +144,11 @@ impl<T: Real> Problem<T, So3<T>, 3, 3> for RotProblem<'_, T> {
         F: FnMut(&SVector<T, 3>, &SMatrix<T, 3, 3>),
     {
         for pair in self.pairs {
-            let (Some(b), Some(w)) = (&unit(&pair.body), &unit(&pair.world)) else {
+            let (Some(b), Some(w)) = (unit(&pair.body), unit(&pair.world)) else {
                 return Err(SolveError::DegenerateGeometry);
             };
-            let block = vector_pair_error(state, b, w, T::one() / pair.sigma);
-            sink(&block.0, &block.1);
+            let (e, j) = vector_pair_error(state, &b, &w, T::one() / pair.sigma);
+            sink(&e, &j);
         }
         Ok(())
     }
@@ -195,9 +164,6 @@ impl<T: Real> Problem<T, So3<T>, 3, 3> for RotProblem<'_, T> {
 /// [`SolveError::NonFiniteGuess`]; [`SolveError::DegenerateGeometry`] (a zero vector, or all
 /// body or all world directions parallel); [`SolveError::NotPositiveDefinite`],
 /// [`SolveError::NonFiniteResidual`] from the solver.
-// Built for size, out of line: inlined into a large caller its loop would work in that
-// caller's stack frame, with longer addressing for every spill.
-#[cfg_attr(estimator_compact, inline(never))]
 pub fn solve_rotation_from_vectors<T: Real>(
     pairs: &[VectorPair<T>],
     guess: Option<&So3<T>>,

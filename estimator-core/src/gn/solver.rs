@@ -1,18 +1,22 @@
 //! The solver core: block-wise accumulation of the normal equations, Gauss-Newton and
 //! Levenberg-Marquardt steps through `⊕`, convergence tests, covariance.
 //!
-//! See the [module docs](crate::gn) for how each step maps to the seed paper's equations.
+//! See the [module docs](crate::gn) for how each step maps to the equations of *Lie Groups and
+//! Smooth Manifolds for Robotic State Estimation*.
 
 use super::linalg;
 use super::{Loss, Manifold, SolveError};
+use crate::kernels::cholesky::solve_in_place;
+use crate::kernels::{all_finite, non_negative_finite, slice::dot};
 use crate::Real;
 use nalgebra::{SMatrix, SVector};
 
 /// A set of residual blocks of dimension `K` over a state `S` with `N` degrees of freedom.
 ///
 /// For each block `i`, `linearize` hands the *whitened* error `eᵢ = Σᵢ^{-1/2} (hᵢ(a) − zᵢ)` and its
-/// Jacobian `Jᵢ = ∂eᵢ/∂ξ` at `ξ = 0` in the sense of seed Def. 4.6, i.e.
-/// `eᵢ(a ⊕ ξ) ≈ eᵢ(a) + Jᵢ ξ` (seed eq. 4.3), to `sink`. Nothing is stored: the solver folds each
+/// Jacobian `Jᵢ = ∂eᵢ/∂ξ` at `ξ = 0` in the sense of Definition 4.6 of *Lie Groups and Smooth
+/// Manifolds for Robotic State Estimation* (`‖f(a) + F_a ξ − f(a exp(ξ^))‖ / ‖ξ‖ → 0`), i.e.
+/// `eᵢ(a ⊕ ξ) ≈ eᵢ(a) + Jᵢ ξ` (its eq. 4.3, `h(a ⊕ ξ) ≈ h(a) + H_a ξ`), to `sink`. Nothing is stored: the solver folds each
 /// block into the `N × N` normal equations as it arrives.
 pub trait Problem<T: Real, S, const N: usize, const K: usize> {
     /// Calls `sink(eᵢ, Jᵢ)` for every block at `state`.
@@ -52,7 +56,9 @@ where
     }
 }
 
-/// The accumulated normal equations of seed eq. (4.4) with IRLS weights `wᵢ = ρ'(‖eᵢ‖²)`:
+/// The accumulated normal equations of the linearized problem (eq. 4.4 of *Lie Groups and Smooth
+/// Manifolds for Robotic State Estimation*, `ξ* = argmin ‖h(a) + H_a ξ − z‖²_Σ`, solved by
+/// `H_aᵀ H_a ξ* = H_aᵀ(z − h(a))`) with IRLS weights `wᵢ = ρ'(‖eᵢ‖²)`:
 /// `A = Σ wᵢ Jᵢᵀ Jᵢ` (the information matrix `Hᵀ W H`), `g = Σ wᵢ Jᵢᵀ eᵢ` (so that
 /// `Hᵀ W (z − h(a)) = −g`), and the robust cost `F = Σ ρ(‖eᵢ‖²)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,39 +85,12 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
         }
     }
 
-    /// Folds one block in: `A += w JᵀJ`, `g += w Jᵀe`, `F += ρ(‖e‖²)`.
-    #[inline]
+    /// Folds one block in: `A += w JᵀJ`, `g += w Jᵀe`, `F += ρ(‖e‖²)` with `(ρ, w) = (ρ(s), ρ'(s))`
+    /// at `s = ‖e‖²`.
     pub fn add<const K: usize>(&mut self, loss: &Loss<T>, e: &SVector<T, K>, j: &SMatrix<T, K, N>) {
-        // Built for size: one copy of the code for every `(N, K)`, with the same arithmetic
-        // (nalgebra's `dot` sums left to right up to `K = 3`, pairwise from `K = 4`).
-        #[cfg(estimator_compact)]
-        if K <= 3 {
-            add_shared(
-                self.information.as_mut_slice(),
-                self.gradient.as_mut_slice(),
-                &mut self.cost,
-                loss,
-                e.as_slice(),
-                j.as_slice(),
-            );
-            self.blocks += 1;
-            return;
-        }
-        self.add_fixed(loss, e, j);
-    }
-
-    /// [`Self::add`] specialised for `(N, K)`.
-    #[inline]
-    fn add_fixed<const K: usize>(
-        &mut self,
-        loss: &Loss<T>,
-        e: &SVector<T, K>,
-        j: &SMatrix<T, K, N>,
-    ) {
         let (rho, w) = loss.evaluate(e.norm_squared());
         let wj = j * w;
-        // `A += (w J)ᵀ J` entry by entry (the same dot products as `tr_mul`, without its
-        // `N × N` temporary).
+        // `A += (w J)ᵀ J` entry by entry, `A_rc += (w J_r)·J_c` over the columns `J_r`, `J_c`.
         for (r, wcol) in wj.column_iter().enumerate() {
             for (c, jcol) in j.column_iter().enumerate() {
                 if let Some(x) = self.information.get_mut((r, c)) {
@@ -137,36 +116,14 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
         P: Problem<T, S, N, K> + ?Sized,
     {
         let mut ne = Self::zeros();
-        ne.rebuild(problem, state, loss)?;
+        ne.accumulate(problem, state, loss)?;
+        finite_sums(ne.information.as_slice(), ne.gradient.as_slice(), ne.cost)?;
         Ok(ne)
     }
 
-    /// [`Self::build`] in place: resets `self` and accumulates every block of `problem` at
-    /// `state` into it (no `N × N` temporary is returned by value, which keeps the stack small
-    /// on embedded targets). On error `self` holds a partial sum.
-    ///
-    /// # Errors
-    /// As [`Self::build`].
-    #[inline(never)]
-    pub(crate) fn rebuild<S, P, const K: usize>(
-        &mut self,
-        problem: &P,
-        state: &S,
-        loss: &Loss<T>,
-    ) -> Result<(), SolveError>
-    where
-        P: Problem<T, S, N, K> + ?Sized,
-    {
-        self.accumulate(problem, state, loss)?;
-        finite_sums(
-            self.information.as_slice(),
-            self.gradient.as_slice(),
-            self.cost,
-        )
-    }
-
-    /// [`Self::rebuild`] without the finiteness test (which [`solve_into`] runs in its shared
-    /// part).
+    /// Resets `self` and accumulates every block of `problem` at `state` into it, without the
+    /// finiteness test of [`Self::build`] (which [`solve_into`] runs in its shared part). On
+    /// error `self` holds a partial sum.
     ///
     /// # Errors
     /// The problem's own error.
@@ -187,49 +144,11 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
 /// [`SolveError::NonFiniteResidual`] unless the cost, the gradient and the information of a
 /// linearization are finite.
 fn finite_sums<T: Real>(information: &[T], gradient: &[T], cost: T) -> Result<(), SolveError> {
-    if cost.is_finite() && linalg::all_finite(gradient) && linalg::all_finite(information) {
+    if cost.is_finite() && all_finite(gradient) && all_finite(information) {
         Ok(())
     } else {
         Err(SolveError::NonFiniteResidual)
     }
-}
-
-/// `x₀y₀ + x₁y₁ + …` summed left to right from the first product, as nalgebra's `dot` for the
-/// short vectors of a block (so the shared code gives the same numbers as the specialised one).
-#[cfg(estimator_compact)]
-fn dot_exact<T: Real>(x: &[T], y: &[T], scale: T) -> T {
-    let mut terms = x.iter().zip(y).map(|(&a, &b)| a * scale * b);
-    let first = terms.next().unwrap_or_else(T::zero);
-    terms.fold(first, |acc, t| acc + t)
-}
-
-/// [`NormalEquations::add`] on the column-major storage: `info` (`n × n`), `grad` (`n`), the
-/// error `e` (`k`) and the Jacobian `j` (`k × n`, column `c` is entries `c·k .. c·k + k`); `n`
-/// and `k` are the lengths of `grad` and `e`. One copy of the code for every `(N, K)`.
-#[cfg(estimator_compact)]
-#[inline(never)]
-fn add_shared<T: Real>(
-    info: &mut [T],
-    grad: &mut [T],
-    cost: &mut T,
-    loss: &Loss<T>,
-    e: &[T],
-    j: &[T],
-) {
-    let (rho, w) = loss.evaluate(dot_exact(e, e, T::one()));
-    let (n, k) = (grad.len(), e.len());
-    if k > 0 {
-        // `A += (w J)ᵀ J` and `g += (w J)ᵀ e`: `(w Jᵣ)·J꜀` entry by entry, `w J` not stored.
-        for (r, (g, jr)) in grad.iter_mut().zip(j.chunks_exact(k)).enumerate() {
-            for (c, jc) in j.chunks_exact(k).enumerate() {
-                if let Some(x) = info.get_mut(c * n + r) {
-                    *x += dot_exact(jr, jc, w);
-                }
-            }
-            *g += dot_exact(jr, e, w);
-        }
-    }
-    *cost += rho;
 }
 
 /// The iteration.
@@ -266,18 +185,7 @@ impl<T: Real> Default for SolverOptions<T> {
     /// Levenberg-Marquardt, least squares, 50 iterations, step tolerance
     /// `max(1e3 ε, 1e-9)`, cost tolerance `max(1e2 ε, 1e-12)`, information step tolerance
     /// `1e-6`, `λ₀ = 1e-3`.
-    // One copy of the four constants for every caller in a build for size.
-    #[cfg_attr(estimator_compact, inline(never))]
     fn default() -> Self {
-        Self::defaults_inline()
-    }
-}
-
-impl<T: Real> SolverOptions<T> {
-    /// `Default::default`'s values, always inlined: for the callers that read one or two of
-    /// them (the constants then fold into their code instead of a call and a copy).
-    #[inline(always)]
-    pub(super) fn defaults_inline() -> Self {
         Self {
             method: Method::LevenbergMarquardt,
             loss: Loss::LeastSquares,
@@ -303,12 +211,14 @@ impl<T: Real> SolverOptions<T> {
     #[must_use]
     pub fn is_valid(&self) -> bool {
         self.loss.is_valid()
-            && super::all_non_negative(&[
+            && [
                 self.step_tolerance,
                 self.cost_tolerance,
                 self.information_step_tolerance,
                 self.initial_damping,
-            ])
+            ]
+            .into_iter()
+            .all(non_negative_finite)
     }
 }
 
@@ -350,12 +260,13 @@ pub struct Solution<T: Real, S, const N: usize> {
 
 const MAX_DAMPING: f64 = 1e12;
 
-/// Minimizes `F(a) = Σᵢ ρ(‖hᵢ(a) − zᵢ‖²_Σ)` (seed eq. 4.1 with a robust loss) over the manifold
-/// `S`, from `initial`.
+/// Minimizes `F(a) = Σᵢ ρ(‖hᵢ(a) − zᵢ‖²_Σ)` over the manifold `S`, from `initial`: eq. 4.1 of
+/// *Lie Groups and Smooth Manifolds for Robotic State Estimation*, `a* = argmin ‖h(a) − z‖²_Σ`,
+/// with a robust loss `ρ`.
 ///
-/// Each iteration accumulates the normal equations block by block ([`NormalEquations`], seed
-/// eq. 4.4 with IRLS weights), factorizes `A` (+ damping) by Cholesky ([`Factor`](super::Factor)), solves for
-/// `ξ` and moves `a ← a ⊕ ξ` (seed eq. 4.5).
+/// Each iteration accumulates the normal equations block by block ([`NormalEquations`], eq. 4.4
+/// with IRLS weights), factorizes `A` (+ damping) by Cholesky ([`Factor`](super::Factor)),
+/// solves for `ξ` and moves `a ← a ⊕ ξ` (eq. 4.5, `a ⊕ ξ = a·exp(ξ^)`).
 ///
 /// # Errors
 /// [`SolveError::InvalidOptions`], [`SolveError::NonFiniteGuess`], any error of the problem at the
@@ -373,14 +284,9 @@ where
     S: Manifold<T, N>,
     P: Problem<T, S, N, K> + ?Sized,
 {
-    // Solved in the returned value (no copy of the solution into the `Result`).
-    let mut out = Ok(Solution::placeholder(initial));
-    if let Ok(s) = &mut out {
-        if let Err(e) = solve_into(problem, options, s) {
-            out = Err(e);
-        }
-    }
-    out
+    let mut solution = Solution::placeholder(initial);
+    solve_into(problem, options, &mut solution)?;
+    Ok(solution)
 }
 
 impl<T: Real, S: Copy, const N: usize> Solution<T, S, N> {
@@ -399,9 +305,8 @@ impl<T: Real, S: Copy, const N: usize> Solution<T, S, N> {
 }
 
 /// [`solve`] from the guess `out.state`, writing its result into `out` (every field, on
-/// success) instead of returning it: callers that keep a solution avoid the by-value copies of
-/// the `N × N` covariance through `Result`, which matters for the stack on embedded targets; the
-/// state is iterated in place. On error `out` may hold a partial result.
+/// success): the state is iterated in place, and a caller that keeps the solution holds one
+/// copy of the `N × N` covariance on its stack. On error `out` may hold a partial result.
 ///
 /// Only the storage and the problem-specific steps ([`Candidate`]) are per problem; the rest
 /// ([`drive`]) is compiled once.
@@ -469,17 +374,17 @@ fn drive<T: Real>(
     run.accept(true);
     let initial_cost = run.parts().cost;
     let (iterations, status) = iterate(run, options)?;
+    // `cov = A⁻¹`, factorized in the trial's information as scratch (the trial linearization is
+    // no longer needed).
     let finite = run.finite();
+    run.information_to_scratch();
     let p = run.parts();
     if !finite || !p.cost.is_finite() {
         return Err(SolveError::NonFiniteResidual);
     }
-    // `Factor::new` then `Factor::inverse_into`, on the trial's information as scratch (a copy
-    // of `A`; the trial linearization is no longer needed).
     let n = p.step.len();
-    copy(p.scratch, p.information);
-    linalg::cholesky_in_place(p.scratch, n)?;
-    linalg::inverse_in_place(p.scratch, n, cov)?;
+    linalg::factor(p.scratch, n)?;
+    linalg::inverse(p.scratch, n, cov)?;
     Ok(Done {
         iterations,
         initial_cost,
@@ -488,22 +393,15 @@ fn drive<T: Real>(
     })
 }
 
-/// [`NormalEquations::rebuild`] at the candidate of `run`, into its trial linearization: the
+/// [`NormalEquations::build`] at the candidate of `run`, into its trial linearization: the
 /// problem-specific accumulation, then the shared finiteness test.
 ///
 /// # Errors
-/// As [`NormalEquations::rebuild`].
+/// As [`NormalEquations::build`].
 fn linearize<T: Real>(run: &mut dyn Candidate<T>) -> Result<(), SolveError> {
     run.linearize()?;
     let p = run.parts();
     finite_sums(p.scratch, p.trial_gradient, p.trial_cost)
-}
-
-/// `dst ← src` entry by entry (the shorter length; no panic on a mismatch).
-fn copy<T: Real>(dst: &mut [T], src: &[T]) {
-    for (d, &s) in dst.iter_mut().zip(src) {
-        *d = s;
-    }
 }
 
 /// What [`iterate`] needs of a step `ξ`: `‖ξ‖`, the model decrease terms `ξᵀAξ` and `ξᵀg`.
@@ -541,7 +439,9 @@ trait Candidate<T: Real> {
     fn parts(&mut self) -> Parts<'_, T>;
     /// `true` when the current state is finite.
     fn finite(&self) -> bool;
-    /// Forms the candidate `a ⊕ ξ` (seed eq. 4.5) from the current state and the kept step;
+    /// The trial linearization's information becomes a copy of the current one's, `A`.
+    fn information_to_scratch(&mut self);
+    /// Forms the candidate `a ⊕ ξ` (eq. 4.5) from the current state and the kept step;
     /// `true` when it is finite.
     fn propose(&mut self) -> bool;
     /// The normal equations at the candidate, into the trial, unchecked (see [`linearize`]).
@@ -585,6 +485,10 @@ where
         self.state.all_finite()
     }
 
+    fn information_to_scratch(&mut self) {
+        self.trial.information = self.ne.information;
+    }
+
     fn propose(&mut self) -> bool {
         self.candidate = self.state.oplus(&self.step);
         self.candidate.all_finite()
@@ -610,8 +514,6 @@ where
 ///
 /// # Errors
 /// As [`solve`], for the failures that happen during the iteration.
-// Built for size, left to the inliner: its one caller is `drive`.
-#[cfg_attr(not(estimator_compact), inline(never))]
 fn iterate<T: Real>(
     run: &mut dyn Candidate<T>,
     options: &SolverOptions<T>,
@@ -624,6 +526,7 @@ fn iterate<T: Real>(
 
     while iterations < options.max_iterations {
         iterations += 1;
+        run.information_to_scratch();
         let p = run.parts();
         let cost = p.cost;
         if cost <= T::zero() {
@@ -722,8 +625,9 @@ enum StepError {
 
 /// The step `ξ` of one iteration, into `step`: `(A + λ diag A) ξ = −g` (Levenberg-Marquardt,
 /// `lm`) or `A ξ = −g` (Gauss-Newton), with the figures [`iterate`] needs, on the column-major
-/// storage: `a` is the `n × n` information, `g` the gradient, `damped` scratch for the damped
-/// matrix and its factor (`n` the length of `step`). One copy of the code for every dimension.
+/// storage: `a` is the `n × n` information, `g` the gradient, `damped` a copy of `a` that
+/// becomes the damped matrix and its factor (`n` the length of `step`). One copy of the code
+/// for every dimension.
 fn damped_step<T: Real>(
     damped: &mut [T],
     a: &[T],
@@ -733,29 +637,22 @@ fn damped_step<T: Real>(
     step: &mut [T],
 ) -> Result<StepStats<T>, StepError> {
     let n = step.len();
-    copy(damped, a);
     if lm {
         damp(damped, n, lambda);
     }
-    // Factorized in place (what `Factor::new` and `Factor::solve` do, without a second
-    // `N × N` copy).
-    linalg::cholesky_in_place(damped, n).map_err(StepError::Factor)?;
+    linalg::factor(damped, n).map_err(StepError::Factor)?;
     for (x, &gk) in step.iter_mut().zip(g) {
         *x = -gk;
     }
-    linalg::substitute(damped, n, step);
-    if !linalg::all_finite(step) {
+    solve_in_place(damped, n, step);
+    if !all_finite(step) {
         return Err(StepError::Solve(SolveError::NonFiniteResidual));
     }
     Ok(step_stats(a, g, step))
 }
 
-/// `‖ξ‖`, `ξᵀAξ` and `ξᵀg` for the column-major `n × n` matrix `a` (`n` the length of `step`):
-/// one copy of the code for every dimension. Built for size it is left to the inliner: its one
-/// caller, [`damped_step`], then keeps the step and the matrix in registers.
-#[cfg_attr(not(estimator_compact), inline(never))]
+/// `‖ξ‖`, `ξᵀAξ` and `ξᵀg` for the column-major `n × n` matrix `a` (`n` the length of `step`).
 fn step_stats<T: Real>(a: &[T], g: &[T], step: &[T]) -> StepStats<T> {
-    use linalg::dot;
     let n = step.len();
     // ξᵀAξ = Σ_c ξ_c (A ξ)_c, with (A ξ)_c = Σ_r A_rc ξ_r for the symmetric A (column c of A).
     let info = if n == 0 {
@@ -775,7 +672,6 @@ fn step_stats<T: Real>(a: &[T], g: &[T], step: &[T]) -> StepStats<T> {
 /// Marquardt scaling on the diagonal of the column-major `n × n` matrix `a`:
 /// `Aₖₖ += λ·max(Aₖₖ, ε·maxₖ Aₖₖ)`, the floor so that a zero column still gets damped. The
 /// dimension is a run-time number: one copy of the code for every `N`.
-#[inline(never)]
 fn damp<T: Real>(a: &mut [T], n: usize, lambda: T) {
     let diagonal = |a: &[T], k: usize| a.get(k * n + k).copied();
     let mut largest = diagonal(a, 0).unwrap_or_else(T::zero);
@@ -791,51 +687,5 @@ fn damp<T: Real>(a: &mut [T], n: usize, lambda: T) {
         if let Some(x) = a.get_mut(k * n + k) {
             *x += lambda * (*x).max(floor);
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The bits of every entry of `ne` (information, gradient, cost).
-    fn entries<T: Real, const N: usize>(
-        ne: &NormalEquations<T, N>,
-    ) -> impl Iterator<Item = u64> + '_ {
-        let all = ne.information.iter().chain(ne.gradient.iter()).copied();
-        all.chain(core::iter::once(ne.cost))
-            .map(|v| Real::to_f64(v).to_bits())
-    }
-
-    /// `NormalEquations::add` (in a build for size: the shared kernel over run-time dimensions)
-    /// gives the same bits as the `(N, K)`-specialised accumulation.
-    fn add_matches_fixed<T: Real, const N: usize, const K: usize>() {
-        let x = |k: usize| T::lit(((k * 37 % 23) as f64 - 11.0) / 7.0);
-        let e = SVector::<T, K>::from_fn(|r, _| x(r + 1));
-        let j = SMatrix::<T, K, N>::from_fn(|r, c| x(3 * r + 5 * c + 2));
-        for loss in [
-            Loss::LeastSquares,
-            Loss::Huber(T::lit(0.5)),
-            Loss::Cauchy(T::lit(0.8)),
-        ] {
-            let mut shared = NormalEquations::<T, N>::zeros();
-            let mut fixed = NormalEquations::<T, N>::zeros();
-            for scale in [T::one(), T::lit(-2.5), T::lit(1e-3)] {
-                shared.add(&loss, &(e * scale), &j);
-                fixed.add_fixed(&loss, &(e * scale), &j);
-            }
-            assert!(entries(&shared).eq(entries(&fixed)), "{loss:?}");
-            assert_eq!(shared.blocks, fixed.blocks);
-        }
-    }
-
-    #[test]
-    fn add_is_the_specialised_accumulation() {
-        add_matches_fixed::<f64, 6, 2>();
-        add_matches_fixed::<f64, 3, 2>();
-        add_matches_fixed::<f64, 3, 3>();
-        add_matches_fixed::<f32, 6, 2>();
-        add_matches_fixed::<f32, 3, 3>();
-        add_matches_fixed::<f64, 6, 4>();
     }
 }

@@ -4,17 +4,19 @@
 //!
 //! * **Start** (closed form): the point closest to all rays in the least-squares sense. The ray
 //!   of view `i` leaves the centre `cᵢ = −Rᵢᵀ tᵢ` along `dᵢ = Rᵢᵀ K⁻¹[u, v, 1]ᵀ / ‖·‖`; with the
-//!   projector `Pᵢ = I − dᵢdᵢᵀ`, `(Σ Pᵢ) p = Σ Pᵢ cᵢ`, a 3×3 system factorized by [`Factor`](super::Factor)
+//!   projector `Pᵢ = I − dᵢdᵢᵀ`, `(Σ Pᵢ) p = Σ Pᵢ cᵢ`, a 3×3 system factorized by [`Factor`]
 //!   (singular for parallel rays).
 //! * **Refinement**: the residual `eᵢ = (K π(Tᵢ p) − zᵢ)/σ` with Jacobian
-//!   `∂eᵢ/∂p = Jπ(xᵢ) Rᵢ / σ` (seed Theorem 5.1: `∂(T p)/∂p = R`), and `p ⊕ δ = p + δ`.
+//!   `∂eᵢ/∂p = Jπ(xᵢ) Rᵢ / σ` (Theorem 5.1 of *Lie Groups and Smooth Manifolds for Robotic
+//!   State Estimation*, `F_(T,p) = T [H(p), I]`, whose point block gives `∂(T p)/∂p = R`), and
+//!   `p ⊕ δ = p + δ`.
 //! * **Covariance**: `(Σ wᵢ JᵢᵀJᵢ)⁻¹` at the solution (m²).
 
 use super::rotation::normalized;
 use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
-use super::{linalg, reprojection_error, Loss, PinholeCamera, SolveError};
+use super::{reprojection_error, Factor, Loss, PinholeCamera, SolveError};
+use crate::kernels::all_finite;
 use crate::lie::{LieGroup, Se3};
-use crate::scalar::all_finite;
 use crate::Real;
 use nalgebra::{Matrix2x3, Matrix3, SMatrix, SVector, Vector2, Vector3};
 
@@ -102,19 +104,16 @@ impl<T: Real> Problem<T, Vector3<T>, 3, 2> for TriProblem<'_, T> {
         F: FnMut(&SVector<T, 2>, &SMatrix<T, 2, 3>),
     {
         for (pose, z) in self.poses.iter().zip(self.pixels) {
-            // Borrowed where it lies (no move out of the `Option`).
-            let block = point_reprojection_error(
+            let (e, j) = point_reprojection_error(
                 &self.camera,
                 pose,
                 state,
                 z,
                 self.inv_sigma,
                 self.min_depth,
-            );
-            let Some((e, j)) = &block else {
-                return Err(SolveError::PointBehindCamera);
-            };
-            sink(e, j);
+            )
+            .ok_or(SolveError::PointBehindCamera)?;
+            sink(&e, &j);
         }
         Ok(())
     }
@@ -129,9 +128,28 @@ impl<T: Real> Problem<T, Vector3<T>, 3, 2> for TriProblem<'_, T> {
 /// parallax); [`SolveError::PointBehindCamera`] (the point lies at depth `≤ min_depth` in a view
 /// at the start or the solution); [`SolveError::NotPositiveDefinite`],
 /// [`SolveError::NonFiniteResidual`] from the solver.
-// Built for size, out of line: inlined into a large caller its loop would work in that
-// caller's stack frame, with longer addressing for every spill.
-#[cfg_attr(estimator_compact, inline(never))]
+///
+/// # Example
+///
+/// A point seen by two cameras 1 m apart, both looking along `+z`:
+///
+/// ```
+/// use estimator_core::gn::{triangulate, PinholeCamera, SolveError, TriangulationOptions};
+/// use estimator_core::lie::{LieGroup, Se3, So3};
+/// use nalgebra::Vector3;
+///
+/// let camera = PinholeCamera::new(500.0, 500.0, 320.0, 240.0);
+/// let point = Vector3::new(0.5, -0.2, 6.0);
+/// let views = [
+///     Se3::identity(),
+///     Se3::from_parts(So3::identity(), Vector3::new(-1.0, 0.0, 0.0)),
+/// ];
+/// let pixels = views.map(|v| camera.project(&v.act(&point), 1e-3).expect("in front"));
+///
+/// let t = triangulate(&views, &pixels, &camera, &TriangulationOptions::default())?;
+/// assert!((t.point - point).norm() < 1e-9);
+/// # Ok::<(), SolveError>(())
+/// ```
 pub fn triangulate<T: Real>(
     cameras_from_world: &[Se3<T>],
     pixels: &[Vector2<T>],
@@ -160,37 +178,21 @@ pub fn triangulate<T: Real>(
         return Err(SolveError::NonFiniteInput);
     }
 
-    // Linear start: (Σ Pᵢ) p = Σ Pᵢ cᵢ (the upper triangle of `m` stays zero).
+    // Linear start: (Σ Pᵢ) p = Σ Pᵢ cᵢ, with the projector `Pᵢ = I − dᵢdᵢᵀ` off the ray.
     let mut m = Matrix3::zeros();
     let mut b = Vector3::zeros();
     for (pose, z) in cameras_from_world.iter().zip(pixels) {
         let world_from_camera = pose.inverse();
         let c = world_from_camera.translation();
-        let d = world_from_camera.rotation().act(&camera.unproject(z));
-        let (d, _) = normalized(&d);
-        // `Pᵢ = I − d dᵀ` is symmetric and `Factor::new` reads only the lower triangle of `m`:
-        // its six distinct entries, then `m += Pᵢ` (lower triangle), `b += Pᵢ cᵢ`, each entry
-        // with the arithmetic of nalgebra's `identity() − d * dᵀ` and `proj * c`.
-        let (x, y, z) = (d.x, d.y, d.z);
-        let (pxx, pyy, pzz) = (T::one() - x * x, T::one() - y * y, T::one() - z * z);
-        let (pxy, pxz, pyz) = (T::zero() - x * y, T::zero() - x * z, T::zero() - y * z);
-        m.m11 += pxx;
-        m.m21 += pxy;
-        m.m31 += pxz;
-        m.m22 += pyy;
-        m.m32 += pyz;
-        m.m33 += pzz;
-        b.x += c.x * pxx + c.y * pxy + c.z * pxz;
-        b.y += c.x * pxy + c.y * pyy + c.z * pyz;
-        b.z += c.x * pxz + c.y * pyz + c.z * pzz;
+        let (d, _) = normalized(&world_from_camera.rotation().act(&camera.unproject(z)));
+        let projector = Matrix3::identity() - d * d.transpose();
+        m += projector;
+        b += projector * c;
     }
-    // `Factor::new(&m)` and `Factor::solve(&b)` in place (any failure is degenerate geometry).
-    let mut start = b;
-    linalg::cholesky_in_place(m.as_mut_slice(), 3).map_err(|_| SolveError::DegenerateGeometry)?;
-    linalg::substitute(m.as_slice(), 3, start.as_mut_slice());
-    if !all_finite(start.as_slice()) {
-        return Err(SolveError::DegenerateGeometry);
-    }
+    // Any failure of the factor or the solve is degenerate geometry (parallel rays).
+    let start = Factor::new(&m)
+        .and_then(|f| f.solve(&b))
+        .map_err(|_| SolveError::DegenerateGeometry)?;
 
     let inv_sigma = T::one() / options.sigma_px;
     let problem = TriProblem {

@@ -95,7 +95,7 @@ use nalgebra::{Const, DimMin, Matrix3, SMatrix, SVector, Vector3};
 /// here by a central difference through `⊕` and `⊖` (the paper's Definition 4.6).
 ///
 /// ```
-/// use estimator_core::lie::{MatrixLieGroup, Se2, So3};
+/// use estimator_core::lie::{LieGroup, MatrixLieGroup, Se2, So3};
 /// use nalgebra::{SVector, Vector3};
 ///
 /// fn check<G: MatrixLieGroup<f64, N, D, M>, const N: usize, const D: usize, const M: usize>(

@@ -103,7 +103,11 @@ fn q_block<T: Real>(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matri
     let a = v * k.c + w * (T::lit(0.5) * se.f * dot);
     let s = v * k.b - w * (dot * (k.c + se.e + se.e));
     // αωᵀ + ωαᵀ: entry (i, j) is αᵢωⱼ + αⱼωᵢ.
-    let (xy, xz, yz) = (a.x * w.y + a.y * w.x, a.x * w.z + a.z * w.x, a.y * w.z + a.z * w.y);
+    let (xy, xz, yz) = (
+        a.x * w.y + a.y * w.x,
+        a.x * w.z + a.z * w.x,
+        a.y * w.z + a.z * w.y,
+    );
     Matrix3::new(
         a.x * w.x + a.x * w.x - g,
         xy - s.z,

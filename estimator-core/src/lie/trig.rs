@@ -306,18 +306,33 @@ mod tests {
     /// Numerical Algorithms*, eq. 5.3), against the sum taken in `f64` for `f32` coefficients.
     #[test]
     fn poly_is_horner_within_its_error_bound() {
-        let c = [1.0 / 6.0, -1.0 / 120.0, 1.0 / 5040.0, -1.0 / 362_880.0, 0.3, -7.0];
+        let c = [
+            1.0 / 6.0,
+            -1.0 / 120.0,
+            1.0 / 5040.0,
+            -1.0 / 362_880.0,
+            0.3,
+            -7.0,
+        ];
         let gamma = |k: f64| k * f64::from(f32::EPSILON) / (1.0 - k * f64::from(f32::EPSILON));
         for i in 0..=400 {
             let x = f64::from(i) * 0.01;
             let xf = x as f32;
             let cf = c.map(|p| p as f32);
             let xe = f64::from(xf);
-            let terms = |n: usize| cf.iter().take(n).enumerate().map(|(k, p)| f64::from(*p) * xe.powi(k as i32));
+            let terms = |n: usize| {
+                cf.iter()
+                    .take(n)
+                    .enumerate()
+                    .map(|(k, p)| f64::from(*p) * xe.powi(k as i32))
+            };
             let check = |got: f32, n: usize| {
                 let exact: f64 = terms(n).sum();
                 let bound = gamma(2.0 * (n as f64 - 1.0)) * terms(n).map(f64::abs).sum::<f64>();
-                assert!((f64::from(got) - exact).abs() <= bound, "{x} {n}: {got} vs {exact}");
+                assert!(
+                    (f64::from(got) - exact).abs() <= bound,
+                    "{x} {n}: {got} vs {exact}"
+                );
             };
             check(poly(xf, [cf[0], cf[1], cf[2]]), 3);
             check(poly(xf, [cf[0], cf[1], cf[2], cf[3]]), 4);

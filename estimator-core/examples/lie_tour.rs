@@ -1,5 +1,6 @@
-//! A short tour of `estimator_core::lie`: the conventions at work on SO(3) and SE(3), the seed's
-//! Example 5.2, and the Jacobians checked against a finite difference, in f32 and f64.
+//! A short tour of `estimator_core::lie`: the conventions at work on SO(3) and SE(3), Example 5.2
+//! of *Lie Groups and Smooth Manifolds for Robotic State Estimation*, and the Jacobians checked
+//! against a finite difference, in f32 and f64.
 //!
 //! Run: `cargo run --release -p estimator-core --example lie_tour`
 
@@ -26,7 +27,7 @@ fn main() {
         );
     }
 
-    // Seed Example 5.2: the Jacobian of f(R, p) = R p is R [[−p]× | I].
+    // The paper's Example 5.2: the Jacobian of f(R, p) = R p is F = R [[−p]× | I].
     let r = So3::exp(&Vector3::new(0.4, -0.9, 1.3));
     let p = Vector3::new(0.3, -1.7, 2.2);
     let (rp, j_r, j_p) = r.act_jac(&p);
@@ -38,7 +39,8 @@ fn main() {
         j_p == r.matrix()
     );
 
-    // A Jacobian against a central difference through ⊕ / ⊖ (Def. 4.6).
+    // A Jacobian against a central difference through ⊕ / ⊖ (the paper's Definition 4.6:
+    // f(a ⊕ τ) ≈ f(a) + F τ).
     let a = Se3::exp(&Vector6::new(1.0, -2.0, 0.5, 0.3, -0.7, 1.1));
     let b = Se3::exp(&Vector6::new(-0.3, 0.7, 2.0, -1.2, 0.4, 0.25));
     let (ab, j_a, _) = a.compose_jac(&b);

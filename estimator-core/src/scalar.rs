@@ -5,14 +5,15 @@
 //!
 //! * [`Real::EPSILON_F64`], the machine epsilon as an `f64`, from which every small-angle threshold
 //!   in [`crate::lie`] is derived at compile time ([`taylor_cutoff`]); there is no global epsilon.
-//! * [`Real::lit`], an `#[inline(always)]` literal conversion so that `f32` code never performs an
-//!   `f64` operation at run time (on a Cortex-M4F that would be software floating point).
+//! * [`Real::lit`], a literal conversion that folds to a constant of type `T`, so that `f32` code
+//!   never performs an `f64` operation at run time (on a Cortex-M4F that would be software
+//!   floating point).
 //! * [`Real::sincos`], sine and cosine of one angle. For `f64` it is `libm::sincos`. For `f32` it
 //!   is [`sincos_f32`], computed entirely in `f32`: `libm::sinf`/`cosf` reduce and evaluate in
 //!   `f64` internally, which a Cortex-M4F emulates in software.
 //! * `x.sqrt_rn()`, the crate's square root (a method of the sealed supertrait, so that
 //!   nalgebra's `x.sqrt()` stays unambiguous): for `f32` [`sqrt_f32`], correctly rounded like
-//!   `libm::sqrtf` at about a third of its flash on a Cortex-M4F; for `f64` `libm::sqrt`.
+//!   `libm::sqrtf` and smaller and faster on a Cortex-M4F; for `f64` `libm::sqrt`.
 
 use nalgebra::RealField;
 
@@ -22,60 +23,25 @@ mod sealed {
     /// on `Real` would make every such call ambiguous (here and in users' generic code).
     pub trait Sealed: Copy {
         /// `√self`, correctly rounded, with IEEE 754's special values: [`super::sqrt_f32`] for
-        /// `f32` (no table: a third of `libm::sqrtf`'s flash on a Cortex-M4F, two thirds of its
-        /// instructions), `libm::sqrt` for `f64`. The same bits as nalgebra's `sqrt` (`libm` or
-        /// `std`, both correctly rounded) on every target.
+        /// `f32`, `libm::sqrt` for `f64`. Being correctly rounded, it equals nalgebra's `sqrt`
+        /// (`libm` or `std`, both correctly rounded) on every target.
         fn sqrt_rn(self) -> Self;
     }
     impl Sealed for f32 {
-        #[inline]
         fn sqrt_rn(self) -> Self {
             super::sqrt_f32(self)
         }
     }
     impl Sealed for f64 {
-        #[inline]
         fn sqrt_rn(self) -> Self {
             libm::sqrt(self)
         }
     }
 }
 
-/// `true` when every number is finite: the one loop behind the `is_finite` and
-/// `try_from_matrix` checks of the groups, the solver's checks and the update's SPD test. No
-/// inline attribute on purpose: at opt-level "s" it stays one out-of-line copy (a class test per
-/// element inlined at each call site costs more flash than the call); at opt-level 3 LLVM
-/// inlines it where it pays (a call inside the filter's state checks makes callers spill).
-#[cfg_attr(estimator_compact, inline(never))]
-pub(crate) fn all_finite<T: Real>(xs: &[T]) -> bool {
-    xs.iter().all(|x| x.is_finite())
-}
-
-/// `0 < x < ∞` (false for NaN): the test of a positive definite pivot or a norm. Built for
-/// size, two floating-point comparisons, `x > 0` and `x·0 = 0` (`x·0` is `±0` for finite `x`,
-/// `NaN` for `±∞` and `NaN`): the same answer as `x.is_finite() && x > 0`, which LLVM turns into
-/// integer tests of the bit pattern at opt-level "s" (about 60 bytes at each site on a
-/// Cortex-M4F). At opt-level 2 or 3 the plain form stays: the other one left a panic path in
-/// the `f64` no-panic build.
-#[inline(always)]
-#[must_use]
-pub(crate) fn positive_finite<T: Real>(x: T) -> bool {
-    #[cfg(estimator_compact)]
-    return x > T::zero() && x * T::zero() == T::zero();
-    #[cfg(not(estimator_compact))]
-    return x.is_finite() && x > T::zero();
-}
-
-/// `x ≥ 0` and finite (`false` for NaN). Built for size, `x · 0 = 0` is the finiteness test
-/// (`∞ · 0` and `NaN · 0` are NaN): two comparisons instead of a class test.
-#[inline(always)]
-#[must_use]
-pub(crate) fn non_negative_finite<T: Real>(x: T) -> bool {
-    #[cfg(estimator_compact)]
-    return x >= T::zero() && x * T::zero() == T::zero();
-    #[cfg(not(estimator_compact))]
-    return x >= T::zero() && x.is_finite();
-}
+// The finiteness and sign tests live in `crate::kernels`; re-exported for the modules that
+// import them from here.
+pub(crate) use crate::kernels::{all_finite, non_negative_finite, positive_finite};
 
 /// A real scalar: `f32` or `f64` (sealed).
 pub trait Real: RealField + Copy + sealed::Sealed {
@@ -83,7 +49,7 @@ pub trait Real: RealField + Copy + sealed::Sealed {
     /// thresholds can be computed in `const` context.
     const EPSILON_F64: f64;
 
-    /// Converts a literal. Always inlined, so `T::lit(1.0 / 6.0)` folds to a constant of type `T`.
+    /// Converts a literal: `T::lit(1.0 / 6.0)` folds to a constant of type `T`.
     fn lit(x: f64) -> Self;
 
     /// `(sin x, cos x)` computed in `Self`'s own precision.
@@ -102,22 +68,18 @@ pub trait Real: RealField + Copy + sealed::Sealed {
 impl Real for f64 {
     const EPSILON_F64: f64 = f64::EPSILON;
 
-    #[inline(always)]
     fn lit(x: f64) -> Self {
         x
     }
 
-    #[inline]
     fn sincos(self) -> (Self, Self) {
         libm::sincos(self)
     }
 
-    #[inline]
     fn arctan2(self, x: Self) -> Self {
         libm::atan2(self, x)
     }
 
-    #[inline(always)]
     fn to_f64(self) -> f64 {
         self
     }
@@ -126,22 +88,18 @@ impl Real for f64 {
 impl Real for f32 {
     const EPSILON_F64: f64 = f32::EPSILON as f64;
 
-    #[inline(always)]
     fn lit(x: f64) -> Self {
         x as f32
     }
 
-    #[inline]
     fn sincos(self) -> (Self, Self) {
         sincos_f32(self)
     }
 
-    #[inline]
     fn arctan2(self, x: Self) -> Self {
         atan2_f32(self, x)
     }
 
-    #[inline(always)]
     fn to_f64(self) -> f64 {
         self as f64
     }
@@ -206,9 +164,9 @@ pub fn sincos_f32(x: f32) -> (f32, f32) {
 /// the multiples of `π/4`, and `NaN` in gives `NaN`.
 ///
 /// Accuracy, measured against `f64` in the tests of this module: at most 2 units in the last
-/// place of the result (1.85 measured, against 1.44 for `libm::atan2f`). Smaller than
-/// `libm::atan2f` + `atanf` (which split `[0, ∞)` into five intervals, with one more
-/// polynomial degree) by about 350 bytes of Cortex-M4F flash.
+/// place of the result (1.85 measured, against 1.44 for `libm::atan2f`). Smaller code than
+/// `libm::atan2f` + `atanf`, which split `[0, ∞)` into five intervals, with one more polynomial
+/// degree.
 #[must_use]
 pub fn atan2_f32(y: f32, x: f32) -> f32 {
     use core::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
@@ -256,9 +214,8 @@ pub fn atan2_f32(y: f32, x: f32) -> f32 {
 /// `√x` in `f32`, correctly rounded (IEEE 754 round to nearest) for every input, without a
 /// table and without `f64`. The Cortex-M4F's `vsqrt.f32` is out of reach from stable safe Rust
 /// (`f32::sqrt` is `std`-only, `core`'s is unstable), and `libm::sqrtf` there is an integer
-/// routine with a 256-byte table (480 bytes in all). This one is 180 bytes and 38 instructions
-/// on the path of a positive normal number, two of them `vdiv.f32` (the firmware's benchmark,
-/// call included: 49 instructions, `libm::sqrtf` 61). Special values as IEEE 754:
+/// routine with a table. This one has no table and is shorter: 38 instructions on the path of a
+/// positive normal number, two of them `vdiv.f32`. Special values as IEEE 754:
 /// `√±0 = ±0`, `√+∞ = +∞`, `NaN` for `NaN` and for every number below zero (`−∞` included).
 ///
 /// Method. A positive normal `x = m·2^(e−150)` (`m` the 24-bit significand, `e` the biased
@@ -285,10 +242,6 @@ pub fn atan2_f32(y: f32, x: f32) -> f32 {
 /// A subnormal `x = i·2⁻¹⁴⁹` first becomes the `f32` of the integer `2i < 2²⁴` (exact), an
 /// exponent 150 too high in the field: subtracting `150·2²³` (a multiple of `2²⁴`, so the low
 /// 24 bits stay) lets the same arithmetic run on a field that has gone negative.
-///
-/// Never inlined: a copy per call site is never worth 180 bytes, and at opt-level 3 the inlined
-/// copies cost `solve_pnp` 1.2 % more instructions (its Cholesky loop lost its shape).
-#[inline(never)]
 #[must_use]
 pub fn sqrt_f32(x: f32) -> f32 {
     let mut i = x.to_bits();
@@ -322,16 +275,15 @@ pub fn sqrt_f32(x: f32) -> f32 {
 }
 
 /// `x mod 2π` (`x ≥ 0`; non-finite in gives non-finite out) for the rare huge argument: the
-/// exact `fmodf(x, 2π_f32)`, by binary long division on floats instead of `fmodf` itself
-/// (whose integer implementation links about 1.5 KB of 64-bit division into the firmware).
+/// exact `fmodf(x, 2π_f32)`, by binary long division on floats (`libm::fmodf` is an integer
+/// routine that links 64-bit division into the firmware).
 ///
 /// With `d = 2π·2^k` the largest such multiple `≤ x`, each step subtracts `d` when `r ≥ d` and
 /// halves `d`. The invariant `r < 2d` makes every subtraction exact (Sterbenz: `d ≤ r ≤ 2d`),
 /// and halving is exact, so the result is `x − m·2π` exactly, `0 ≤ r < 2π`. At most 128
-/// doublings and 128 halvings (the `f32` exponent range). Kept out of line and cold: the common
-/// path never pays for it.
+/// doublings and 128 halvings (the `f32` exponent range). Cold: the common path never pays for
+/// it.
 #[cold]
-#[inline(never)]
 fn reduce_large(x: f32) -> f32 {
     const TAU: f32 = core::f32::consts::TAU;
     if !x.is_finite() {
@@ -440,7 +392,7 @@ mod tests {
         assert!(worst_rel <= f32::EPSILON as f64, "rel {worst_rel}");
     }
 
-    /// The float long division of `reduce_large` is the exact `fmod` (`%`) it replaces.
+    /// The float long division of `reduce_large` is the exact `fmod` (`%`).
     #[test]
     fn reduce_large_is_exact_fmod() {
         let tau = core::f32::consts::TAU;

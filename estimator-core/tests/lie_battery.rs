@@ -4,11 +4,13 @@
 //! What it checks, at random points (proptest), at the identity, at tangents of size 1e-9…1e-4
 //! and at rotations 1e-6…1e-2 short of π:
 //!
-//! * group laws (associativity, identity, inverse), `vee∘hat`, hat as `Σ τᵢ Gⁱ` (seed eq. 3.2);
+//! * group laws (associativity, identity, inverse), `vee∘hat`, hat as `τ^ = Σ τᵢ Gⁱ` (eq. 3.2 of
+//!   *Lie Groups and Smooth Manifolds for Robotic State Estimation*, "the paper");
 //! * `log∘exp` and `exp∘log`; the adjoint identity `a·exp(τ) = exp(Ad_a τ)·a`;
 //!   `J_r J_r⁻¹ = J_l J_l⁻¹ = I`;
 //! * every `*_jac` Jacobian against central finite differences through `⊕`/`⊖`;
-//! * seed Theorem 5.1: `∂(a·p)/∂a` column `k` equals `(M(a) Gᵏ p̄)` (homogeneous `p̄`);
+//! * the paper's Theorem 5.1, `F = a [H(p) | I]` with `τ^ p̄ = H(p) τ`: `∂(a·p)/∂a` column `k`
+//!   equals `(M(a) Gᵏ p̄)` (homogeneous `p̄`);
 //! * `f32` against `f64` at the same stored numbers, with relative error bounds in `f32` ulps.
 //!
 //! # Tolerances
@@ -112,7 +114,7 @@ fn homogeneous<T: Real, const D: usize, const M: usize>(p: &SVector<T, D>) -> SV
     SVector::<T, M>::from_fn(|i, _| if i < D { p[i] } else { T::one() })
 }
 
-/// `exp(X) = Σ_k X^k/k!` (seed §3), summed to convergence after scaling `X` by `2^-s` so that
+/// `exp(X) = Σ_k X^k/k!` (the paper, §3), summed to convergence after scaling `X` by `2^-s` so that
 /// `‖X‖ ≤ 1/2`, then squared `s` times. Independent of every closed form under test.
 fn matrix_exp_series<const M: usize>(x: &SMatrix<f64, M, M>) -> SMatrix<f64, M, M> {
     let norm = x.norm();
@@ -189,7 +191,7 @@ fn check_algebra<T, G, const N: usize, const D: usize, const M: usize>(
         tol,
         "matrix homomorphism",
     );
-    // hat / vee and the generators (seed eq. 3.2).
+    // hat / vee and the generators (the paper, eq. 3.2: τ^ = Σ τᵢ Gⁱ).
     close(&G::vee(&G::hat(tau)), tau, 0.0, "vee(hat)");
     let mut sum = SMatrix::<T, M, M>::zeros();
     for i in 0..N {
@@ -266,7 +268,7 @@ fn check_algebra<T, G, const N: usize, const D: usize, const M: usize>(
     );
     // normalize moves a unit element by its norm error (≤ 2ε, quadratic in the matrix) only.
     close(&a.normalize().matrix(), &a.matrix(), 8.0 * eps, "normalize");
-    // Independent reference: the matrix exponential as the seed's series (§3), summed in f64
+    // Independent reference: the matrix exponential as the paper's series (§3), summed in f64
     // with scaling and squaring, against the closed form.
     let series = matrix_exp_series(&G::hat(tau).map(|x| x.to_f64()));
     close(
@@ -383,7 +385,7 @@ fn check_jacobians<T, G, const N: usize, const D: usize, const M: usize>(
     let num = numeric_jacobian(|d| a.rminus(&b.rplus(d)) - t, h_log);
     close(&jb, &num, tol_log, "rminus_jac ∂b vs FD");
 
-    // act_jac (seed Theorem 5.1).
+    // act_jac (the paper, Theorem 5.1: F = a [H(p) | I]).
     let (q, ja, jp) = a.act_jac(p);
     // Two valid evaluations (matrix vs quaternion) differ by a few ε per term of R p.
     close(

@@ -1,11 +1,21 @@
-//! Group-specific checks that the generic battery cannot express: the seed's Example 5.2 in
-//! closed form, agreement with nalgebra's own SO(3), quaternion sign and norm handling,
-//! `try_from_matrix` acceptance and rejection, and non-finite inputs.
+//! Group-specific checks that the generic battery cannot express: Example 5.2 of *Lie Groups and
+//! Smooth Manifolds for Robotic State Estimation* ("the paper") in closed form, agreement with
+//! nalgebra's own SO(3), SE(3)'s Jacobian against Barfoot's `Q` written with matrix products,
+//! SO(3)'s `J_l = J_rᵀ`, SE(3)'s adjoint as its block formula, quaternion sign and norm
+//! handling, `try_from_matrix` acceptance, projection and rejection (every branch of Shepperd's
+//! method), and non-finite inputs.
+//!
+//! Tolerances are rounding bounds: `γ_k = kε/(1 − kε)` times the sum of the magnitudes of the
+//! terms (Higham, *Accuracy and Stability of Numerical Algorithms*, §3.1), or a few `ε` times
+//! the size of the result where the computation is a short chain of such sums.
 
-use estimator_core::lie::{skew, LieGroup, Se2, Se3, So2, So3, ORTHOGONALITY_TOLERANCE};
+use estimator_core::lie::{
+    skew, LieGroup, MatrixLieGroup, Se2, Se3, So2, So3, ORTHOGONALITY_TOLERANCE,
+};
+use estimator_core::Real;
 use nalgebra::{
-    Matrix2, Matrix3, Matrix4, Quaternion, Rotation3, UnitQuaternion, Vector1, Vector2, Vector3,
-    Vector6,
+    Matrix2, Matrix3, Matrix4, Matrix6, Quaternion, Rotation3, SMatrix, UnitQuaternion, Vector1,
+    Vector2, Vector3, Vector6,
 };
 
 fn max_abs_diff<const R: usize, const C: usize>(
@@ -15,7 +25,7 @@ fn max_abs_diff<const R: usize, const C: usize>(
     (a - b).amax()
 }
 
-/// Seed Example 5.2: the generators of so(3), `H(p) = Σ_k Gₖ pᵏ = [−p]×`, and
+/// The paper's Example 5.2: the generators of so(3), `H(p) = Σ_k Gₖ pᵏ = [−p]×`, and
 /// `F_(R,p) = R [[−p]× | I]` as returned by `So3::act_jac`.
 #[test]
 fn example_5_2_closed_form() {
@@ -241,4 +251,327 @@ fn renormalize_is_quadratic() {
     let b = So3::<f32>::exp(&Vector3::new(-2.0, 0.1, 0.9));
     let r = a.compose(&b).renormalize();
     assert!((r.quaternion().norm_squared() - 1.0).abs() <= 4.0 * f32::EPSILON);
+}
+
+/// Deterministic numbers in `[-1, 1)` (64-bit LCG).
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((self.0 >> 11) as f64) / ((1u64 << 52) as f64) - 1.0
+    }
+}
+
+/// `γ_k = kε/(1 − kε)`.
+fn gamma(k: f64, eps: f64) -> f64 {
+    k * eps / (1.0 - k * eps)
+}
+
+/// `max |a − b|` over the entries, in `f64`.
+fn max_diff<T: Real, const R: usize, const C: usize>(
+    a: &SMatrix<T, R, C>,
+    b: &SMatrix<f64, R, C>,
+) -> f64 {
+    a.iter()
+        .zip(b.iter())
+        .fold(0.0, |m, (x, y)| m.max((x.to_f64() - y).abs()))
+}
+
+/// `try_from_matrix` recovers a rotation matrix in each of the four branches of Shepperd's
+/// method (the largest of `w, x, y, z` taken by the square root): angles from 0 to π about each
+/// axis and random axes. The quaternion has a relative error of a few `ε` (a square root, one
+/// division by `s ≥ 1`, a normalization), and each entry of its matrix adds `γ₄`: `16ε`.
+/// Matrices within the tolerance are projected onto SO(3) (orthogonal to `8ε`); matrices far
+/// from it are refused.
+fn shepperd_branches<T: Real>() {
+    let eps = T::EPSILON_F64;
+    let mut rng = Lcg(7);
+    let mut branch = [0usize; 4];
+    for i in 0..400 {
+        let axis = match i % 4 {
+            0 => Vector3::x(),
+            1 => Vector3::y(),
+            2 => Vector3::z(),
+            _ => Vector3::new(rng.next(), rng.next(), rng.next()).normalize(),
+        };
+        let angle = core::f64::consts::PI * (1.0 - (f64::from(i) / 400.0).powi(3));
+        let r = *UnitQuaternion::from_scaled_axis(axis * angle)
+            .to_rotation_matrix()
+            .matrix();
+        let m = r.map(T::lit);
+        let back = So3::try_from_matrix(&m).expect("a rotation matrix is accepted");
+        let m64 = m.map(|x| x.to_f64());
+        assert!(max_diff(&back.matrix(), &m64) <= 16.0 * eps, "{i}: {m64}");
+        let q = back.quaternion().coords;
+        let largest = (0..4)
+            .max_by(|&a, &b| q[a].abs().partial_cmp(&q[b].abs()).expect("finite"))
+            .unwrap_or(0);
+        if let Some(n) = branch.get_mut(largest) {
+            *n += 1;
+        }
+        // A perturbation below the tolerance is projected onto the group.
+        let noisy = r.map(|x| T::lit(x + 1e-4 * rng.next()));
+        let p = So3::try_from_matrix(&noisy).expect("1e-4 off is near the group");
+        let pm = p.matrix();
+        let orth = (pm.transpose() * pm).map(|x| x.to_f64());
+        assert!(max_diff(&orth.map(T::lit), &Matrix3::identity()) <= 8.0 * eps);
+        assert!(max_diff(&pm, &r) <= 1e-3);
+        // An arbitrary matrix is far from SO(3) (`‖mᵀm − I‖_F` well above the tolerance).
+        let any = Matrix3::from_fn(|_, _| rng.next());
+        let err = (any.transpose() * any - Matrix3::identity()).norm();
+        if err > 2.0 * ORTHOGONALITY_TOLERANCE {
+            assert!(So3::try_from_matrix(&any.map(T::lit)).is_none(), "{any}");
+        }
+    }
+    // Storage order [x, y, z, w]: every branch was taken.
+    assert!(branch.iter().all(|&n| n > 20), "{branch:?}");
+}
+
+#[test]
+fn try_from_matrix_recovers_rotations_in_every_shepperd_branch() {
+    shepperd_branches::<f32>();
+    shepperd_branches::<f64>();
+}
+
+/// `Σ_k (−1)^k θ^{2k} / (2k + j)!`: the series of `(1 − cos θ)/θ²` (`j = 2`), `(θ − sin θ)/θ³`
+/// (`j = 3`) and `(θ²/2 + cos θ − 1)/θ⁴` (`j = 4`), summed in `f64` to convergence for `θ ≤ π`.
+fn series(theta: f64, j: u32) -> f64 {
+    let x = theta * theta;
+    let mut term = 1.0 / (1..=j).map(f64::from).product::<f64>();
+    let mut sum = 0.0;
+    for k in 0..40 {
+        sum += term;
+        let n = f64::from(2 * k + j);
+        term *= -x / ((n + 1.0) * (n + 2.0));
+    }
+    sum
+}
+
+/// `(2θ − 3 sin θ + θ cos θ)/(2θ⁵) = ½ Σ_{n≥2} (−1)^n (2n − 2) θ^{2n−4}/(2n + 1)!`.
+fn series_g(theta: f64) -> f64 {
+    let x = theta * theta;
+    let mut sum = 0.0;
+    let mut power = 1.0; // θ^{2n−4}
+    let mut fact: f64 = (1..=5).map(f64::from).product(); // (2n + 1)!
+    for n in 2..40 {
+        let sign = if n % 2 == 0 { 1.0 } else { -1.0 };
+        sum += sign * f64::from(2 * n - 2) * power / fact;
+        power *= x;
+        fact *= f64::from((2 * n + 2) * (2 * n + 3));
+    }
+    0.5 * sum
+}
+
+/// `J_r(ξ) = [[J_r(ω), Q(−v, −ω)], [0, J_r(ω)]]` in `f64` with Barfoot's `Q` as printed
+/// (*State Estimation for Robotics*, eq. 7.86, `V = [v]×`, `W = [ω]×`):
+///
+/// ```text
+/// Q(v, ω) = ½V + (θ − sin θ)/θ³ (WV + VW + WVW) + (θ²/2 + cos θ − 1)/θ⁴ (W²V + VW² − 3WVW)
+///         + (2θ − 3 sin θ + θ cos θ)/(2θ⁵) (WVW² + W²VW)
+/// ```
+///
+/// and `J_r(ω) = I − (1 − cos θ)/θ² W + (θ − sin θ)/θ³ W²`. Returns the matrix and the sum of
+/// the magnitudes of its terms (entrywise), the scale of its rounding error.
+fn se3_jr_reference(xi: &Vector6<f64>) -> (Matrix6<f64>, Matrix6<f64>) {
+    let (v, w) = (xi.fixed_rows::<3>(0), xi.fixed_rows::<3>(3));
+    let theta = w.norm();
+    let (b, c, e, g) = (
+        series(theta, 2),
+        series(theta, 3),
+        series(theta, 4),
+        series_g(theta),
+    );
+    let (vm, wm) = (-skew(&v.into_owned()), -skew(&w.into_owned())); // Q(−v, −ω)
+    let (va, wa) = (vm.abs(), wm.abs());
+    let q = vm * 0.5
+        + (wm * vm + vm * wm + wm * vm * wm) * c
+        + (wm * wm * vm + vm * wm * wm - wm * vm * wm * 3.0) * e
+        + (wm * vm * wm * wm + wm * wm * vm * wm) * g;
+    let q_size = va * 0.5
+        + (wa * va + va * wa + wa * va * wa) * c.abs()
+        + (wa * wa * va + va * wa * wa + wa * va * wa * 3.0) * e.abs()
+        + (wa * va * wa * wa + wa * wa * va * wa) * g.abs();
+    let wr = skew(&w.into_owned());
+    let jr = Matrix3::identity() - wr * b + wr * wr * c;
+    let jr_size = Matrix3::identity() + wr.abs() * b + wr.abs() * wr.abs() * c;
+    let block = |d: &Matrix3<f64>, u: &Matrix3<f64>| {
+        let mut m = Matrix6::zeros();
+        m.fixed_view_mut::<3, 3>(0, 0).copy_from(d);
+        m.fixed_view_mut::<3, 3>(0, 3).copy_from(u);
+        m.fixed_view_mut::<3, 3>(3, 3).copy_from(d);
+        m
+    };
+    (block(&jr, &q), block(&jr_size, &q_size))
+}
+
+/// SE(3)'s `J_r(ξ)` and `J_l(ξ) = J_r(−ξ)` (closed-form `Q`, no matrix product) against
+/// [`se3_jr_reference`], at angles from the series range to near π. Each side errs by a few
+/// `γ_k` of the magnitudes of its terms (products of up to four 3×3 matrices, `γ₁₂` each, and
+/// coefficients to a few `ε`): `64ε` times the reference's term sum.
+fn se3_jacobians_against_barfoot<T: Real>() {
+    let eps = T::EPSILON_F64;
+    let mut rng = Lcg(23);
+    for scale in [1e-6, 1e-3, 0.1, 0.5, 1.0, 2.0, 3.1] {
+        for _ in 0..50 {
+            let dir = Vector3::new(rng.next(), rng.next(), rng.next()).normalize();
+            let w = dir * scale;
+            let v = Vector3::new(rng.next(), rng.next(), rng.next()) * 2.0;
+            let xi = Vector6::new(v.x, v.y, v.z, w.x, w.y, w.z).map(T::lit);
+            let xi64 = xi.map(|x| x.to_f64());
+            for (got, at) in [
+                (Se3::right_jacobian(&xi), xi64),
+                (Se3::left_jacobian(&xi), -xi64),
+            ] {
+                let (want, size) = se3_jr_reference(&at);
+                let err = max_diff(&got, &want);
+                let bound = 64.0 * eps * size.amax();
+                assert!(
+                    err <= bound,
+                    "ξ = {at:?}: {err:e} > {bound:e}\n{got}\n{want}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn se3_jacobians_match_barfoot_q_with_matrix_products() {
+    se3_jacobians_against_barfoot::<f32>();
+    se3_jacobians_against_barfoot::<f64>();
+}
+
+/// SO(3): `J_l(ω) = J_r(−ω) = J_r(ω)ᵀ` and `J_l⁻¹(ω) = J_r⁻¹(ω)ᵀ` (`[−ω]× = [ω]×ᵀ`,
+/// `[ω]×²` symmetric), and `rminus_jac`'s second Jacobian `−J_l⁻¹(τ) = −J_r⁻¹(τ)ᵀ`. Both sides
+/// come from the same coefficients; each entry is a sum of three terms (`γ₃` of `‖J‖`).
+fn so3_left_is_transposed_right<T: Real>() {
+    let eps = T::EPSILON_F64;
+    let mut rng = Lcg(37);
+    for scale in [1e-6, 1e-2, 1.0, 3.0, 10.0] {
+        for _ in 0..50 {
+            let w = Vector3::new(rng.next(), rng.next(), rng.next()).map(|x| T::lit(scale * x));
+            let pairs = [
+                (So3::left_jacobian(&w), So3::right_jacobian(&w).transpose()),
+                (
+                    So3::left_jacobian_inv(&w),
+                    So3::right_jacobian_inv(&w).transpose(),
+                ),
+            ];
+            for (l, rt) in pairs {
+                let rt64 = rt.map(|x| x.to_f64());
+                let bound = 2.0 * gamma(3.0, eps) * rt64.amax().max(1.0);
+                assert!(max_diff(&l, &rt64) <= bound, "{w:?}");
+            }
+            let a = So3::exp(&w);
+            let b = So3::exp(&(w * T::lit(-0.4)));
+            let (tau, ja, jb) = a.rminus_jac(&b);
+            let jr_inv = So3::right_jacobian_inv(&tau);
+            let want = (-jr_inv.transpose()).map(|x| x.to_f64());
+            let bound = 2.0 * gamma(3.0, eps) * want.amax().max(1.0);
+            assert!(max_diff(&jb, &want) <= bound);
+            assert!(max_diff(&ja, &jr_inv.map(|x| x.to_f64())) <= bound);
+        }
+    }
+}
+
+#[test]
+fn so3_left_jacobians_are_the_transposed_right_ones() {
+    so3_left_is_transposed_right::<f32>();
+    so3_left_is_transposed_right::<f64>();
+}
+
+/// SE(3)'s adjoint is `[[R, [t]×R], [0, R]]`: against the block formula with nalgebra's
+/// product, entrywise within `2γ₃ (|[t]×|·|R|)` (each entry of `[t]×R` a sum of three
+/// products on either side).
+fn se3_adjoint_blocks<T: Real>() {
+    let eps = T::EPSILON_F64;
+    let mut rng = Lcg(29);
+    for _ in 0..200 {
+        let xi = Vector6::from_fn(|i, _| rng.next() * if i < 3 { 5.0 } else { 3.0 }).map(T::lit);
+        let a = Se3::exp(&xi);
+        let r = a.rotation().matrix().map(|x| x.to_f64());
+        let tx = skew(&a.translation().map(|x| x.to_f64()));
+        let ad = a.adjoint();
+        let upper = tx * r;
+        let bound = (tx.abs() * r.abs()) * (2.0 * gamma(3.0, eps));
+        for i in 0..3 {
+            for j in 0..3 {
+                let got = |r0, c0| ad[(r0 + i, c0 + j)].to_f64();
+                assert_eq!(got(0, 0), r[(i, j)]);
+                assert_eq!(got(3, 3), r[(i, j)]);
+                assert_eq!(got(3, 0), 0.0);
+                assert!((got(0, 3) - upper[(i, j)]).abs() <= bound[(i, j)]);
+            }
+        }
+    }
+}
+
+#[test]
+fn se3_adjoint_is_its_block_formula() {
+    se3_adjoint_blocks::<f32>();
+    se3_adjoint_blocks::<f64>();
+}
+
+/// `∂(a·b)/∂b` and `∂(a⁻¹·b)/∂b` are exactly the identity (the right perturbation of `b`
+/// passes through unchanged).
+fn identity_jacobians<G, const N: usize, const D: usize, const M: usize>(a: &G, b: &G)
+where
+    G: MatrixLieGroup<f64, N, D, M>,
+{
+    let id = SMatrix::<f64, N, N>::identity();
+    assert_eq!(a.compose_jac(b).2, id);
+    assert_eq!(a.between_jac(b).2, id);
+    assert_eq!(a.between_jac(&G::identity()).2, id);
+}
+
+#[test]
+fn jacobians_with_respect_to_b_are_the_identity() {
+    identity_jacobians::<So2<f64>, 1, 2, 2>(&So2::from_angle(0.3), &So2::from_angle(-2.0));
+    identity_jacobians::<Se2<f64>, 3, 2, 3>(&Se2::new(0.5, -2.0, 2.0), &Se2::new(-1.5, 0.25, -2.8));
+    let (a, b) = (
+        So3::exp(&Vector3::new(0.3, -0.2, 1.1)),
+        So3::exp(&Vector3::new(-1.0, 0.4, 0.2)),
+    );
+    identity_jacobians::<So3<f64>, 3, 3, 3>(&a, &b);
+    identity_jacobians::<Se3<f64>, 6, 3, 4>(
+        &Se3::from_parts(a, Vector3::new(1.0, 2.0, -3.0)),
+        &Se3::exp(&Vector6::new(0.1, 2.0, -1.0, 0.4, -2.5, 0.9)),
+    );
+}
+
+/// A NaN or infinite entry anywhere is refused by every `try_from_matrix` (in the rotation block
+/// through the orthogonality error, in the translation by the finiteness test), and `is_finite`
+/// tells a non-finite element from a finite one.
+#[test]
+fn non_finite_entries_are_refused() {
+    let bad = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY];
+    let r2 = So2::from_angle(0.7).matrix();
+    let h2 = Se2::new(1.0, 2.0, 0.3).matrix();
+    let h3 = Se3::exp(&Vector6::new(1.0, 2.0, 3.0, 0.1, 0.2, 0.3)).matrix();
+    for x in bad {
+        for k in 0..4 {
+            let mut m = r2;
+            m[k] = x;
+            assert!(So2::try_from_matrix(&m).is_none(), "{m}");
+        }
+        for k in [(0, 2), (1, 2)] {
+            let mut m = h2;
+            m[k] = x;
+            assert!(Se2::try_from_matrix(&m).is_none(), "{m}");
+        }
+        for k in [(0, 3), (1, 3), (2, 3), (1, 1)] {
+            let mut m = h3;
+            m[k] = x;
+            assert!(Se3::try_from_matrix(&m).is_none(), "{m}");
+        }
+        assert!(!So2::from_angle(x).is_finite());
+        assert!(!Se2::from_parts(So2::from_angle(0.3), Vector2::new(x, 0.0)).is_finite());
+        let r = So3::exp(&Vector3::new(0.1, 0.2, 0.3));
+        assert!(!Se3::from_parts(r, Vector3::new(0.0, x, 0.0)).is_finite());
+    }
+    assert!(So2::from_angle(0.3).is_finite());
+    assert!(Se2::new(1.0, 2.0, 0.3).is_finite());
 }

@@ -37,6 +37,19 @@ pub(crate) fn axpy<T: Real>(y: &Vector3<T>, a: T, x: &Vector3<T>) -> Vector3<T> 
     Vector3::new(y.x + x.x * a, y.y + x.y * a, y.z + x.z * a)
 }
 
+/// `a·[p]×`, the product with the skew-symmetric matrix of `p` (`[p]× x = p × x`): row `i`
+/// is `(aᵢ × p)ᵀ`, `aᵢ` the row `i` of `a`, since `xᵀ[p]× = (x × p)ᵀ`: two products per entry,
+/// the three zeros of `[p]×` never multiplied.
+#[inline(always)]
+#[must_use]
+pub(crate) fn mul_skew<T: Real>(a: &Matrix3<T>, p: &Vector3<T>) -> Matrix3<T> {
+    let row = |x: T, y: T, z: T| (y * p.z - z * p.y, z * p.x - x * p.z, x * p.y - y * p.x);
+    let (a11, a12, a13) = row(a.m11, a.m12, a.m13);
+    let (a21, a22, a23) = row(a.m21, a.m22, a.m23);
+    let (a31, a32, a33) = row(a.m31, a.m32, a.m33);
+    Matrix3::new(a11, a12, a13, a21, a22, a23, a31, a32, a33)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -71,6 +84,23 @@ mod tests {
             let exact = y + x * a;
             // y + x·a is the same two roundings in either form.
             assert_eq!(axpy(&y, a, &x), exact);
+        }
+    }
+
+    /// Each entry is a difference of two products, `|fl − exact| ≤ γ₂ Σ|terms|`; nalgebra's
+    /// product with the skew matrix adds a third, zero product and errs by at most `γ₃` of the
+    /// same sum, so the two differ by at most `2γ₃ (|a|·|[p]×|)` entrywise.
+    #[test]
+    fn mul_skew_agrees_with_the_product_by_the_skew_matrix_within_gamma3() {
+        let mut rng = Lcg(9);
+        let gamma3 = 3.0 * f64::EPSILON / (1.0 - 3.0 * f64::EPSILON);
+        for _ in 0..1000 {
+            let a = Matrix3::from_fn(|_, _| rng.next() * 10.0);
+            let p = Vector3::from_fn(|_, _| rng.next() * 3.0);
+            let skew = Matrix3::new(0.0, -p.z, p.y, p.z, 0.0, -p.x, -p.y, p.x, 0.0);
+            let bound = (a.abs() * skew.abs()) * (2.0 * gamma3);
+            let d = (mul_skew(&a, &p) - a * skew).abs();
+            assert!(d.iter().zip(bound.iter()).all(|(d, b)| d <= b));
         }
     }
 }

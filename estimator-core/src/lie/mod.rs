@@ -1,21 +1,24 @@
 //! Fixed-size matrix Lie groups SO(2), SE(2), SO(3), SE(3) with every Jacobian.
 //!
+//! The mathematics follows *Lie Groups and Smooth Manifolds for Robotic State Estimation*
+//! ("the paper" below); equation, definition and theorem numbers refer to it.
+//!
 //! # Conventions (one, everywhere)
 //!
 //! * **Scalar.** Every type is generic over `T:`[`Real`] and works for `f32` and `f64`.
-//! * **Hat and vee** (seed paper eq. 3.2): `τ^ = Σᵢ τᵢ Gⁱ`, with the generators `Gⁱ = hat(eᵢ)`
+//! * **Hat and vee** (the paper, eq. 3.2): `τ^ = Σᵢ τᵢ Gⁱ`, with the generators `Gⁱ = hat(eᵢ)`
 //!   listed on each group; `vee` is its inverse on the Lie algebra.
-//! * **Exponential** (seed §3): `exp(τ) = Σ_k (τ^)^k / k!`, evaluated in closed form.
-//! * **Right (local) perturbation** (seed eq. 4.5): `a ⊕ τ = a · exp(τ^)` and
+//! * **Exponential** (the paper, §3): `exp(τ^) = Σ_k (τ^)^k / k!`, evaluated in closed form.
+//! * **Right (local) perturbation** (the paper, eq. 4.5): `a ⊕ τ = a · exp(τ^)` and
 //!   `b ⊖ a = log(a⁻¹ · b)`. In code, `a.rplus(&τ)` is `a ⊕ τ` and `b.rminus(&a)` is `b ⊖ a`, so
 //!   `a.rplus(&b.rminus(&a)) == b`.
-//! * **Jacobians** are right Jacobians of that chart (seed Def. 4.6): for `f: G → M`,
-//!   `f(a ⊕ τ) ⊖ f(a) ≈ J τ`, the rows in `M`'s tangent, the columns in `G`'s tangent (for a
-//!   vector-valued `f`, `⊕`/`⊖` are `+`/`−`). Names with `left` are the left-chart ones:
-//!   `J_l(τ) = J_r(−τ)`.
+//! * **Jacobians** are right Jacobians of that chart (the paper, Definition 4.6: `F_a` with
+//!   `f(a·exp(τ^)) ≈ f(a) + F_a τ`): for `f: G → M`, `f(a ⊕ τ) ⊖ f(a) ≈ J τ`, the rows in `M`'s
+//!   tangent, the columns in `G`'s tangent (for a vector-valued `f`, `⊕`/`⊖` are `+`/`−`). Names
+//!   with `left` are the left-chart ones: `J_l(τ) = J_r(−τ)`.
 //! * **Adjoint**: `a · exp(τ) = exp(Ad_a τ) · a`.
-//! * **Tangent order**: SO(2) `θ`; SE(2) `[v_x, v_y, ω]`; SO(3) `ω`; SE(3) `ξ = [v; ω]`, translation
-//!   part first, as the seed's twist `(v, ω)`.
+//! * **Tangent order**: SO(2) `θ`; SE(2) `[v_x, v_y, ω]`; SO(3) `ω`; SE(3) `ξ = [v; ω]`,
+//!   translation part first, as the paper's twist `ξ = (v, ω)` (§3).
 //! * **Quaternions**: Hamilton, `q = w + xi + yj + zk`, written `[w, x, y, z]`; unit norm is
 //!   restored on input, and `w ≥ 0` is not required (`q` and `−q` are the same rotation).
 //! * **Frames**: `a_from_b` maps coordinates in frame `b` into frame `a`; `act` applies that map.
@@ -34,7 +37,7 @@
 //! | `between_jac(b)` | `a⁻¹·b` | `−Ad_{b⁻¹a}`, `I` |
 //! | `rplus_jac(τ)` | `a ⊕ τ` | `Ad_{exp(τ)}⁻¹`, `J_r(τ)` |
 //! | `rminus_jac(b)` | `τ = a ⊖ b` | `J_r⁻¹(τ)`, `−J_l⁻¹(τ)` |
-//! | `act_jac(p)` | `a·p` | `R·[H(p) | I]`-type blocks (seed Theorem 5.1), `R` |
+//! | `act_jac(p)` | `a·p` | `a·[H(p) | I]` (the paper, Theorem 5.1), `R` |
 //!
 //! # Numerics
 //!
@@ -42,6 +45,24 @@
 //! the `trig` kernel); `1 − cos θ` is computed as `2 sin²(θ/2)`; the SO(3) logarithm goes through
 //! the quaternion with `θ = 2·atan2(‖v‖, |w|)`, well conditioned up to and at `θ = π`. Non-finite
 //! inputs propagate as non-finite values (never a panic); [`LieGroup::is_finite`] tells.
+//!
+//! # Example
+//!
+//! ```
+//! use estimator_core::lie::{LieGroup, Se3, So3};
+//! use nalgebra::{Vector3, Vector6};
+//!
+//! // a ⊕ τ = a·exp(τ^), and b ⊖ a = log(a⁻¹·b) undoes it.
+//! let a = So3::exp(&Vector3::new(0.1, -0.4, 0.9));
+//! let tau = Vector3::new(0.02, 0.03, -0.01);
+//! let b = a.rplus(&tau);
+//! assert!((b.rminus(&a) - tau).amax() < 1e-15);
+//!
+//! // The same on SE(3), whose tangent is ξ = [v; ω].
+//! let t = Se3::exp(&Vector6::new(1.0, 2.0, 3.0, 0.1, 0.2, 0.3));
+//! let xi = Vector6::new(0.01, 0.0, -0.02, 0.0, 0.03, 0.0);
+//! assert!((t.rplus(&xi).rminus(&t) - xi).amax() < 1e-15);
+//! ```
 
 mod se2;
 mod se3;
@@ -56,13 +77,47 @@ pub use so3::So3;
 
 pub use crate::scalar::Real;
 
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{Const, DimMin, Matrix3, SMatrix, SVector, Vector3};
 
 /// A matrix Lie group acting on points, with the operations and Jacobians of the module docs.
 ///
 /// Implemented by [`So2`], [`Se2`], [`So3`], [`Se3`]. Generic code that needs arithmetic on the
 /// tangent and Jacobian types uses [`MatrixLieGroup`], which fixes them to nalgebra's fixed-size
 /// matrices.
+///
+/// The default methods implement the Jacobians of the module docs from the group operations, the
+/// adjoint and `J_r`, `J_r⁻¹`; a group overrides one only where it shares work between the value
+/// and its Jacobians (one trigonometric kernel for `exp` and `J_r`, say).
+///
+/// # Example
+///
+/// Generic code over any group: the Jacobian of `a·b` with respect to `a` is `Ad_{b⁻¹}`, checked
+/// here by a central difference through `⊕` and `⊖` (the paper's Definition 4.6).
+///
+/// ```
+/// use estimator_core::lie::{LieGroup, MatrixLieGroup, Se2, So3};
+/// use nalgebra::{SVector, Vector3};
+///
+/// fn check<G: MatrixLieGroup<f64, N, D, M>, const N: usize, const D: usize, const M: usize>(
+///     a: G,
+///     b: G,
+/// ) {
+///     let (ab, ja, jb) = a.compose_jac(&b);
+///     assert_eq!(jb, nalgebra::SMatrix::<f64, N, N>::identity());
+///     let h = 1e-6;
+///     for i in 0..N {
+///         let mut d = SVector::<f64, N>::zeros();
+///         d[i] = h;
+///         let col = (a.rplus(&d).compose(&b).rminus(&ab) - a.rplus(&-d).compose(&b).rminus(&ab))
+///             / (2.0 * h);
+///         assert!((col - ja.column(i)).amax() < 1e-8);
+///     }
+/// }
+///
+/// let (a, b) = (So3::exp(&Vector3::new(0.3, -0.2, 1.0)), So3::exp(&Vector3::new(-1.1, 0.4, 0.2)));
+/// check::<So3<f64>, 3, 3, 3>(a, b);
+/// check::<Se2<f64>, 3, 2, 3>(Se2::new(1.0, -2.0, 0.5), Se2::new(0.3, 0.7, -2.0));
+/// ```
 pub trait LieGroup<T: Real>: Copy + core::fmt::Debug + PartialEq + Sized {
     /// Degrees of freedom: the dimension of the tangent space.
     const DOF: usize;
@@ -90,7 +145,7 @@ pub trait LieGroup<T: Real>: Copy + core::fmt::Debug + PartialEq + Sized {
     #[must_use]
     fn identity() -> Self;
 
-    /// `exp(τ^)`, the exponential map (seed §3).
+    /// `exp(τ^)`, the exponential map (the paper, §3): `exp(τ^) = Σ_k (τ^)^k / k!`.
     #[must_use]
     fn exp(tau: &Self::Tangent) -> Self;
 
@@ -99,7 +154,7 @@ pub trait LieGroup<T: Real>: Copy + core::fmt::Debug + PartialEq + Sized {
     #[must_use]
     fn log(&self) -> Self::Tangent;
 
-    /// `τ^ = Σᵢ τᵢ Gⁱ` (seed eq. 3.2).
+    /// `τ^ = Σᵢ τᵢ Gⁱ` (the paper, eq. 3.2).
     #[must_use]
     fn hat(tau: &Self::Tangent) -> Self::Matrix;
 
@@ -116,7 +171,7 @@ pub trait LieGroup<T: Real>: Copy + core::fmt::Debug + PartialEq + Sized {
     #[must_use]
     fn inverse(&self) -> Self;
 
-    /// The group action `a·p` (seed §5).
+    /// The group action `a·p` (the paper, §5).
     #[must_use]
     fn act(&self, p: &Self::Point) -> Self::Point;
 
@@ -178,21 +233,18 @@ pub trait LieGroup<T: Real>: Copy + core::fmt::Debug + PartialEq + Sized {
 
     /// `a⁻¹·b`.
     #[must_use]
-    #[cfg_attr(estimator_compact, inline(never))]
     fn between(&self, b: &Self) -> Self {
         self.inverse().compose(b)
     }
 
-    /// `a ⊕ τ = a·exp(τ)` (seed eq. 4.5).
+    /// `a ⊕ τ = a·exp(τ^)` (the paper, eq. 4.5).
     #[must_use]
-    #[cfg_attr(estimator_compact, inline(never))]
     fn rplus(&self, tau: &Self::Tangent) -> Self {
         self.compose(&Self::exp(tau))
     }
 
     /// `a ⊖ b = log(b⁻¹·a)`, so that `b ⊕ (a ⊖ b) = a`.
     #[must_use]
-    #[cfg_attr(estimator_compact, inline(never))]
     fn rminus(&self, b: &Self) -> Self::Tangent {
         b.between(self).log()
     }
@@ -212,7 +264,7 @@ pub trait LieGroup<T: Real>: Copy + core::fmt::Debug + PartialEq + Sized {
     /// `(a·b, Ad_b⁻¹ = Ad_{b⁻¹}, I)`.
     #[must_use]
     fn compose_jac(&self, b: &Self) -> (Self, Self::Jacobian, Self::Jacobian) {
-        // Ad_e = I, and it constant-folds.
+        // `I` as `Ad_e` (the trait knows no identity matrix): a constant once compiled.
         (
             self.compose(b),
             b.inverse().adjoint(),
@@ -230,9 +282,8 @@ pub trait LieGroup<T: Real>: Copy + core::fmt::Debug + PartialEq + Sized {
     /// `(a ⊕ τ, Ad_{exp(τ)}⁻¹, J_r(τ))`.
     #[must_use]
     fn rplus_jac(&self, tau: &Self::Tangent) -> (Self, Self::Jacobian, Self::Jacobian) {
-        // Not destructured: `exp_jac`'s pair is read where it was returned (no copy of it).
-        let sj = Self::exp_jac(tau);
-        (self.compose(&sj.0), sj.0.inverse().adjoint(), sj.1)
+        let (e, jr) = Self::exp_jac(tau);
+        (self.compose(&e), e.inverse().adjoint(), jr)
     }
 
     /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))`.
@@ -246,7 +297,8 @@ pub trait LieGroup<T: Real>: Copy + core::fmt::Debug + PartialEq + Sized {
         )
     }
 
-    /// `(a·p, ∂(a·p)/∂a, ∂(a·p)/∂p)`: seed Theorem 5.1, `F = a·[H(p) | I]`.
+    /// `(a·p, ∂(a·p)/∂a, ∂(a·p)/∂p)`: the paper's Theorem 5.1, `F_(a,p) = a·[H(p) | I]` with
+    /// `τ^ p = H(p) τ`.
     #[must_use]
     fn act_jac(&self, p: &Self::Point) -> (Self::Point, Self::ActJacobian, Self::PointJacobian);
 }
@@ -284,9 +336,8 @@ impl<T: Real, G, const N: usize, const D: usize, const M: usize> MatrixLieGroup<
 /// accepts and projects; larger is "not near the group".
 pub const ORTHOGONALITY_TOLERANCE: f64 = 1e-3;
 
-/// `[ω]×`, the skew-symmetric matrix with `[ω]× p = ω × p` (SO(3) hat, seed Example 5.2).
-#[cfg_attr(not(estimator_compact), inline)]
-#[cfg_attr(estimator_compact, inline(never))]
+/// `[ω]×`, the skew-symmetric matrix with `[ω]× p = ω × p`: the SO(3) hat `ω^ = Σᵢ ωᵢ Gⁱ`
+/// (the paper, eq. 3.2, with the generators of Example 5.2).
 #[must_use]
 pub fn skew<T: Real>(w: &Vector3<T>) -> Matrix3<T> {
     let z = T::zero();
@@ -294,13 +345,12 @@ pub fn skew<T: Real>(w: &Vector3<T>) -> Matrix3<T> {
 }
 
 /// `s·I + p[ω]× + q[ω]×²`, the shape of the SO(3) series (`J_r = I − b[ω]× + c[ω]×²`,
-/// `J_r⁻¹ = I + ½[ω]× + d[ω]×²`, see the SO(3) module docs), written out entry by entry with
-/// `[ω]×² = ωωᵀ − ‖ω‖² I` (diagonal `−(ω_y² + ω_z²)` etc., no cancellation): no product of skew
-/// matrices and no 3×3 temporaries.
+/// `J_r⁻¹ = I + ½[ω]× + d[ω]×²`, see the SO(3) module docs), entry by entry with
+/// `[ω]×² = ωωᵀ − ‖ω‖² I` (diagonal `−(ω_y² + ω_z²)` etc., a sum of squares that cannot
+/// cancel).
 ///
-/// The signs are exact: `[−ω]× = −[ω]×` and `[−ω]×² = [ω]×²`, so `J(−ω) = J(ω)ᵀ` is `p → −p`
-/// (the transposed and left Jacobians) and `−J` is `(s, p, q) → (−s, −p, −q)`, each bit for bit
-/// the transposed or negated matrix.
+/// The signs are exact: `[−ω]× = −[ω]×` and `[−ω]×² = [ω]×²`, so the transposed matrix
+/// `J(ω)ᵀ = J(−ω)` is `p → −p`, and `−J` is `(s, p, q) → (−s, −p, −q)`.
 #[must_use]
 pub(crate) fn skew_poly<T: Real>(s: T, p: T, q: T, w: &Vector3<T>) -> Matrix3<T> {
     let (x, y, z) = (w.x, w.y, w.z);
@@ -320,58 +370,16 @@ pub(crate) fn skew_poly<T: Real>(s: T, p: T, q: T, w: &Vector3<T>) -> Matrix3<T>
     )
 }
 
-pub(crate) use crate::scalar::{all_finite, positive_finite};
+pub(crate) use crate::kernels::{all_finite, positive_finite};
 
-/// `m ← −m`, entry by entry: the same bits as `-m`. Out of line under `estimator_compact`: one
-/// short loop shared by every negated Jacobian instead of an unrolled load, negate and store per
-/// entry at each `-jacobian` (at opt-level 3 it inlines and unrolls as `-m` did).
-#[cfg_attr(estimator_compact, inline(never))]
-pub(crate) fn negate<T: Real, const R: usize, const C: usize>(m: &mut SMatrix<T, R, C>) {
-    for x in m.as_mut_slice() {
-        *x = -*x;
-    }
+/// `true` when `m` is within [`ORTHOGONALITY_TOLERANCE`] of SO(N): `‖mᵀm − I‖_F ≤ tol` and
+/// `det m > 0`. `false` for a non-finite entry, whose square makes the error infinite or NaN.
+pub(crate) fn near_rotation<T: Real, const N: usize>(m: &SMatrix<T, N, N>) -> bool
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>>,
+{
+    let err = (m.tr_mul(m) - SMatrix::<T, N, N>::identity()).norm_squared();
+    let tol = T::lit(ORTHOGONALITY_TOLERANCE);
+    // Written so that NaN (which compares false) is rejected too.
+    err <= tol * tol && m.determinant() > T::zero()
 }
-
-/// The `N × N` identity. Out of line under `estimator_compact`: one copy per size instead of a
-/// store per entry at each Jacobian that is `I` (the same matrix either way).
-#[cfg_attr(estimator_compact, inline(never))]
-#[must_use]
-pub(crate) fn eye<T: Real, const N: usize>() -> SMatrix<T, N, N> {
-    SMatrix::identity()
-}
-
-/// `‖MᵀM − I‖²_F`, the orthogonality error of [`LieGroup::try_from_matrix`]: entry `(i, j)` of
-/// `MᵀM` is the dot product of columns `i` and `j`. The same operations in the same order as
-/// `(m.transpose() * m - I).norm_squared()`, without the two `N × N` temporaries.
-#[must_use]
-pub(crate) fn orthogonality_error<T: Real, const N: usize>(m: &SMatrix<T, N, N>) -> T {
-    let mut err = T::zero();
-    for (j, cj) in m.column_iter().enumerate() {
-        let mut col = T::zero();
-        for (i, ci) in m.column_iter().enumerate() {
-            let d = ci.dot(&cj) - if i == j { T::one() } else { T::zero() };
-            col += d * d;
-        }
-        err += col;
-    }
-    err
-}
-
-/// `M ← M[p]×` with `p` by component: each row is replaced by `rᵢ × p` once read (row `i` of
-/// the product depends on row `i` of `M` only): row `i` of `R[p]×` is `rᵢᵀ[p]× = (rᵢ × p)ᵀ`,
-/// with no zero products of a full multiplication by the skew matrix and no 3×3 temporary.
-pub(crate) fn mul_skew_in_place<T: Real>(m: &mut Matrix3<T>, x: T, y: T, z: T) {
-    // Column-major storage: row `i` is entry `i` of each of the three columns. A loop over the
-    // rows (one copy of the body when built for size), no indexing.
-    let (c1, rest) = m.as_mut_slice().split_at_mut(3);
-    let (c2, c3) = rest.split_at_mut(3);
-    for ((a, b), c) in c1.iter_mut().zip(c2.iter_mut()).zip(c3.iter_mut()) {
-        let (ra, rb, rc) = (*a, *b, *c);
-        *a = rb * z - rc * y;
-        *b = rc * x - ra * z;
-        *c = ra * y - rb * x;
-    }
-}
-
-#[cfg(test)]
-mod rewrites;

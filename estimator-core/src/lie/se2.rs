@@ -1,6 +1,8 @@
-//! SE(2), planar rigid motions `T = (R, t)`, the seed's motivating example (§3).
+//! SE(2), planar rigid motions `T = (R, t)`, the motivating example of *Lie Groups and Smooth
+//! Manifolds for Robotic State Estimation* (§3).
 //!
-//! Tangent `τ = [v_x, v_y, ω]`, the seed's 2-D twist; generators give (seed §3)
+//! Tangent `τ = [v_x, v_y, ω]`, the paper's 2-D twist `ξ = (v, ω)`; its hat (§3, and eq. 3.2
+//! `τ^ = Σᵢ τᵢ Gⁱ`) is
 //!
 //! ```text
 //! τ^ = [0 −ω v_x; ω 0 v_y; 0 0 0]
@@ -13,14 +15,27 @@
 //! * `J_r(τ) = [[a, ωb, ωc·v_x − b·v_y], [−ωb, a, b·v_x + ωc·v_y], [0, 0, 1]]`, and
 //!   `J_r⁻¹` by block inversion: `M⁻¹ = [[h, −ω/2], [ω/2, h]]`, last column `−M⁻¹ m`.
 //! * `Ad_T = [[R, (t_y, −t_x)ᵀ], [0, 1]]`.
-//! * `act_jac(p) = (R p + t, [R | R G p], R)` with `G = [0 −1; 1 0]` (seed Theorem 5.1).
+//! * `act_jac(p) = (R p + t, [R | R G p], R)` with `G = [0 −1; 1 0]`: the paper's Theorem 5.1,
+//!   `F = T [H(p) | I]` with `H(p) = [I | G p]`.
 
 use super::so2::So2;
 use super::trig::{half_cot, poly, AngleCoeffs, Cutoff};
-use super::{all_finite, eye, negate, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{all_finite, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
 
 /// A planar rigid motion `T = (R, t) ∈ SE(2)`.
+///
+/// ```
+/// use estimator_core::lie::{LieGroup, Se2};
+/// use nalgebra::{Vector2, Vector3};
+///
+/// // A quarter turn, then one metre along the new x axis: exp of the twist (v, ω) = (π/2, 0, π/2).
+/// let h = core::f64::consts::FRAC_PI_2;
+/// let a = Se2::exp(&Vector3::new(h, 0.0, h));
+/// assert!((a.translation() - Vector2::new(1.0, 1.0)).amax() < 1e-15);
+/// assert!((a.log() - Vector3::new(h, 0.0, h)).amax() < 1e-15);
+/// assert!((a.act(&Vector2::new(1.0, 0.0)) - Vector2::new(1.0, 2.0)).amax() < 1e-15);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Se2<T: Real> {
     rotation: So2<T>,
@@ -65,7 +80,7 @@ impl<T: Real> Se2<T> {
         self.translation
     }
 
-    #[cfg_attr(estimator_compact, inline(never))]
+    /// `exp(τ) = (R(ω), V v)` from the kernel of `ω`.
     fn exp_from(k: &AngleCoeffs<T>, tau: &Vector3<T>) -> Self {
         let w = tau.z;
         let wb = w * k.b;
@@ -77,7 +92,7 @@ impl<T: Real> Se2<T> {
         }
     }
 
-    #[cfg_attr(estimator_compact, inline(never))]
+    /// `J_r(τ)` from the kernel of `ω` (module docs).
     fn jr_from(k: &AngleCoeffs<T>, tau: &Vector3<T>) -> Matrix3<T> {
         let (vx, vy, w) = (tau.x, tau.y, tau.z);
         let wb = w * k.b;
@@ -95,11 +110,13 @@ impl<T: Real> Se2<T> {
         )
     }
 
+    /// `J_r⁻¹(τ)` by block inversion of `J_r = [[M, m], [0, 1]]`: `[[M⁻¹, −M⁻¹ m], [0, 1]]`,
+    /// `M⁻¹ = [[h, −ω/2], [ω/2, h]]`.
     fn jr_inv_from(k: &AngleCoeffs<T>, tau: &Vector3<T>) -> Matrix3<T> {
         let w = tau.z;
         let h = half_cot(k.theta_sq, k.theta, k.sin_half, k.cos_half);
         let hw = T::lit(0.5) * w;
-        // J_r's last column `m` (the same expressions), read from jr_from.
+        // J_r's last column `m`.
         let jr = Self::jr_from(k, tau);
         let (m13, m23) = (jr.m13, jr.m23);
         Matrix3::new(
@@ -169,7 +186,7 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         Vector3::new(m.m13, m.m23, m.m21)
     }
 
-    #[cfg_attr(estimator_compact, inline(never))]
+    /// `(R_a R_b, R_a t_b + t_a)` (the paper, §3).
     fn compose(&self, b: &Self) -> Self {
         Self {
             rotation: self.rotation.compose(&b.rotation),
@@ -177,16 +194,12 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         }
     }
 
-    #[cfg_attr(estimator_compact, inline(never))]
+    /// `(R⁻¹, −R⁻¹ t)`.
     fn inverse(&self) -> Self {
-        // `−(R⁻¹ t)` entry by entry: So2::act of `(cos, −sin)`, each entry negated (no vector
-        // temporary and no `Neg` pass).
         let r_inv = self.rotation.inverse();
-        let (c, ns) = (r_inv.cos(), r_inv.sin());
-        let t = &self.translation;
         Self {
             rotation: r_inv,
-            translation: Vector2::new(-(c * t.x - ns * t.y), -(ns * t.x + c * t.y)),
+            translation: -r_inv.act(&self.translation),
         }
     }
 
@@ -194,7 +207,6 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         self.rotation.act(p) + self.translation
     }
 
-    #[cfg_attr(estimator_compact, inline(never))]
     fn adjoint(&self) -> Matrix3<T> {
         let (c, s) = (self.rotation.cos(), self.rotation.sin());
         let t = &self.translation;
@@ -209,18 +221,6 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         Self::jr_inv_from(&AngleCoeffs::from_theta_sq(tau.z * tau.z), tau)
     }
 
-    /// `J_r(−τ)`, `−τ` entry by entry.
-    fn left_jacobian(tau: &Vector3<T>) -> Matrix3<T> {
-        Self::right_jacobian(&Vector3::new(-tau.x, -tau.y, -tau.z))
-    }
-
-    /// `J_r⁻¹(−τ)`, `−τ` entry by entry. Out of line when built for size (`rminus_jac` calls it
-    /// too).
-    #[cfg_attr(estimator_compact, inline(never))]
-    fn left_jacobian_inv(tau: &Vector3<T>) -> Matrix3<T> {
-        Self::right_jacobian_inv(&Vector3::new(-tau.x, -tau.y, -tau.z))
-    }
-
     fn matrix(&self) -> Matrix3<T> {
         let (c, s) = (self.rotation.cos(), self.rotation.sin());
         let t = &self.translation;
@@ -231,21 +231,17 @@ impl<T: Real> LieGroup<T> for Se2<T> {
         Self::from_parts(self.rotation.normalize(), self.translation)
     }
 
+    /// Accepts `[[R, t], [0, 1]]` with `Σ|bottom row − (0, 0, 1)| ≤` [`ORTHOGONALITY_TOLERANCE`],
+    /// a finite `t`, and `R` accepted by [`So2`]'s `try_from_matrix`.
     fn try_from_matrix(m: &Matrix3<T>) -> Option<Self> {
-        let tol = T::lit(ORTHOGONALITY_TOLERANCE);
-        // `x·0` is `±0` for finite `x` and NaN otherwise (see SE(3)'s `try_from_matrix`): the sum
-        // is NaN exactly when `t` is not finite.
-        let z = T::zero();
-        let finite_t = m.m13 * z + m.m23 * z;
-        let bottom = m.m31.abs() + m.m32.abs() + (m.m33 - T::one()).abs() + finite_t;
+        let t = Vector2::new(m.m13, m.m23);
+        let bottom = m.m31.abs() + m.m32.abs() + (m.m33 - T::one()).abs();
         // Written so that NaN (which compares false) is rejected too.
-        let bottom_ok = bottom <= tol;
-        if !bottom_ok {
+        if !(bottom <= T::lit(ORTHOGONALITY_TOLERANCE) && all_finite(t.as_slice())) {
             return None;
         }
-        // The rotation block entry by entry (`fixed_view(..).into_owned()` is a copy loop).
         let r = So2::try_from_matrix(&Matrix2::new(m.m11, m.m12, m.m21, m.m22))?;
-        Some(Self::from_parts(r, Vector2::new(m.m13, m.m23)))
+        Some(Self::from_parts(r, t))
     }
 
     fn is_finite(&self) -> bool {
@@ -256,36 +252,6 @@ impl<T: Real> LieGroup<T> for Se2<T> {
     fn exp_jac(tau: &Vector3<T>) -> (Self, Matrix3<T>) {
         let k = AngleCoeffs::from_theta_sq(tau.z * tau.z);
         (Self::exp_from(&k, tau), Self::jr_from(&k, tau))
-    }
-
-    /// `(a·b, Ad_{b⁻¹}, I)`, the identity from `eye` (not `Ad_e` built from an identity motion).
-    fn compose_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
-        (self.compose(b), b.inverse().adjoint(), eye())
-    }
-
-    /// `(a⁻¹, −Ad_a)`, negated in place (`negate`).
-    fn inverse_jac(&self) -> (Self, Matrix3<T>) {
-        // Negated where it is returned (no copy of the Jacobian after the negation).
-        let mut out = (self.inverse(), self.adjoint());
-        negate(&mut out.1);
-        out
-    }
-
-    /// `(z = a⁻¹·b, −Ad_{z⁻¹}, I)`, negated in place (`negate`).
-    fn between_jac(&self, b: &Self) -> (Self, Matrix3<T>, Matrix3<T>) {
-        // `z` written where it is returned and read there (no copy of it into the tuple).
-        let mut out = (self.between(b), eye(), eye());
-        out.1 = out.0.inverse().adjoint();
-        negate(&mut out.1);
-        out
-    }
-
-    /// `(τ = a ⊖ b, J_r⁻¹(τ), −J_l⁻¹(τ))`, the last negated in place (`negate`).
-    fn rminus_jac(&self, b: &Self) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {
-        let tau = self.rminus(b);
-        let mut jl = Self::left_jacobian_inv(&tau);
-        negate(&mut jl);
-        (tau, Self::right_jacobian_inv(&tau), jl)
     }
 
     /// `(R p + t, [R | R G p], R)`, `G = [0 −1; 1 0]`.

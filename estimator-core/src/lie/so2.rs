@@ -2,14 +2,24 @@
 //!
 //! Tangent `θ ∈ R¹`; one generator `G¹ = [0 −1; 1 0]`, so `θ^ = θG¹`.
 //! `exp(θ) = (cos θ, sin θ)`, `log = atan2(sin θ, cos θ) ∈ (−π, π]`. The group is commutative:
-//! `Ad = J_r = J_l = 1`. `act_jac(p) = (R p, R G¹ p, R)` (seed Theorem 5.1 with `H(p) = G¹p`).
+//! `Ad = J_r = J_l = 1`. `act_jac(p) = (R p, R G¹ p, R)`: Theorem 5.1 of *Lie Groups and Smooth
+//! Manifolds for Robotic State Estimation*, `F = R [H(p) | I]` with `H(p) = G¹p`.
 
-use super::{
-    all_finite, orthogonality_error, positive_finite, LieGroup, Real, ORTHOGONALITY_TOLERANCE,
-};
+use super::{all_finite, near_rotation, positive_finite, LieGroup, Real};
 use nalgebra::{Matrix1, Matrix2, Matrix2x1, Vector1, Vector2};
 
 /// A planar rotation `R ∈ SO(2)`.
+///
+/// ```
+/// use estimator_core::lie::{LieGroup, So2};
+/// use nalgebra::{Vector1, Vector2};
+///
+/// let r = So2::from_angle(0.5_f64);
+/// let p = r.act(&Vector2::new(1.0, 0.0));
+/// assert!((p - Vector2::new(0.5_f64.cos(), 0.5_f64.sin())).amax() < 1e-15);
+/// // exp and log are the angle; ⊕ adds angles.
+/// assert!((r.rplus(&Vector1::new(0.25)).angle() - 0.75).abs() < 1e-15);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct So2<T: Real> {
     re: T,
@@ -25,9 +35,7 @@ impl<T: Real> So2<T> {
     }
 
     /// From `(cos θ, sin θ)` of any non-zero finite norm (normalized); `None` otherwise.
-    /// Out of line: `normalize` and `try_from_matrix` share it (never on a hot path).
     #[must_use]
-    #[inline(never)]
     pub fn from_cos_sin(re: T, im: T) -> Option<Self> {
         let n2 = re * re + im * im;
         if !positive_finite(n2) {
@@ -41,7 +49,6 @@ impl<T: Real> So2<T> {
     }
 
     /// From `(cos θ, sin θ)` already of unit norm (not checked).
-    #[inline]
     pub(crate) fn from_unit(re: T, im: T) -> Self {
         Self { re, im }
     }
@@ -154,22 +161,13 @@ impl<T: Real> LieGroup<T> for So2<T> {
         self.rotation_matrix()
     }
 
-    #[cfg_attr(estimator_compact, inline(never))]
     fn normalize(&self) -> Self {
         Self::from_cos_sin(self.re, self.im).unwrap_or(*self)
     }
 
     /// The nearest rotation of a 2×2 matrix is `((m₁₁ + m₂₂)/2, (m₂₁ − m₁₂)/2)` normalized.
-    ///
-    /// A non-finite entry makes the orthogonality error infinite or NaN (a sum of squares with
-    /// that entry's square in it), which the tolerance test rejects: no separate finiteness check.
     fn try_from_matrix(m: &Matrix2<T>) -> Option<Self> {
-        let err = orthogonality_error(m);
-        let tol = T::lit(ORTHOGONALITY_TOLERANCE);
-        // Written so that NaN (which compares false) is rejected too.
-        let orthogonal = err <= tol * tol;
-        let proper = m.determinant() > T::zero();
-        if !(orthogonal && proper) {
+        if !near_rotation(m) {
             return None;
         }
         Self::from_cos_sin(m.m11 + m.m22, m.m21 - m.m12)

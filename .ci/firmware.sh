@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Firmware proof for estimator-core (issue 6), called by .ci/run as `bash .ci/firmware.sh`.
+# Firmware proof for estimator-core on a Cortex-M4F, called by .ci/run as `bash .ci/firmware.sh`.
 #
 #  1. installs what it needs (thumbv7em-none-eabihf target, qemu-system-arm, LLVM binutils);
 #  2. notes whether the committed stream (src/stream.rs, cut from host-sim datasets) is what
@@ -13,7 +13,8 @@
 #  6. instruction counts, peak stack, size_of and flash against firmware/budgets.txt (opt-level 3)
 #     and firmware/budgets-s.txt (the stack at opt-level "s").
 #
-# FIRMWARE_STRICT=1 enforces the issue's targets and ignores the allowances in budgets.txt.
+# FIRMWARE_STRICT=1 enforces the targets (not the ceilings) and ignores the allowances in
+# budgets.txt.
 set -euo pipefail
 cd "$(dirname "$0")/../firmware"
 FW=$PWD

@@ -8,7 +8,7 @@ DEMO_OUT: the demo's semihosting output (`bench <i> <name> stack=<bytes>`, `size
 ICOUNT_OUT: the plugin's output (`icount <i> <instructions>`); window 0 is the empty one, whose
 count (the marker overhead) is subtracted from the others.
 EXTRA: files of `name value` lines (flash sizes measured by the script).
-FIRMWARE_STRICT=1: enforce the issue's targets instead of the ceilings; no allowances.
+FIRMWARE_STRICT=1: enforce the targets, not the ceilings; no allowances.
 """
 import os
 import re

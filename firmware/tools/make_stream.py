@@ -3,8 +3,9 @@
 
   make_stream.py INS_DATASET AHRS_DATASET CAMERA_DATASET > src/stream.rs
 
-Each argument is a folder in the EuRoC layout written by `host-sim simulate` (CONTRACT.md,
-"Dataset folder"); `tools/make_stream.sh` makes the three and calls this script. What it takes:
+Each argument is a folder in the EuRoC layout written by `host-sim simulate` (the layout is in
+the rustdoc of `host_sim::dataset`); `tools/make_stream.sh` makes the three and calls this
+script. What it takes:
 
 * INS (15 states): IMU, magnetometer and GNSS samples of WINDOW_S seconds from START_S, with the
   ground truth at both ends and the sensors' parameters (IMU noise densities, the magnetometer's

@@ -8,7 +8,7 @@
 //! * [`metrics`]: streaming scores against ground truth; [`stats`]: chi-square quantiles.
 //! * [`plot`]: the PNG plots.
 //! * [`montecarlo`]: consistency over seeds against chi-square bands.
-//! * [`replay`]: the filter over a dataset folder, with every output of the contract.
+//! * [`replay`]: the filter over a dataset folder, with its outputs (trajectories, metrics, plots).
 #![warn(missing_docs)]
 
 pub mod baseline;

@@ -215,7 +215,8 @@ fn check_outcome(c: &mut Checker, o: &scenario::Outcome<f32>) {
     let r = &expected::EXPECTED_F64;
     let h = &expected::EXPECTED_F32_HOST;
     c.equal("no error returned", o.failure, 0);
-    // Against the f64 reference: tolerances of the f32 arithmetic (README, "Tolerances").
+    // Against the f64 reference: tolerances of the f32 arithmetic (README, "The demo and its
+    // checks").
     c.close("so3 exp vs f64", &o.so3_exp, &r.so3_exp, 1e-6);
     c.close("so3 log vs f64", &o.so3_log, &r.so3_log, 1e-5);
     c.close("se3 log vs f64", &o.se3_log, &r.se3_log, 1e-5);

@@ -1,4 +1,15 @@
-//! The command line (see the contract's `host-sim` table).
+//! The command line:
+//!
+//! | command | does |
+//! |---|---|
+//! | `host-sim [run] [--scenario NAME] [--seed N] [--out DIR]` | simulate, filter, score, plot; prints a summary table (default: the `default` scenario into `out/`) |
+//! | `host-sim simulate --scenario NAME [--seed N] --out DIR` | write a dataset folder with ground truth ([`crate::dataset`]) |
+//! | `host-sim replay DATASET [--out DIR] [--config FILE]` | run the filter over a dataset folder, with or without ground truth |
+//! | `host-sim montecarlo --scenario NAME --runs N` | consistency over seeds: NEES / NIS against chi-square bands |
+//! | `host-sim scenarios` | list the built-in scenarios |
+//!
+//! Exit status 0 on success; bad input (a missing file, a malformed row, time going backwards)
+//! gives a one-line error naming the file and the line, and a non-zero exit status.
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;

@@ -1,5 +1,24 @@
-//! Dataset folders in the EuRoC / ASL layout (see the contract): writing a simulated one, and
-//! reading any one as a time-ordered stream of sensor events with constant memory.
+//! Dataset folders in the EuRoC / ASL layout: writing a simulated one, and reading any one as a
+//! time-ordered stream of sensor events with constant memory.
+//!
+//! Times are integer nanoseconds (64 bits; they may start anywhere, as EuRoC's near 1.4e18).
+//!
+//! | file | columns |
+//! |---|---|
+//! | `imu0/data.csv` | `#timestamp [ns]`, gyroscope `w_RS_S_x/y/z [rad s^-1]`, accelerometer `a_RS_S_x/y/z [m s^-2]` (body frame) |
+//! | `imu0/sensor.yaml` | `rate_hz`, `gyroscope_noise_density`, `gyroscope_random_walk`, `accelerometer_noise_density`, `accelerometer_random_walk` (continuous time, Kalibr units) |
+//! | `mag0/data.csv` | `#timestamp [ns]`, `m_x/y/z [uT]` (body frame) |
+//! | `mag0/sensor.yaml` | `rate_hz`, `sigma` (white noise per sample and axis, µT), `reference_field` (`[x, y, z]`, world frame, µT) |
+//! | `gnss0/data.csv` | `#timestamp [ns]`, `p_x/y/z [m]`, `v_x/y/z [m s^-1]` (world frame), `sigma_p [m]`, `sigma_v [m s^-1]` |
+//! | `gnss0/sensor.yaml` | optional: `lever_arm` (`[x, y, z]`, body frame, m; zero when absent) |
+//! | `baro0/data.csv`, `baro0/sensor.yaml` | `#timestamp [ns]`, `altitude [m]`; `sigma` (m) |
+//! | `cam0/sensor.yaml` | `intrinsics: [fu, fv, cu, cv]`, `resolution: [w, h]`, `T_BS` (body from camera, 4×4 row-major `data:` list as in EuRoC), `sigma_px` |
+//! | `cam0/landmarks.csv` | `id`, `x/y/z [m]` (world frame) |
+//! | `cam0/observations.csv` | `#timestamp [ns]`, `id`, `u [px]`, `v [px]` |
+//! | `state_groundtruth_estimate0/data.csv` | EuRoC ground truth: timestamp, `p_RS_R` xyz, `q_RS` w x y z, `v_RS_R` xyz, `b_w_RS_S` xyz, `b_a_RS_S` xyz |
+//!
+//! Every sensor folder but `imu0` is optional; files and keys the layout does not name are
+//! ignored.
 //!
 //! Errors name the file and the line, in one line: `imu0/data.csv:17: expected 7 columns, got 6`.
 

@@ -1,5 +1,12 @@
-//! `host-sim replay`: runs the error-state filter over a dataset folder and writes the outputs of
-//! the contract (`estimate.tum`, `estimate.csv`, `groundtruth.tum`, `metrics.json`, plots).
+//! `host-sim replay`: runs the error-state filter over a dataset folder and writes its outputs:
+//!
+//! | file | content |
+//! |---|---|
+//! | `estimate.tum` | TUM trajectory, `timestamp[s] tx ty tz qx qy qz qw` |
+//! | `estimate.csv` | the full state and the 1-σ of each error-state component, with a header |
+//! | `groundtruth.tum` | the truth in TUM format, where the dataset has it |
+//! | `metrics.json` | where the truth exists: RMSEs, NEES, NIS and update counts per sensor, time per IMU sample |
+//! | `*.png` | trajectory, per-axis errors inside their ±3σ bands, biases, NIS |
 //!
 //! The filter configures itself from the dataset's `sensor.yaml` files and starts itself from the
 //! data: it averages the first `align_window_s` of IMU (and magnetometer) samples, at rest, for
@@ -630,7 +637,7 @@ fn replay_in<T: Real>(
     Ok(scorer)
 }
 
-/// The outputs of the contract. They are written as `NAME.partial` and renamed together at the
+/// The file outputs (the plots aside). They are written as `NAME.partial` and renamed together at the
 /// end; on any error (the guard drops uncommitted) the partial files are removed, so a failed
 /// run never leaves outputs that look complete.
 const OUTPUTS: [&str; 4] = [

@@ -3,10 +3,12 @@
 //!
 //! With `body_from_camera = T_BS` and the true `world_from_body`, a landmark `p_w` is at
 //! `x = (T_wb T_BS)⁻¹ p_w` in the camera frame and is seen at `z = K π(x) + σ n`,
-//! `π(x, y, z) = (x/z, y/z)` (the seed's `z_ij = π(T_i p_j)`), when `z > 0.1 m` and the pixel is
-//! inside the image. An outlier replaces the pixel by a uniform one. Defaults: a 752×480 global
-//! shutter camera like EuRoC's cam0 (fu = fv = 458, cu = 367, cv = 248), looking forward along
-//! the body x axis, 10 Hz, 1 px noise.
+//! `π(x, y, z) = (x/z, y/z)`, when `z > 0.1 m` and the pixel is inside the image: the landmark
+//! measurement `z_ij = h(T_i, p_j) = π(T_i p_j)` of *Lie Groups and Smooth Manifolds for Robotic
+//! State Estimation* (§4), with `T_i = (T_wb T_BS)⁻¹` (camera from world), then the intrinsics
+//! `K`. An outlier replaces the pixel by a uniform one. Defaults: a 752×480 global shutter camera
+//! like EuRoC's cam0 (fu = fv = 458, cu = 367, cv = 248), looking forward along the body x axis,
+//! 10 Hz, 1 px noise.
 
 use super::Noise;
 use crate::trajectory::Kinematics;

@@ -2,23 +2,28 @@
 //!
 //! * [`lie`]: the fixed-size Lie groups SO(2), SE(2), SO(3), SE(3) with every Jacobian, generic
 //!   over `f32` and `f64`, following one convention (right perturbation `a ⊕ τ = a·exp(τ^)`,
-//!   seed paper eq. 4.5). Its module docs state the conventions.
+//!   eq. 4.5 of the paper below). Its module docs state the conventions.
 //! * [`eskf`]: the on-manifold error-state Kalman filter, 15-state inertial ([`eskf::Ins`]) and
 //!   attitude-only ([`eskf::Ahrs`]), with gated Joseph and iterated updates and typed outcomes.
 //! * [`gn`]: a fixed-size Gauss-Newton / Levenberg-Marquardt solver on manifolds with robust
 //!   losses, and on top of it [`gn::solve_pnp`], triangulation and rotation from vector pairs.
 //! * [`scalar`]: the [`Real`] scalar trait, with an all-`f32` sine/cosine for Cortex-M4F.
+//! * `kernels` (private): the hand-written small-matrix routines the modules above call, each
+//!   with its reference test.
 //!
 //! Nothing allocates and nothing panics: every entry point that takes outside data returns a
 //! `Result` with a typed error.
 //!
-//! Built for size (opt-level `"s"` or `"z"`, or the `compact` feature), a few kernels are
-//! compiled once and called instead of being inlined at every use: the same source and the same
-//! results, only the inlining differs (`build.rs` sets `cfg(estimator_compact)`). Opt-level 2 and
-//! 3 keep the specialised, faster copies.
+//! The mathematics follows *Lie Groups and Smooth Manifolds for Robotic State Estimation*;
+//! equation numbers in the docs refer to it, and each equation is restated where it is used.
 //!
-//! The mathematics follows the seed paper on Lie groups for state estimation; equation numbers in
-//! the docs refer to it.
+//! The crate re-exports the [`nalgebra`] it is built with, so a user's matrices are always of
+//! the same version: `use estimator_core::nalgebra::Vector3;`.
+//!
+//! Where things go: a new measurement model is one file in `eskf/models/` (plus its Jacobian
+//! test in `tests/eskf_jacobians.rs`), a new Lie group one file in `lie/` (plus its entry in the
+//! battery of `tests/lie_battery.rs`), a new kernel one file in `kernels/` with its reference
+//! test.
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -28,7 +33,12 @@ pub mod gn;
 mod kernels;
 pub mod lie;
 pub mod scalar;
+// The unit tests share the integration tests' support module (and need `std` for it).
 #[cfg(test)]
+extern crate std;
+#[cfg(test)]
+#[path = "../tests/support/mod.rs"]
 mod test_support;
 
+pub use nalgebra;
 pub use scalar::Real;

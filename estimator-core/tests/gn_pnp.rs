@@ -15,6 +15,7 @@
 //!   the check uses `1e-7` relative to `max(1, max|J|)`.
 
 mod gn_util;
+mod support;
 
 use estimator_core::gn::{
     check_point_spread, reprojection_error, solve_pnp, Loss, Method, PinholeCamera, PnpOptions,
@@ -566,9 +567,10 @@ fn error_point_behind_camera() {
         solve_pnp(&w, &c.pixels, &camera(), &c.truth, &PnpOptions::default()).unwrap_err(),
         SolveError::PointBehindCamera
     );
-    // A landmark exactly at depth min_depth is behind.
+    // A landmark at depth min_depth is behind. The round trip through the pose moves the depth
+    // by a few ulps of the pose's scale (≈ 1e-15 m), so it is placed 1e-12 m inside.
     let mut w = c.world.clone();
-    w[2] = c.truth.inverse().act(&Vector3::new(0.0, 0.0, 1e-3));
+    w[2] = c.truth.inverse().act(&Vector3::new(0.0, 0.0, 1e-3 - 1e-12));
     assert_eq!(
         solve_pnp(&w, &c.pixels, &camera(), &c.truth, &PnpOptions::default()).unwrap_err(),
         SolveError::PointBehindCamera

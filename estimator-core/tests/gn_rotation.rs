@@ -5,6 +5,7 @@
 //! NEES tolerances as in `gn_triangulation.rs` (3 degrees of freedom).
 
 mod gn_util;
+mod support;
 
 use estimator_core::gn::{
     solve_rotation_from_vectors, vector_pair_error, Loss, SolveError, SolverOptions, VectorPair,

@@ -3,6 +3,7 @@
 //! Levenberg-Marquardt, and every error path of `solve`.
 
 mod gn_util;
+mod support;
 
 use estimator_core::gn::{
     solve, Factor, Loss, Manifold, Method, Product, ResidualBlock, SolveError, SolverOptions,

@@ -5,6 +5,7 @@
 //! at most `max(2, 0.005 M)` trials above the χ²(3) 99.9 % quantile 16.27.
 
 mod gn_util;
+mod support;
 
 use estimator_core::gn::{
     point_reprojection_error, triangulate, Loss, PinholeCamera, SolveError, TriangulationOptions,
@@ -56,10 +57,6 @@ fn tri_case(rng: &mut Rng, n: usize, sigma: f64) -> TriCase {
     }
 }
 
-fn nees3(d: &Vector3<f64>, cov: &Matrix3<f64>) -> f64 {
-    (d.transpose() * cov.try_inverse().unwrap() * d)[(0, 0)]
-}
-
 /// `∂e/∂p` against Richardson central differences (`h = 1e-4` m; tolerance `1e-7` relative).
 #[test]
 fn point_jacobian_matches_finite_differences() {
@@ -99,7 +96,7 @@ fn recovers_the_landmark_within_its_covariance_f32_f64() {
                     ..TriangulationOptions::default()
                 };
                 let s = triangulate(&c.poses, &c.pixels, &camera(), &o).unwrap();
-                n64.push(nees3(&(s.point - c.point), &s.covariance));
+                n64.push(support::nees(&(s.point - c.point), &s.covariance));
                 let poses32: Vec<Se3<f32>> = c.poses.iter().map(|p| p.cast()).collect();
                 let o32 = TriangulationOptions {
                     sigma_px: sigma as f32,
@@ -107,7 +104,7 @@ fn recovers_the_landmark_within_its_covariance_f32_f64() {
                 };
                 let s = triangulate(&poses32, &cast_v2(&c.pixels), &cam32, &o32).unwrap();
                 let d = s.point.cast::<f64>() - c.point;
-                n32.push(nees3(&d, &s.covariance.cast()));
+                n32.push(support::nees(&d, &s.covariance.cast()));
             }
         }
     }
@@ -139,7 +136,7 @@ fn cauchy_rejects_outlying_views() {
             ..TriangulationOptions::default()
         };
         let s = triangulate(&c.poses, &c.pixels, &camera(), &o).unwrap();
-        assert!(nees3(&(s.point - c.point), &s.covariance) <= CHI2_3_999);
+        assert!(support::nees(&(s.point - c.point), &s.covariance) <= CHI2_3_999);
         let p = triangulate(
             &c.poses,
             &c.pixels,
@@ -147,7 +144,7 @@ fn cauchy_rejects_outlying_views() {
             &TriangulationOptions::default(),
         )
         .unwrap();
-        if nees3(&(p.point - c.point), &p.covariance) > CHI2_3_999 {
+        if support::nees(&(p.point - c.point), &p.covariance) > CHI2_3_999 {
             plain_bad += 1;
         }
     }

@@ -21,10 +21,12 @@
 //! the Jacobian; nothing is tuned to the observed error. Values (`exp`, `log`, products) are
 //! compared to a few `ε` times the size of the quantity and the condition of the operation.
 
+mod support;
 use estimator_core::lie::{MatrixLieGroup, Se2, Se3, So2, So3};
 use estimator_core::Real;
 use nalgebra::{SMatrix, SVector};
 use proptest::prelude::*;
+use support::fd_jacobian;
 
 // ---------------------------------------------------------------------------------------------
 // Helpers
@@ -65,24 +67,6 @@ fn close<T: Real, const R: usize, const C: usize>(
 /// of two or three group operations behind each `f` carry a few `ε` each, hence the factor 8.
 fn fd_tol(eps: f64, scale: f64, h: f64) -> f64 {
     8.0 * eps * scale / h
-}
-
-/// Richardson-extrapolated central difference of a map `R^N → R^K`.
-fn numeric_jacobian<T: Real, const N: usize, const K: usize>(
-    f: impl Fn(&SVector<T, N>) -> SVector<T, K>,
-    h: f64,
-) -> SMatrix<T, K, N> {
-    let mut j = SMatrix::<T, K, N>::zeros();
-    for i in 0..N {
-        let d = |step: f64| {
-            let mut e = SVector::<T, N>::zeros();
-            e[i] = T::lit(step);
-            (f(&e) - f(&-e)) / T::lit(2.0 * step)
-        };
-        let col = (d(0.5 * h) * T::lit(4.0) - d(h)) / T::lit(3.0);
-        j.set_column(i, &col);
-    }
-    j
 }
 
 /// Which tangent coordinates are angles, for building rotations of a chosen size.
@@ -327,16 +311,16 @@ fn check_jacobians<T, G, const N: usize, const D: usize, const M: usize>(
         4.0 * eps,
         "exp_jac = right_jacobian",
     );
-    let num = numeric_jacobian(|d| G::exp(&(tau + d)).rminus(&e), h);
+    let num = fd_jacobian(|d| G::exp(&(tau + d)).rminus(&e), h);
     close(&jr, &num, tol, "exp_jac vs FD");
     // Left Jacobian: exp(τ + δ) ≈ exp(J_l δ)·exp(τ).
-    let num = numeric_jacobian(|d| G::exp(&(tau + d)).compose(&e.inverse()).log(), h);
+    let num = fd_jacobian(|d| G::exp(&(tau + d)).compose(&e.inverse()).log(), h);
     close(&G::left_jacobian(tau), &num, tol, "left_jacobian vs FD");
 
     // log_jac: log(a ⊕ δ) − log(a) ≈ J_r⁻¹(log a) δ.
     let (l, jl) = a.log_jac();
     close(&l, &a.log(), 4.0 * eps, "log_jac value");
-    let num = numeric_jacobian(|d| a.rplus(d).log() - l, h_log);
+    let num = fd_jacobian(|d| a.rplus(d).log() - l, h_log);
     close(&jl, &num, tol_log, "log_jac vs FD");
     close(
         &jl,
@@ -347,7 +331,7 @@ fn check_jacobians<T, G, const N: usize, const D: usize, const M: usize>(
 
     // inverse_jac.
     let (inv, j) = a.inverse_jac();
-    let num = numeric_jacobian(|d| a.rplus(d).inverse().rminus(&inv), h);
+    let num = fd_jacobian(|d| a.rplus(d).inverse().rminus(&inv), h);
     close(&j, &num, tol, "inverse_jac vs FD");
 
     // compose_jac.
@@ -358,31 +342,31 @@ fn check_jacobians<T, G, const N: usize, const D: usize, const M: usize>(
         0.0,
         "compose_jac value",
     );
-    let num = numeric_jacobian(|d| a.rplus(d).compose(b).rminus(&ab), h);
+    let num = fd_jacobian(|d| a.rplus(d).compose(b).rminus(&ab), h);
     close(&ja, &num, tol, "compose_jac ∂a vs FD");
-    let num = numeric_jacobian(|d| a.compose(&b.rplus(d)).rminus(&ab), h);
+    let num = fd_jacobian(|d| a.compose(&b.rplus(d)).rminus(&ab), h);
     close(&jb, &num, tol, "compose_jac ∂b vs FD");
 
     // between_jac.
     let (z, ja, jb) = a.between_jac(b);
-    let num = numeric_jacobian(|d| a.rplus(d).between(b).rminus(&z), h);
+    let num = fd_jacobian(|d| a.rplus(d).between(b).rminus(&z), h);
     close(&ja, &num, tol, "between_jac ∂a vs FD");
-    let num = numeric_jacobian(|d| a.between(&b.rplus(d)).rminus(&z), h);
+    let num = fd_jacobian(|d| a.between(&b.rplus(d)).rminus(&z), h);
     close(&jb, &num, tol, "between_jac ∂b vs FD");
 
     // rplus_jac.
     let (x, ja, jt) = a.rplus_jac(tau);
-    let num = numeric_jacobian(|d| a.rplus(d).rplus(tau).rminus(&x), h);
+    let num = fd_jacobian(|d| a.rplus(d).rplus(tau).rminus(&x), h);
     close(&ja, &num, tol, "rplus_jac ∂a vs FD");
-    let num = numeric_jacobian(|d| a.rplus(&(tau + d)).rminus(&x), h);
+    let num = fd_jacobian(|d| a.rplus(&(tau + d)).rminus(&x), h);
     close(&jt, &num, tol, "rplus_jac ∂τ vs FD");
 
     // rminus_jac: τ = a ⊖ b.
     let (t, ja, jb) = a.rminus_jac(b);
     close(&t, &a.rminus(b), 4.0 * eps, "rminus_jac value");
-    let num = numeric_jacobian(|d| a.rplus(d).rminus(b) - t, h_log);
+    let num = fd_jacobian(|d| a.rplus(d).rminus(b) - t, h_log);
     close(&ja, &num, tol_log, "rminus_jac ∂a vs FD");
-    let num = numeric_jacobian(|d| a.rminus(&b.rplus(d)) - t, h_log);
+    let num = fd_jacobian(|d| a.rminus(&b.rplus(d)) - t, h_log);
     close(&jb, &num, tol_log, "rminus_jac ∂b vs FD");
 
     // act_jac (the paper, Theorem 5.1: F = a [H(p) | I]).
@@ -394,9 +378,9 @@ fn check_jacobians<T, G, const N: usize, const D: usize, const M: usize>(
         8.0 * eps * (1.0 + p.lp_norm(1).to_f64()),
         "act_jac value",
     );
-    let num = numeric_jacobian(|d| a.rplus(d).act(p) - q, h);
+    let num = fd_jacobian(|d| a.rplus(d).act(p) - q, h);
     close(&ja, &num, tol, "act_jac ∂a vs FD");
-    let num = numeric_jacobian(|d| a.act(&(p + d)) - q, h);
+    let num = fd_jacobian(|d| a.act(&(p + d)) - q, h);
     close(&jp, &num, tol, "act_jac ∂p vs FD");
     // Theorem 5.1 literally: column k of ∂(a·p)/∂a is M(a)·Gᵏ·p̄, and ∂/∂p is the rotation block.
     let m = a.matrix();

@@ -20,7 +20,6 @@ use crate::Real;
 use nalgebra::{SMatrix, SVector};
 
 /// Re-exported for `eskf::update`, which imports the dot product and the substitution from here.
-pub(crate) use crate::kernels::{cholesky::solve_in_place as substitute, slice::dot};
 
 /// Multiple of `N · ε` below which a relative pivot `dᵢ / Aᵢᵢ` counts as zero.
 pub const PIVOT_TOLERANCE_EPS: f64 = 16.0;

@@ -54,7 +54,7 @@ pub(crate) fn symmetrize<T: Real>(a: &mut [T], n: usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_support::Lcg;
+    use crate::test_support::Rng;
     use nalgebra::{DMatrix, DVector};
 
     fn gamma(k: usize) -> f64 {
@@ -65,14 +65,14 @@ mod tests {
     /// `|fl(xᵀy) − xᵀy| ≤ γ_n Σ|xᵢ yᵢ|` (Higham §3.1), against nalgebra's `dot`.
     #[test]
     fn dot_axpy_distance_agree_with_nalgebra_within_gamma_n() {
-        let mut rng = Lcg(3);
+        let mut rng = Rng::new(3);
         for n in 1..20 {
-            let x = DVector::from_fn(n, |_, _| rng.next() * 5.0);
-            let y = DVector::from_fn(n, |_, _| rng.next() * 5.0);
+            let x = DVector::from_fn(n, |_, _| rng.range(-1.0, 1.0) * 5.0);
+            let y = DVector::from_fn(n, |_, _| rng.range(-1.0, 1.0) * 5.0);
             let s: f64 = x.iter().zip(y.iter()).map(|(a, b)| (a * b).abs()).sum();
             assert!((dot(x.as_slice(), y.as_slice()) - x.dot(&y)).abs() <= 2.0 * gamma(n) * s);
 
-            let a = rng.next();
+            let a = rng.range(-1.0, 1.0);
             let mut z = y.clone();
             axpy(z.as_mut_slice(), a, x.as_slice());
             assert_eq!(z, &y + &x * a); // one product and one sum per entry, either way
@@ -85,9 +85,9 @@ mod tests {
 
     #[test]
     fn symmetrize_gives_the_symmetric_part() {
-        let mut rng = Lcg(4);
+        let mut rng = Rng::new(4);
         for n in 1..8 {
-            let m = DMatrix::from_fn(n, n, |_, _| rng.next());
+            let m = DMatrix::from_fn(n, n, |_, _| rng.range(-1.0, 1.0));
             let mut s = m.clone();
             symmetrize(s.as_mut_slice(), n);
             assert_eq!(s, s.transpose());

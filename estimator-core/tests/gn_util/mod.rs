@@ -1,50 +1,26 @@
-//! Shared helpers of the `gn_*` tests: a deterministic PRNG (splitmix64 + Box-Muller), random
-//! rotations and synthetic PnP problems, Richardson finite differences.
+//! Shared helpers of the `gn_*` tests: random rotations and synthetic PnP problems, on the
+//! shared `support` module (random stream, finite differences).
 #![allow(dead_code)]
 
 use estimator_core::gn::PinholeCamera;
 use estimator_core::lie::{LieGroup, Se3, So3};
-use nalgebra::{SMatrix, SVector, Vector2, Vector3, Vector6};
+use nalgebra::{SMatrix, Vector2, Vector3, Vector6};
 
-/// splitmix64 with Box-Muller normals.
-pub struct Rng(u64);
+pub use crate::support::{fd_jacobian, Rng};
 
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Self(seed ^ 0x9E37_79B9_7F4A_7C15)
-    }
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    pub fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    pub fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.uniform()
-    }
-    pub fn normal(&mut self) -> f64 {
-        let u1 = self.uniform().max(1e-300);
-        let u2 = self.uniform();
-        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-    }
-    pub fn unit3(&mut self) -> Vector3<f64> {
-        loop {
-            let v = Vector3::new(self.normal(), self.normal(), self.normal());
-            let n = v.norm();
-            if n > 1e-6 {
-                return v / n;
-            }
-        }
-    }
-    pub fn rotation(&mut self) -> So3<f64> {
+/// Random rotations and poses on the shared stream.
+pub trait RngExt {
+    /// A rotation of uniformly distributed axis and angle in `[0, π)`.
+    fn rotation(&mut self) -> So3<f64>;
+    /// A pose: such a rotation, and a translation of `N(0, 2² I)`.
+    fn pose(&mut self) -> Se3<f64>;
+}
+
+impl RngExt for Rng {
+    fn rotation(&mut self) -> So3<f64> {
         So3::exp(&(self.unit3() * self.range(0.0, std::f64::consts::PI)))
     }
-    pub fn pose(&mut self) -> Se3<f64> {
+    fn pose(&mut self) -> Se3<f64> {
         let t = Vector3::new(self.normal(), self.normal(), self.normal()) * 2.0;
         Se3::from_parts(self.rotation(), t)
     }
@@ -130,28 +106,8 @@ pub fn pose_error(a: &Se3<f64>, b: &Se3<f64>) -> (f64, f64) {
     (d, (a.translation() - b.translation()).norm())
 }
 
-/// Richardson-extrapolated central difference of `f` at `ξ = 0`, column by column:
-/// `D = (4 D(h/2) − D(h))/3`, truncation `O(h⁴)`.
-pub fn fd_jacobian<const K: usize, const N: usize>(
-    f: impl Fn(&SVector<f64, N>) -> SVector<f64, K>,
-    h: f64,
-) -> SMatrix<f64, K, N> {
-    let mut j = SMatrix::<f64, K, N>::zeros();
-    for c in 0..N {
-        let d = |h: f64| {
-            let mut e = SVector::<f64, N>::zeros();
-            e[c] = h;
-            (f(&e) - f(&-e)) / (2.0 * h)
-        };
-        let col = (d(h * 0.5) * 4.0 - d(h)) / 3.0;
-        j.set_column(c, &col);
-    }
-    j
-}
-
 /// `δ = b ⊖ a` for SE(3) and the NEES `δᵀ P⁻¹ δ`.
 pub fn nees(est: &Se3<f64>, truth: &Se3<f64>, cov: &SMatrix<f64, 6, 6>) -> f64 {
     let d: Vector6<f64> = truth.rminus(est);
-    let inv = cov.try_inverse().expect("covariance invertible");
-    (d.transpose() * inv * d)[(0, 0)]
+    crate::support::nees(&d, cov)
 }

@@ -6,7 +6,7 @@
 //! generators, synthetic PnP problems) live beside it and build on this module.
 #![allow(dead_code)] // every test binary uses a different part
 
-use nalgebra::{SMatrix, SVector, Vector3};
+use nalgebra::{RealField, SMatrix, SVector, Vector3};
 
 /// xorshift64* (Vigna, 2016) with Box–Muller normals: deterministic, seedable, and enough for
 /// test data (not for cryptography).
@@ -49,7 +49,7 @@ impl Rng {
         }
         let (u1, u2) = (self.uniform(), self.uniform());
         let r = (-2.0 * u1.ln()).sqrt();
-        let t = std::f64::consts::TAU * u2;
+        let t = core::f64::consts::TAU * u2;
         self.spare = Some(r * t.sin());
         r * t.cos()
     }
@@ -79,18 +79,19 @@ impl Rng {
 
 /// The Jacobian of `f` at `ξ = 0` by Richardson-extrapolated central differences, column by
 /// column: `D(h) = (f(h e_c) − f(−h e_c))/2h`, `J ≈ (4 D(h/2) − D(h))/3` (truncation `O(h⁴)`).
-pub fn fd_jacobian<const K: usize, const N: usize>(
-    f: impl Fn(&SVector<f64, N>) -> SVector<f64, K>,
+pub fn fd_jacobian<T: RealField + Copy, const K: usize, const N: usize>(
+    f: impl Fn(&SVector<T, N>) -> SVector<T, K>,
     h: f64,
-) -> SMatrix<f64, K, N> {
-    let mut j = SMatrix::<f64, K, N>::zeros();
+) -> SMatrix<T, K, N> {
+    let lit = |x: f64| -> T { nalgebra::convert(x) };
+    let mut j = SMatrix::<T, K, N>::zeros();
     for c in 0..N {
         let d = |h: f64| {
-            let mut e = SVector::<f64, N>::zeros();
-            e[c] = h;
-            (f(&e) - f(&-e)) / (2.0 * h)
+            let mut e = SVector::<T, N>::zeros();
+            e[c] = lit(h);
+            (f(&e) - f(&-e)) / lit(2.0 * h)
         };
-        j.set_column(c, &((d(h * 0.5) * 4.0 - d(h)) / 3.0));
+        j.set_column(c, &((d(h * 0.5) * lit(4.0) - d(h)) / lit(3.0)));
     }
     j
 }

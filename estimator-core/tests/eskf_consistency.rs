@@ -11,6 +11,7 @@ mod eskf_common;
 mod support;
 
 use eskf_common::*;
+use support::{chi2_quantile, nees};
 use estimator_core::eskf::*;
 use estimator_core::lie::LieGroup;
 use nalgebra::{SMatrix, SVector, Vector3};

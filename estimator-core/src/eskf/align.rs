@@ -11,7 +11,7 @@
 
 use super::config::FilterConfig;
 use super::error::EskfError;
-use crate::kernels::{all_finite, mat3};
+use crate::kernels::{all_finite, mat3, positive_finite};
 use crate::lie::So3;
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
@@ -179,7 +179,7 @@ pub(crate) fn prior_attitude_covariance<T: Real>(
     config: &FilterConfig<T>,
 ) -> Result<Matrix3<T>, EskfError> {
     let gn = config.gravity.norm();
-    if !(gn > T::zero()) {
+    if !positive_finite(gn) {
         return Err(EskfError::ZeroNorm);
     }
     let up = -config.gravity / gn;

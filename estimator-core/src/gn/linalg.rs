@@ -19,8 +19,6 @@ use crate::kernels::cholesky::{factor_in_place, inverse_into, solve_in_place};
 use crate::Real;
 use nalgebra::{SMatrix, SVector};
 
-/// Re-exported for `eskf::update`, which imports the dot product and the substitution from here.
-
 /// Multiple of `N · ε` below which a relative pivot `dᵢ / Aᵢᵢ` counts as zero.
 pub const PIVOT_TOLERANCE_EPS: f64 = 16.0;
 

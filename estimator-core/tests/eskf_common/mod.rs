@@ -6,7 +6,7 @@ use estimator_core::eskf::{ImuNoise, ImuSample, InsState};
 use estimator_core::lie::{LieGroup, So3};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
-pub use crate::support::{chi2_quantile, nees, Rng};
+pub use crate::support::Rng;
 
 pub const G: f64 = 9.81;
 

@@ -85,7 +85,9 @@ impl<T: Real> CameraLandmark<T> {
             .rotation()
             .inverse()
             .act(&(q - self.body_from_camera.translation()));
-        if !(c.z > self.min_depth) {
+        // False for a NaN depth too.
+        let in_front = c.z > self.min_depth;
+        if !in_front {
             return Err(EskfError::BehindCamera);
         }
         let k = &self.intrinsics;

@@ -49,7 +49,9 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for H
         let r = x.attitude().rotation_matrix();
         let (cx, cy) = (r.m11, r.m21);
         let n2 = cx * cx + cy * cy;
-        if !(n2 > T::lit(1e-6)) {
+        // False for NaN too.
+        let away_from_vertical = n2 > T::lit(1e-6);
+        if !away_from_vertical {
             return Err(EskfError::SingularGeometry);
         }
         let mut jacobian = SMatrix::<T, 1, N>::zeros();

@@ -89,9 +89,6 @@ pub(crate) fn predict_ins<T: Real>(
         fx: skew(&f),
         dt,
     };
-    let f_finite = [fr.f00, fr.f03, fr.b, fr.fx]
-        .iter()
-        .all(|m| all_finite(m.as_slice()));
     // Two passes of one kernel, `FRows::apply` (F's block rows θ, v, p applied to a 15 × 3
     // block column):
     // * t = 0..5, F P: block column j = t of P gives M_ij = (F P)_ij, i = 0..2, stored as
@@ -120,11 +117,12 @@ pub(crate) fn predict_ins<T: Real>(
             }
         }
     }
-    // F and P are finite, so N = F P Fᵀ can only fail by overflow, and for a positive
-    // semi-definite N, |N_ij| ≤ √(N_ii N_jj): a finite diagonal bounds every entry. The
-    // diagonal of N is the diagonal of L's top 9 × 9.
+    // P is finite (an invariant of the filter), so N = F P Fᵀ is finite exactly when its
+    // diagonal is: a non-finite entry of row i of F makes N_ii = Σ_kl F_ik P_kl F_il infinite
+    // or NaN, and for a positive semi-definite N, |N_ij| ≤ √(N_ii N_jj) bounds every other
+    // entry. The diagonal of N is the diagonal of L's top 9 × 9.
     let diagonal_finite = (0..9).all(|k| l.get((k, k)).is_some_and(|d| d.is_finite()));
-    if !(f_finite && new_x.is_finite() && diagonal_finite) {
+    if !(diagonal_finite && new_x.is_finite()) {
         return Err(EskfError::NonFinite);
     }
     // The lower blocks N_ki (k ≥ i, i < 3) and their transposes; P_33, P_34, P_44 are
@@ -182,7 +180,10 @@ pub(crate) fn predict_ahrs<T: Real>(
         n.m11, n.m12, n.m13, n.m12, n.m22, n.m23, n.m13, n.m23, n.m33,
     );
     let attitude = x.attitude.compose(&dr).renormalize();
-    if !(all_finite(n00.as_slice()) && all_finite(m01.as_slice()) && attitude.is_finite()) {
+    // As in the 15-state prediction: a non-finite F or an overflow shows on the diagonal of
+    // N00, which bounds M01 through the positive semi-definite P⁺.
+    let diagonal_finite = (0..3).all(|k| n00.get((k, k)).is_some_and(|d| d.is_finite()));
+    if !(diagonal_finite && attitude.is_finite()) {
         return Err(EskfError::NonFinite);
     }
     set_block(p, 0, 0, &n00);

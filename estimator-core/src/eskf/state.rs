@@ -5,7 +5,7 @@ use super::error::EskfError;
 use crate::kernels::all_finite;
 use crate::lie::{LieGroup, So3};
 use crate::Real;
-use nalgebra::{SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3x4, SMatrix, SVector, Vector3};
 
 /// A nominal state with an `N`-dimensional error state whose first three components are the
 /// right attitude error `δθ` (`R = R̂·exp(δθ^)`, the right `⊕` of *Lie Groups and Smooth
@@ -117,11 +117,14 @@ impl<T: Real> ErrorState<T, 15> for InsState<T> {
     }
 
     fn is_finite(&self) -> bool {
-        self.attitude.is_finite()
-            && all_finite(self.velocity.as_slice())
-            && all_finite(self.position.as_slice())
-            && all_finite(self.gyro_bias.as_slice())
-            && all_finite(self.accel_bias.as_slice())
+        // The four vectors side by side: one check.
+        let vectors = Matrix3x4::from_columns(&[
+            self.velocity,
+            self.position,
+            self.gyro_bias,
+            self.accel_bias,
+        ]);
+        self.attitude.is_finite() && all_finite(vectors.as_slice())
     }
 
     fn attitude(&self) -> &So3<T> {

@@ -8,7 +8,6 @@ use crate::Real;
 use nalgebra::{Matrix3, SMatrix};
 
 /// Block `(i, j)` of `m` (zero outside the matrix).
-#[inline(always)]
 #[must_use]
 pub(crate) fn block<T: Real, const R: usize, const C: usize>(
     m: &SMatrix<T, R, C>,
@@ -19,7 +18,6 @@ pub(crate) fn block<T: Real, const R: usize, const C: usize>(
 }
 
 /// Block `(i, j)` of the column-major matrix with `rows` rows stored in `s` (zero outside it).
-#[inline(always)]
 #[must_use]
 pub(crate) fn block_in<T: Real>(s: &[T], rows: usize, i: usize, j: usize) -> Matrix3<T> {
     let mut out = Matrix3::zeros();
@@ -36,7 +34,6 @@ pub(crate) fn block_in<T: Real>(s: &[T], rows: usize, i: usize, j: usize) -> Mat
 }
 
 /// Writes `v` into block `(i, j)` of `m` (nothing outside the matrix).
-#[inline(always)]
 pub(crate) fn set_block<T: Real, const R: usize, const C: usize>(
     m: &mut SMatrix<T, R, C>,
     i: usize,
@@ -56,7 +53,6 @@ pub(crate) fn set_block<T: Real, const R: usize, const C: usize>(
 
 /// Adds `s·I` to block `(i, j)` of the square `m`, and to block `(j, i)` when `i ≠ j` (a
 /// symmetric update of a covariance).
-#[inline(always)]
 pub(crate) fn add_scaled_identity<T: Real, const N: usize>(
     m: &mut SMatrix<T, N, N>,
     i: usize,

@@ -2,30 +2,33 @@
 
 use crate::Real;
 
-/// `true` when every element of `s` is finite: `Σ xᵢ·0 = 0`.
+/// `true` when every element of `s` is finite: `Σ xᵢ·0 = 0`. One out-of-line copy for every
+/// length.
 ///
 /// `x·0` is `±0` for a finite `x` and NaN for `±∞` or NaN (IEEE 754-2008 §7.2: `0·∞` is an
 /// invalid operation); NaN propagates through the sum and `−0 = +0` in the comparison. Two
 /// floating-point instructions per element and no branch, over the contiguous storage.
-#[inline(always)]
+#[inline(never)]
 #[must_use]
 pub(crate) fn all_finite<T: Real>(s: &[T]) -> bool {
     let z = T::zero();
     s.iter().fold(z, |acc, x| acc + *x * z) == z
 }
 
-/// `0 < x < ∞` (false for NaN): the test of a positive-definite pivot or a norm.
+/// `0 < x < ∞` (false for NaN): the test of a positive-definite pivot or a norm. Two
+/// floating-point comparisons: `x > 0`, and `x·0 = 0`, which is false for `∞` and NaN (see
+/// [`all_finite`]).
 #[inline(always)]
 #[must_use]
 pub(crate) fn positive_finite<T: Real>(x: T) -> bool {
-    x.is_finite() && x > T::zero()
+    x > T::zero() && x * T::zero() == T::zero()
 }
 
-/// `0 ≤ x < ∞` (false for NaN).
+/// `0 ≤ x < ∞` (false for NaN), as [`positive_finite`].
 #[inline(always)]
 #[must_use]
 pub(crate) fn non_negative_finite<T: Real>(x: T) -> bool {
-    x >= T::zero() && x.is_finite()
+    x >= T::zero() && x * T::zero() == T::zero()
 }
 
 #[cfg(test)]

@@ -8,7 +8,6 @@ use crate::Real;
 use nalgebra::{Matrix3, Vector3};
 
 /// `a·b`: `(ab)_ij = a_i1 b_1j + a_i2 b_2j + a_i3 b_3j`.
-#[inline(always)]
 #[must_use]
 pub(crate) fn mul<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
     let column = |x: T, y: T, z: T| mul_vec(a, &Vector3::new(x, y, z));
@@ -20,7 +19,6 @@ pub(crate) fn mul<T: Real>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
 }
 
 /// `a·v`: `(av)_i = a_i1 v_1 + a_i2 v_2 + a_i3 v_3`.
-#[inline(always)]
 #[must_use]
 pub(crate) fn mul_vec<T: Real>(a: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
     Vector3::new(
@@ -31,7 +29,6 @@ pub(crate) fn mul_vec<T: Real>(a: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
 }
 
 /// `y + a·x` for 3-vectors.
-#[inline(always)]
 #[must_use]
 pub(crate) fn axpy<T: Real>(y: &Vector3<T>, a: T, x: &Vector3<T>) -> Vector3<T> {
     Vector3::new(y.x + x.x * a, y.y + x.y * a, y.z + x.z * a)
@@ -40,7 +37,6 @@ pub(crate) fn axpy<T: Real>(y: &Vector3<T>, a: T, x: &Vector3<T>) -> Vector3<T> 
 /// `a·[p]×`, the product with the skew-symmetric matrix of `p` (`[p]× x = p × x`): row `i`
 /// is `(aᵢ × p)ᵀ`, `aᵢ` the row `i` of `a`, since `xᵀ[p]× = (x × p)ᵀ`: two products per entry,
 /// the three zeros of `[p]×` never multiplied.
-#[inline(always)]
 #[must_use]
 pub(crate) fn mul_skew<T: Real>(a: &Matrix3<T>, p: &Vector3<T>) -> Matrix3<T> {
     let row = |x: T, y: T, z: T| (y * p.z - z * p.y, z * p.x - x * p.z, x * p.y - y * p.x);

@@ -3,14 +3,12 @@
 use crate::Real;
 
 /// `Σ xᵢ yᵢ` over the common length, from zero, left to right.
-#[inline(always)]
 #[must_use]
 pub(crate) fn dot<T: Real>(x: &[T], y: &[T]) -> T {
     x.iter().zip(y).fold(T::zero(), |acc, (&p, &q)| acc + p * q)
 }
 
 /// `y ← y + a·x` over the common length.
-#[inline(always)]
 pub(crate) fn axpy<T: Real>(y: &mut [T], a: T, x: &[T]) {
     for (y, &x) in y.iter_mut().zip(x) {
         *y += a * x;
@@ -18,7 +16,6 @@ pub(crate) fn axpy<T: Real>(y: &mut [T], a: T, x: &[T]) {
 }
 
 /// `‖a − b‖₂` over the common length.
-#[inline(always)]
 #[must_use]
 pub(crate) fn distance<T: Real>(a: &[T], b: &[T]) -> T {
     a.iter()
@@ -32,7 +29,6 @@ pub(crate) fn distance<T: Real>(a: &[T], b: &[T]) -> T {
 
 /// `A ← (A + Aᵀ)/2` for the column-major `n × n` storage `a`: both `a_ij` and `a_ji` get
 /// `(a_ij + a_ji)·½` (the sum commutes, so the result is exactly symmetric).
-#[inline(always)]
 pub(crate) fn symmetrize<T: Real>(a: &mut [T], n: usize) {
     let half = T::lit(0.5);
     for c in 0..n {
@@ -46,6 +42,29 @@ pub(crate) fn symmetrize<T: Real>(a: &mut [T], n: usize) {
             }
             if let Some(v) = a.get_mut(r * n + c) {
                 *v = s;
+            }
+        }
+    }
+}
+
+/// `dst ← srcᵀ`, `dst_vec ← src_vec`: the column-major `rows × cols` matrix in `src`
+/// (`rows = src_vec.len()`, `cols = src.len() / rows`) written transposed into the column-major
+/// storage `dst` with `cols` rows, and the vector `src_vec` copied into `dst_vec`; the rest of
+/// `dst` and `dst_vec` is set to zero (a measurement's `H` and residual into a padded working
+/// set).
+#[inline(never)]
+pub(crate) fn transpose_into<T: Real>(src: &[T], src_vec: &[T], dst: &mut [T], dst_vec: &mut [T]) {
+    dst_vec.fill(T::zero());
+    for (d, s) in dst_vec.iter_mut().zip(src_vec) {
+        *d = *s;
+    }
+    let rows = src_vec.len().max(1);
+    let cols = src.len() / rows;
+    dst.fill(T::zero());
+    for (j, col) in src.chunks_exact(rows).enumerate() {
+        for (i, v) in col.iter().enumerate() {
+            if let Some(e) = dst.get_mut(i * cols + j) {
+                *e = *v;
             }
         }
     }
@@ -81,6 +100,16 @@ mod tests {
             let bound = 2.0 * gamma(n + 2) * d;
             assert!((distance(x.as_slice(), y.as_slice()) - d).abs() <= bound);
         }
+    }
+
+    #[test]
+    fn transpose_into_is_the_transpose_padded_with_zeros() {
+        let m = nalgebra::Matrix2x3::new(1.0, 2.0, 3.0, 4.0, 5.0, 6.0);
+        let (mut out, mut v) = ([9.0; 9], [9.0; 3]);
+        transpose_into(m.as_slice(), &[7.0, 8.0], &mut out, &mut v);
+        assert_eq!(&out[..6], m.transpose().as_slice());
+        assert_eq!(&out[6..], &[0.0; 3]);
+        assert_eq!(v, [7.0, 8.0, 0.0]);
     }
 
     #[test]

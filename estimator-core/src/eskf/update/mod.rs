@@ -30,6 +30,7 @@ pub(crate) mod gate;
 
 use super::error::{EskfError, UpdateOutcome};
 use super::state::ErrorState;
+use crate::kernels::slice::transpose_into;
 use crate::kernels::{all_finite, mat3};
 use crate::lie::{LieGroup, So3};
 use crate::Real;
@@ -142,21 +143,19 @@ where
     Mo: Measurement<T, S, N, M>,
 {
     fn linearize_rows(&self, x: &S, w: &mut Work<T, N, C>) -> Result<(), EskfError> {
-        let lin = self.0.linearize(x)?;
-        w.ht.fill(T::zero());
-        w.r.fill(T::zero());
-        // Column j of H (M entries) becomes row j of Hᵀ: entry (c, j) of H at c·N + j.
-        let ht = w.ht.as_mut_slice();
-        for (j, h_col) in lin.jacobian.as_slice().chunks_exact(M.max(1)).enumerate() {
-            for (c, v) in h_col.iter().enumerate() {
-                if let Some(e) = ht.get_mut(c * N + j) {
-                    *e = *v;
-                }
-            }
-        }
-        for (d, s) in w.r.iter_mut().zip(lin.residual.iter()) {
-            *d = *s;
-        }
+        // Read in place: the linearization is not moved out of its `Result` (one copy of it on
+        // the stack, on the update's deepest path).
+        let lin = self.0.linearize(x);
+        let lin = match &lin {
+            Ok(lin) => lin,
+            Err(e) => return Err(*e),
+        };
+        transpose_into(
+            lin.jacobian.as_slice(),
+            lin.residual.as_slice(),
+            w.ht.as_mut_slice(),
+            w.r.as_mut_slice(),
+        );
         Ok(())
     }
 }

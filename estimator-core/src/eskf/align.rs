@@ -8,6 +8,9 @@
 //! * `R` is the rotation taking the body triad `(u_b, h_b, u_b × h_b)` onto the world triad
 //!   `(u, h_w, u × h_w)`: `R = W Bᵀ`.
 //! * Initial gyro bias: the mean angular rate `ω̄` (the body does not rotate).
+//!
+//! Results carrying vectors are matched, not propagated with `?`: on a Cortex-M4F the `?` of a
+//! `Result<Vector3<f32>, _>` copies the value through an unaligned `memcpy`.
 
 use super::config::FilterConfig;
 use super::error::EskfError;
@@ -88,7 +91,10 @@ pub fn align_at_rest<T: Real>(
     mag: Option<&MagnetometerWindow<'_, T>>,
     rest_tolerance: T,
 ) -> Result<Alignment<T>, EskfError> {
-    let (f, w) = (mean(accel)?, mean(gyro)?);
+    let (f, w) = match (mean(accel), mean(gyro)) {
+        (Ok(f), Ok(w)) => (f, w),
+        (Err(e), _) | (_, Err(e)) => return Err(e),
+    };
     if !(all_finite(gravity.as_slice()) && rest_tolerance.is_finite()) {
         return Err(EskfError::NonFinite);
     }
@@ -103,7 +109,10 @@ pub fn align_at_rest<T: Real>(
     let uw = -gravity / ng;
     let pair = match mag {
         Some(m) => {
-            let mb = mean(m.samples)?;
+            let mb = match mean(m.samples) {
+                Ok(mb) => mb,
+                Err(e) => return Err(e),
+            };
             if !all_finite(m.reference.as_slice()) {
                 return Err(EskfError::NonFinite);
             }
@@ -117,8 +126,10 @@ pub fn align_at_rest<T: Real>(
     // R = W Bᵀ, W = [u_w, h_w, u_w × h_w], B = [u_b, h_b, u_b × h_b] (columns).
     let w_triad = triad(&uw, &hw);
     let b_triad = triad(&ub, &hb);
-    let attitude = So3::from_rotation_matrix(&mat3::mul(&w_triad, &b_triad.transpose()))
-        .ok_or(EskfError::NonFinite)?;
+    let Some(attitude) = So3::from_rotation_matrix(&mat3::mul(&w_triad, &b_triad.transpose()))
+    else {
+        return Err(EskfError::NonFinite);
+    };
     Ok(Alignment {
         attitude,
         gyro_bias: w,

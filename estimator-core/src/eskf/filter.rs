@@ -162,12 +162,10 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
             accel_bias: Vector3::zeros(),
         };
         let mut p = SMatrix::<T, 15, 15>::zeros();
-        set_block(
-            &mut p,
-            0,
-            0,
-            &prior_attitude_covariance(alignment, sigmas, &config)?,
-        );
+        match prior_attitude_covariance(alignment, sigmas, &config) {
+            Ok(attitude) => set_block(&mut p, 0, 0, &attitude),
+            Err(e) => return Err(e),
+        }
         let sq = |s: T| s * s;
         add_scaled_identity(&mut p, 1, 1, sq(sigmas.velocity));
         add_scaled_identity(&mut p, 2, 2, sq(sigmas.position));
@@ -189,12 +187,10 @@ impl<T: Real> Filter<T, AhrsState<T>, 6> {
     ) -> Result<Self, EskfError> {
         config.validate()?;
         let mut p = SMatrix::<T, 6, 6>::zeros();
-        set_block(
-            &mut p,
-            0,
-            0,
-            &prior_attitude_covariance(alignment, sigmas, &config)?,
-        );
+        match prior_attitude_covariance(alignment, sigmas, &config) {
+            Ok(attitude) => set_block(&mut p, 0, 0, &attitude),
+            Err(e) => return Err(e),
+        }
         add_scaled_identity(&mut p, 1, 1, sigmas.gyro_bias * sigmas.gyro_bias);
         let state = AhrsState {
             attitude: alignment.attitude,

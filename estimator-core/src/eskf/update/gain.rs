@@ -11,6 +11,7 @@ use nalgebra::SVector;
 
 /// `U = P H̃ᵀ`, `S = H̃ U + R`, `S⁻¹`, `K = U S⁻¹` into `w`, for the `n × n` covariance `p`
 /// (column-major), over the `m` active columns of the working set only.
+#[inline(never)]
 fn gain_into<T: Real, const N: usize, const C: usize>(
     p: &[T],
     w: &mut Work<T, N, C>,
@@ -96,6 +97,7 @@ fn mat_vec<T: Real>(a: &[T], x: &[T], out: &mut [T]) {
 /// One Gauss-Newton step after a re-linearization: the gain there, then
 /// `δx_{k+1} = K_k (r_k + H̃_k δx_k)` into `w.dx`. `None` (with `U`, `S`, `K` and `δx` as they
 /// were) when the gain or the step failed, else whether `‖δx_{k+1} − δx_k‖ < tol`.
+#[inline(never)]
 pub(super) fn step<T: Real, const N: usize, const C: usize>(
     p: &[T],
     opts: &UpdateOptions<T>,

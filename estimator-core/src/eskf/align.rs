@@ -58,8 +58,8 @@ fn mean<T: Real>(xs: &[Vector3<T>]) -> Result<Vector3<T>, EskfError> {
 /// The unit vector along the part of `v` orthogonal to the unit `u`, if any.
 fn horizontal<T: Real>(v: &Vector3<T>, u: &Vector3<T>) -> Option<Vector3<T>> {
     let h = mat3::axpy(v, -u.dot(v), u);
-    let n = h.norm();
-    if n > T::lit(1e-6) * v.norm() && n > T::zero() {
+    let n = mat3::norm(&h);
+    if n > T::lit(1e-6) * mat3::norm(v) && n > T::zero() {
         Some(h / n)
     } else {
         None
@@ -98,7 +98,7 @@ pub fn align_at_rest<T: Real>(
     if !(all_finite(gravity.as_slice()) && rest_tolerance.is_finite()) {
         return Err(EskfError::NonFinite);
     }
-    let (nf, ng) = (f.norm(), gravity.norm());
+    let (nf, ng) = (mat3::norm(&f), mat3::norm(gravity));
     if !(nf > T::zero() && ng > T::zero()) {
         return Err(EskfError::ZeroNorm);
     }
@@ -189,7 +189,7 @@ pub(crate) fn prior_attitude_covariance<T: Real>(
     sigmas: &InitialSigmas<T>,
     config: &FilterConfig<T>,
 ) -> Result<Matrix3<T>, EskfError> {
-    let gn = config.gravity.norm();
+    let gn = mat3::norm(&config.gravity);
     if !positive_finite(gn) {
         return Err(EskfError::ZeroNorm);
     }

@@ -11,18 +11,19 @@ use nalgebra::{SMatrix, SVector};
 /// `A` is finite, symmetric to `10⁻⁶` of its largest entry, and positive definite (its Cholesky
 /// factor exists).
 pub(crate) fn is_spd<T: Real, const M: usize>(a: &SMatrix<T, M, M>) -> bool {
-    if !all_finite(a.as_slice()) {
+    let mut l = *a;
+    is_symmetric(a.as_slice(), M) && factor_in_place(l.as_mut_slice(), M, T::zero())
+}
+
+/// The column-major `n × n` storage `a` is finite and symmetric to `10⁻⁶` of its largest entry
+/// (one compiled copy for every size).
+fn is_symmetric<T: Real>(a: &[T], n: usize) -> bool {
+    if a.len() != n * n || !all_finite(a) {
         return false;
     }
-    let tol = a.amax() * T::lit(1e-6);
-    let symmetric = (0..M).all(|j| {
-        (j + 1..M).all(|i| match (a.get((i, j)), a.get((j, i))) {
-            (Some(x), Some(y)) => (*x - *y).abs() <= tol,
-            _ => false,
-        })
-    });
-    let mut l = *a;
-    symmetric && factor_in_place(l.as_mut_slice(), M, T::zero())
+    let tol = a.iter().fold(T::zero(), |m, x| m.max(x.abs())) * T::lit(1e-6);
+    let at = |k: usize| a.get(k).copied().unwrap_or_else(T::zero);
+    (0..n).all(|j| (j + 1..n).all(|i| (at(j * n + i) - at(i * n + j)).abs() <= tol))
 }
 
 /// The checks every filter constructor makes on a given start: a valid configuration, a finite

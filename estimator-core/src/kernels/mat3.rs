@@ -28,6 +28,14 @@ pub(crate) fn mul_vec<T: Real>(a: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
     )
 }
 
+/// `‖v‖ = √(v·v)` through the crate's correctly rounded square root ([`Real::sqrt_rn`]);
+/// nalgebra's `norm` would link `libm`'s table-driven `sqrtf` into a Cortex-M4F firmware.
+#[inline(always)]
+#[must_use]
+pub(crate) fn norm<T: Real>(v: &Vector3<T>) -> T {
+    v.norm_squared().sqrt_rn()
+}
+
 /// `y + a·x` for 3-vectors.
 #[must_use]
 pub(crate) fn axpy<T: Real>(y: &Vector3<T>, a: T, x: &Vector3<T>) -> Vector3<T> {

@@ -1,10 +1,11 @@
 //! The accelerometer as a gravity sensor: its direction (both filters), or the whole specific
 //! force of a body at rest with the accelerometer bias (15-state filter).
 
-use super::{in_body, isotropic, three_rows};
+use super::{attitude_only, in_body, isotropic, three_rows};
 use crate::eskf::update::{Linearization, Measurement};
 use crate::eskf::{ErrorState, EskfError, InsState};
-use crate::kernels::all_finite;
+use crate::kernels::{all_finite, mat3};
+use crate::lie::So3;
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
 
@@ -48,18 +49,25 @@ impl<T: Real> GravityDirection<T> {
     }
 }
 
-impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for GravityDirection<T> {
-    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
+impl<T: Real> GravityDirection<T> {
+    /// The residual `f_m/‖f_m‖ − Rᵀ u` and the attitude block `[Rᵀ u]×` (one compiled copy for
+    /// both filters).
+    fn attitude_parts(&self, attitude: &So3<T>) -> Result<(Vector3<T>, Matrix3<T>), EskfError> {
         if !(all_finite(self.accel.as_slice()) && all_finite(self.up.as_slice())) {
             return Err(EskfError::NonFinite);
         }
-        let (na, nu) = (self.accel.norm(), self.up.norm());
+        let (na, nu) = (mat3::norm(&self.accel), mat3::norm(&self.up));
         if !(na > T::zero() && nu > T::zero()) {
             return Err(EskfError::ZeroNorm);
         }
-        let (predicted, d_attitude) = in_body(x.attitude(), &(self.up / nu));
-        let residual = self.accel / na - predicted;
-        Ok(three_rows(residual, &[(0, &d_attitude)], &[]))
+        let (predicted, d_attitude) = in_body(attitude, &(self.up / nu));
+        Ok((self.accel / na - predicted, d_attitude))
+    }
+}
+
+impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for GravityDirection<T> {
+    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
+        attitude_only(self.attitude_parts(x.attitude()))
     }
 
     fn noise(&self) -> Matrix3<T> {

@@ -2,6 +2,7 @@
 
 use crate::eskf::update::{Linearization, Measurement};
 use crate::eskf::{ErrorState, EskfError};
+use crate::lie::So3;
 use crate::Real;
 use nalgebra::{Matrix1, SMatrix, Vector1};
 
@@ -41,12 +42,14 @@ impl<T: Real> Heading<T> {
     }
 }
 
-impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for Heading<T> {
-    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 1>, EskfError> {
+impl<T: Real> Heading<T> {
+    /// The wrapped residual and the attitude row (entries 1 and 2; entry 0 is zero): the part
+    /// that does not depend on the filter.
+    fn attitude_parts(&self, attitude: &So3<T>) -> Result<(T, [T; 2]), EskfError> {
         if !self.yaw.is_finite() {
             return Err(EskfError::NonFinite);
         }
-        let r = x.attitude().rotation_matrix();
+        let r = attitude.rotation_matrix();
         let (cx, cy) = (r.m11, r.m21);
         let n2 = cx * cx + cy * cy;
         // False for NaN too.
@@ -54,17 +57,24 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for H
         if !away_from_vertical {
             return Err(EskfError::SingularGeometry);
         }
+        let row = [(cy * r.m13 - cx * r.m23) / n2, (cx * r.m22 - cy * r.m12) / n2];
+        let (s, c) = (self.yaw - cy.arctan2(cx)).sincos();
+        Ok((s.arctan2(c), row))
+    }
+}
+
+impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for Heading<T> {
+    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 1>, EskfError> {
+        let (residual, row) = match self.attitude_parts(x.attitude()) {
+            Ok(parts) => parts,
+            Err(e) => return Err(e),
+        };
         let mut jacobian = SMatrix::<T, 1, N>::zeros();
-        let row = [
-            (cy * r.m13 - cx * r.m23) / n2,
-            (cx * r.m22 - cy * r.m12) / n2,
-        ];
-        for (d, s) in jacobian.as_mut_slice().iter_mut().skip(1).zip(row) {
+        for (d, s) in jacobian.iter_mut().skip(1).zip(row) {
             *d = s;
         }
-        let (s, c) = (self.yaw - cy.arctan2(cx)).sincos();
         Ok(Linearization {
-            residual: Vector1::new(s.arctan2(c)),
+            residual: Vector1::new(residual),
             jacobian,
         })
     }

@@ -1,9 +1,10 @@
 //! Three-axis magnetometer against a world reference field.
 
-use super::{in_body, isotropic, three_rows};
+use super::{attitude_only, in_body, isotropic};
 use crate::eskf::update::{Linearization, Measurement};
 use crate::eskf::{ErrorState, EskfError};
 use crate::kernels::all_finite;
+use crate::lie::So3;
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
 
@@ -42,16 +43,24 @@ impl<T: Real> Magnetometer<T> {
     }
 }
 
-impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for Magnetometer<T> {
-    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
+impl<T: Real> Magnetometer<T> {
+    /// The residual `z − Rᵀ m_w` and the attitude block `[Rᵀ m_w]×`: the part that does not
+    /// depend on the filter (one compiled copy for both).
+    fn attitude_parts(&self, attitude: &So3<T>) -> Result<(Vector3<T>, Matrix3<T>), EskfError> {
         if !(all_finite(self.field.as_slice()) && all_finite(self.reference.as_slice())) {
             return Err(EskfError::NonFinite);
         }
         if self.field.norm_squared() <= T::zero() || self.reference.norm_squared() <= T::zero() {
             return Err(EskfError::ZeroNorm);
         }
-        let (predicted, d_attitude) = in_body(x.attitude(), &self.reference);
-        Ok(three_rows(self.field - predicted, &[(0, &d_attitude)], &[]))
+        let (predicted, d_attitude) = in_body(attitude, &self.reference);
+        Ok((self.field - predicted, d_attitude))
+    }
+}
+
+impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for Magnetometer<T> {
+    fn linearize(&self, x: &S) -> Result<Linearization<T, N, 3>, EskfError> {
+        attitude_only(self.attitude_parts(x.attitude()))
     }
 
     fn noise(&self) -> Matrix3<T> {

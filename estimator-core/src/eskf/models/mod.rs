@@ -31,6 +31,7 @@ pub use magnetometer::Magnetometer;
 pub use zero_velocity::ZeroVelocity;
 
 use super::update::Linearization;
+use super::EskfError;
 use crate::kernels::block::set_block;
 use crate::lie::{skew, LieGroup, So3};
 use crate::Real;
@@ -46,6 +47,17 @@ fn isotropic<T: Real>(sigma: T) -> Matrix3<T> {
 fn in_body<T: Real>(attitude: &So3<T>, v: &Vector3<T>) -> (Vector3<T>, Matrix3<T>) {
     let b = attitude.inverse().act(v);
     (b, skew(&b))
+}
+
+/// The linearization of a model that sees only the attitude, from its residual and attitude
+/// block (the direction models, whose parts are computed once for both filters).
+fn attitude_only<T: Real, const N: usize>(
+    parts: Result<(Vector3<T>, Matrix3<T>), EskfError>,
+) -> Result<Linearization<T, N, 3>, EskfError> {
+    match parts {
+        Ok((residual, d_attitude)) => Ok(three_rows(residual, &[(0, &d_attitude)], &[])),
+        Err(e) => Err(e),
+    }
 }
 
 /// The linearization of a three-row model: `residual`, and `H` zero except for the given

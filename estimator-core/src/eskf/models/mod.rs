@@ -32,7 +32,6 @@ pub use zero_velocity::ZeroVelocity;
 
 use super::update::Linearization;
 use super::EskfError;
-use crate::kernels::block::set_block;
 use crate::lie::{skew, LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -62,17 +61,25 @@ fn attitude_only<T: Real, const N: usize>(
 
 /// The linearization of a three-row model: `residual`, and `H` zero except for the given
 /// `(column, block)` pairs and the identity blocks starting at the columns in `identities`.
+/// (Block `k` of a `3 × N` column-major matrix is the nine entries `9k .. 9k + 9`.)
 fn three_rows<T: Real, const N: usize>(
     residual: Vector3<T>,
     blocks: &[(usize, &Matrix3<T>)],
     identities: &[usize],
 ) -> Linearization<T, N, 3> {
     let mut jacobian = SMatrix::<T, 3, N>::zeros();
+    let h = jacobian.as_mut_slice();
     for (col, b) in blocks {
-        set_block(&mut jacobian, 0, col / 3, b);
+        if let Some(dst) = h.get_mut(3 * col..3 * col + 9) {
+            dst.copy_from_slice(b.as_slice());
+        }
     }
     for col in identities {
-        set_block(&mut jacobian, 0, col / 3, &Matrix3::identity());
+        for i in 0..3 {
+            if let Some(e) = h.get_mut(3 * col + 4 * i) {
+                *e = T::one();
+            }
+        }
     }
     Linearization { residual, jacobian }
 }

@@ -11,10 +11,10 @@ mod eskf_common;
 mod support;
 
 use eskf_common::*;
-use support::{chi2_quantile, nees};
 use estimator_core::eskf::*;
 use estimator_core::lie::LieGroup;
 use nalgebra::{SMatrix, SVector, Vector3};
+use support::{chi2_quantile, nees};
 
 const RUNS: usize = 30;
 const DT: f64 = 0.005;

@@ -84,6 +84,7 @@ fn triad<T: Real>(u: &Vector3<T>, h: &Vector3<T>) -> Matrix3<T> {
 /// force must have a norm within `rest_tolerance` (m/s²) of `‖g‖`, else [`EskfError::NotAtRest`].
 /// Errors: [`EskfError::EmptyWindow`], [`EskfError::NonFinite`], [`EskfError::ZeroNorm`] (zero
 /// mean accelerometer, magnetometer or reference, or a field with no horizontal part).
+#[allow(clippy::question_mark)] // the matches on vector results: see the module docs
 pub fn align_at_rest<T: Real>(
     accel: &[Vector3<T>],
     gyro: &[Vector3<T>],
@@ -109,14 +110,15 @@ pub fn align_at_rest<T: Real>(
     let uw = -gravity / ng;
     let pair = match mag {
         Some(m) => {
+            let mw = m.reference;
             let mb = match mean(m.samples) {
                 Ok(mb) => mb,
                 Err(e) => return Err(e),
             };
-            if !all_finite(m.reference.as_slice()) {
+            if !all_finite(mw.as_slice()) {
                 return Err(EskfError::NonFinite);
             }
-            (horizontal(&mb, &ub), horizontal(&m.reference, &uw))
+            (horizontal(&mb, &ub), horizontal(&mw, &uw))
         }
         None => (level_axis(&ub), level_axis(&uw)),
     };

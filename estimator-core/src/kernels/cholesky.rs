@@ -10,7 +10,7 @@
 //! is the caller's relative pivot tolerance.
 
 use super::finite::all_finite;
-use super::slice::{axpy, dot, symmetrize};
+use super::slice::{axpy, dot};
 use crate::Real;
 
 /// `A = L Lᵀ` in place on the column-major `n × n` storage `a`: only the lower triangle is
@@ -89,22 +89,54 @@ pub(crate) fn solve_in_place<T: Real>(l: &[T], n: usize, b: &mut [T]) {
     }
 }
 
-/// `X ← (L Lᵀ)⁻¹` for the factor `l` (both column-major `n × n`), solved column by column of
-/// the identity and symmetrized, `(X + Xᵀ)/2`, against round-off. `false` when an entry of the
-/// result is not finite.
+/// `X ← (L Lᵀ)⁻¹ = L⁻ᵀ L⁻¹` for the factor `l` (both column-major `n × n`): `X`'s upper
+/// triangle first receives `Y = L⁻¹` transposed (`Y_jj = 1/L_jj`,
+/// `Y_ij = −(Σ_{j≤k<i} L_ik Y_kj)/L_ii`), then `X_ij = Σ_{k ≥ max(i,j)} Y_ki Y_kj` row by row
+/// from the top, each row of `Y` read before it is overwritten; the result is exactly
+/// symmetric. `false` when an entry of the result is not finite.
 #[inline(never)]
 #[must_use]
 pub(crate) fn inverse_into<T: Real>(l: &[T], n: usize, x: &mut [T]) -> bool {
-    if n == 0 {
-        return true;
+    if l.len() != n * n || x.len() != n * n {
+        return false;
     }
-    for (c, col) in x.chunks_exact_mut(n).enumerate() {
-        for (r, v) in col.iter_mut().enumerate() {
-            *v = if r == c { T::one() } else { T::zero() };
+    let at = |s: &[T], i: usize, j: usize| s.get(j * n + i).copied().unwrap_or_else(T::zero);
+    // Yᵀ into the upper triangle of x: x[j, i] = Y_ij for i ≥ j.
+    for j in 0..n {
+        let y_jj = T::one() / at(l, j, j);
+        if let Some(e) = x.get_mut(j * n + j) {
+            *e = y_jj;
         }
-        solve_in_place(l, n, col);
+        for i in j + 1..n {
+            let mut acc = T::zero();
+            for k in j..i {
+                acc += at(l, i, k) * at(x, j, k);
+            }
+            let y_ij = -acc / at(l, i, i);
+            if let Some(e) = x.get_mut(i * n + j) {
+                *e = y_ij;
+            }
+        }
     }
-    symmetrize(x, n);
+    // X_ij = Σ_{k ≥ j} Y_ki Y_kj for i ≤ j (Y_ki = x[i, k] above the diagonal): row i of X
+    // needs rows i.. of Yᵀ, so rows are finished from the top and mirrored below.
+    for i in 0..n {
+        for j in i..n {
+            let mut acc = T::zero();
+            for k in j..n {
+                acc += at(x, i, k) * at(x, j, k);
+            }
+            if let Some(e) = x.get_mut(j * n + i) {
+                *e = acc;
+            }
+        }
+        for j in i + 1..n {
+            let v = at(x, i, j);
+            if let Some(e) = x.get_mut(i * n + j) {
+                *e = v;
+            }
+        }
+    }
     all_finite(x)
 }
 

@@ -57,7 +57,10 @@ impl<T: Real> Heading<T> {
         if !away_from_vertical {
             return Err(EskfError::SingularGeometry);
         }
-        let row = [(cy * r.m13 - cx * r.m23) / n2, (cx * r.m22 - cy * r.m12) / n2];
+        let row = [
+            (cy * r.m13 - cx * r.m23) / n2,
+            (cx * r.m22 - cy * r.m12) / n2,
+        ];
         let (s, c) = (self.yaw - cy.arctan2(cx)).sincos();
         Ok((s.arctan2(c), row))
     }
@@ -65,10 +68,7 @@ impl<T: Real> Heading<T> {
 
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 1> for Heading<T> {
     fn linearize(&self, x: &S) -> Result<Linearization<T, N, 1>, EskfError> {
-        let (residual, row) = match self.attitude_parts(x.attitude()) {
-            Ok(parts) => parts,
-            Err(e) => return Err(e),
-        };
+        let (residual, row) = self.attitude_parts(x.attitude())?;
         let mut jacobian = SMatrix::<T, 1, N>::zeros();
         for (d, s) in jacobian.iter_mut().skip(1).zip(row) {
             *d = s;

@@ -4,7 +4,7 @@ use super::align::{prior_attitude_covariance, Alignment, InitialSigmas};
 use super::config::{FilterConfig, ImuSample};
 use super::covariance::{check_start, sigmas};
 use super::error::{EskfError, UpdateOutcome};
-use super::state::{AhrsState, ErrorState, InsState};
+use super::state::{sealed::Sealed, AhrsState, ErrorState, InsState};
 use super::update::{update, Measurement, UpdateOptions};
 use crate::kernels::block::{add_scaled_identity, set_block};
 use crate::Real;
@@ -117,8 +117,7 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
     /// [`EskfError::NonFinite`], [`EskfError::NonPositiveDt`], [`EskfError::DtTooLarge`]; the
     /// filter is then unchanged.
     pub fn predict(&mut self, imu: &ImuSample<T>) -> Result<(), EskfError> {
-        self.state
-            .propagate(&mut self.covariance, imu, &self.config)
+        Sealed::propagate(&mut self.state, &mut self.covariance, imu, &self.config)
     }
 
     /// Fuses one measurement: gate, Joseph form, optional Gauss-Newton iterations, injection

@@ -13,7 +13,7 @@ use nalgebra::{Matrix3x4, SMatrix, SVector, Vector3};
 /// components are additive (`x = x̂ + δx`).
 ///
 /// Sealed: implemented by [`InsState`] (`N = 15`) and [`AhrsState`] (`N = 6`).
-pub trait ErrorState<T: Real, const N: usize>: Copy + sealed::Sealed {
+pub trait ErrorState<T: Real, const N: usize>: Copy + sealed::Sealed<T, N> {
     /// `x ⊕ δx`: `R ← R·exp(δθ^)`, every other block `+ δ`.
     #[must_use]
     fn oplus(&self, dx: &SVector<T, N>) -> Self;
@@ -25,24 +25,26 @@ pub trait ErrorState<T: Real, const N: usize>: Copy + sealed::Sealed {
     /// The attitude `R` (world from body).
     #[must_use]
     fn attitude(&self) -> &So3<T>;
-
-    /// Propagates the state and its error covariance `P` over one IMU sample (the prediction
-    /// step; equations in the [`crate::eskf`] module docs). Writes `self` and `p` only on `Ok`.
-    ///
-    /// # Errors
-    /// [`EskfError::NonFinite`], [`EskfError::NonPositiveDt`], [`EskfError::DtTooLarge`].
-    fn propagate(
-        &mut self,
-        p: &mut SMatrix<T, N, N>,
-        imu: &ImuSample<T>,
-        config: &FilterConfig<T>,
-    ) -> Result<(), EskfError>;
 }
 
 pub(crate) mod sealed {
-    pub trait Sealed {}
-    impl<T: crate::Real> Sealed for super::InsState<T> {}
-    impl<T: crate::Real> Sealed for super::AhrsState<T> {}
+    use super::{EskfError, FilterConfig, ImuSample};
+    use crate::Real;
+    use nalgebra::SMatrix;
+
+    /// Seals [`ErrorState`](super::ErrorState), and carries the prediction step of each state,
+    /// which only the filter calls.
+    pub trait Sealed<T: Real, const N: usize> {
+        /// Propagates the state and its error covariance `P` over one IMU sample (the
+        /// prediction; equations in the [`crate::eskf`] module docs). Writes `self` and `p` only
+        /// on `Ok`.
+        fn propagate(
+            &mut self,
+            p: &mut SMatrix<T, N, N>,
+            imu: &ImuSample<T>,
+            config: &FilterConfig<T>,
+        ) -> Result<(), EskfError>;
+    }
 }
 
 /// The 15-state inertial nominal state `x = (R, v, p, b_g, b_a)`.
@@ -130,7 +132,9 @@ impl<T: Real> ErrorState<T, 15> for InsState<T> {
     fn attitude(&self) -> &So3<T> {
         &self.attitude
     }
+}
 
+impl<T: Real> sealed::Sealed<T, 15> for InsState<T> {
     fn propagate(
         &mut self,
         p: &mut SMatrix<T, 15, 15>,
@@ -156,7 +160,9 @@ impl<T: Real> ErrorState<T, 6> for AhrsState<T> {
     fn attitude(&self) -> &So3<T> {
         &self.attitude
     }
+}
 
+impl<T: Real> sealed::Sealed<T, 6> for AhrsState<T> {
     fn propagate(
         &mut self,
         p: &mut SMatrix<T, 6, 6>,

@@ -3,7 +3,7 @@
 
 use super::config::{check_dt, FilterConfig, ImuSample};
 use super::error::EskfError;
-use super::state::{AhrsState, ErrorState, InsState};
+use super::state::{sealed::Sealed, AhrsState, ErrorState, InsState};
 use crate::kernels::block::{add_scaled_identity, block, block_in, set_block};
 use crate::kernels::{all_finite, mat3};
 use crate::lie::{skew, LieGroup, So3};
@@ -52,7 +52,7 @@ impl<T: Real> FRows<T> {
 /// Nominal: `ω = ω_m − b_g`, `f = f_m − b_a`, `a = R f + g`, `ΔR = exp(ω dt)`,
 /// `R⁺ = R ΔR`, `v⁺ = v + a dt`, `p⁺ = p + v dt + ½ a dt²`.
 /// Covariance: `P⁺ = F P Fᵀ + Q` with the nonzero blocks of `F` ([`FRows`]).
-pub(crate) fn predict_ins<T: Real>(
+fn predict_ins<T: Real>(
     x: &mut InsState<T>,
     p: &mut SMatrix<T, 15, 15>,
     imu: &ImuSample<T>,
@@ -154,7 +154,7 @@ pub(crate) fn predict_ins<T: Real>(
 /// The attitude-only prediction: `R⁺ = R exp((ω_m − b_g) dt)`, `P⁺ = F P Fᵀ + Q`,
 /// `F = [ΔRᵀ, −J_r dt; 0, I]`, `Q = diag(σ_g² dt I, σ_bg² dt I)`. Only the gyro and `dt` of the
 /// sample are read.
-pub(crate) fn predict_ahrs<T: Real>(
+fn predict_ahrs<T: Real>(
     x: &mut AhrsState<T>,
     p: &mut SMatrix<T, 6, 6>,
     imu: &ImuSample<T>,
@@ -204,4 +204,26 @@ pub(crate) fn predict_ahrs<T: Real>(
     );
     x.attitude = attitude;
     Ok(())
+}
+
+impl<T: Real> Sealed<T, 15> for InsState<T> {
+    fn propagate(
+        &mut self,
+        p: &mut SMatrix<T, 15, 15>,
+        imu: &ImuSample<T>,
+        config: &FilterConfig<T>,
+    ) -> Result<(), EskfError> {
+        predict_ins(self, p, imu, config)
+    }
+}
+
+impl<T: Real> Sealed<T, 6> for AhrsState<T> {
+    fn propagate(
+        &mut self,
+        p: &mut SMatrix<T, 6, 6>,
+        imu: &ImuSample<T>,
+        config: &FilterConfig<T>,
+    ) -> Result<(), EskfError> {
+        predict_ahrs(self, p, imu, config)
+    }
 }

@@ -5,7 +5,7 @@ use super::error::EskfError;
 use crate::kernels::all_finite;
 use crate::lie::{LieGroup, So3};
 use crate::Real;
-use nalgebra::{Matrix3x4, SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3x4, SVector, Vector3};
 
 /// A nominal state with an `N`-dimensional error state whose first three components are the
 /// right attitude error `δθ` (`R = R̂·exp(δθ^)`, the right `⊕` of *Lie Groups and Smooth
@@ -134,17 +134,6 @@ impl<T: Real> ErrorState<T, 15> for InsState<T> {
     }
 }
 
-impl<T: Real> sealed::Sealed<T, 15> for InsState<T> {
-    fn propagate(
-        &mut self,
-        p: &mut SMatrix<T, 15, 15>,
-        imu: &ImuSample<T>,
-        config: &FilterConfig<T>,
-    ) -> Result<(), EskfError> {
-        super::predict::predict_ins(self, p, imu, config)
-    }
-}
-
 impl<T: Real> ErrorState<T, 6> for AhrsState<T> {
     fn oplus(&self, dx: &SVector<T, 6>) -> Self {
         Self {
@@ -159,16 +148,5 @@ impl<T: Real> ErrorState<T, 6> for AhrsState<T> {
 
     fn attitude(&self) -> &So3<T> {
         &self.attitude
-    }
-}
-
-impl<T: Real> sealed::Sealed<T, 6> for AhrsState<T> {
-    fn propagate(
-        &mut self,
-        p: &mut SMatrix<T, 6, 6>,
-        imu: &ImuSample<T>,
-        config: &FilterConfig<T>,
-    ) -> Result<(), EskfError> {
-        super::predict::predict_ahrs(self, p, imu, config)
     }
 }

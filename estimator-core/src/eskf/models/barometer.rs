@@ -1,7 +1,8 @@
 //! Barometric altitude.
 
+use crate::eskf::error::EskfError;
+use crate::eskf::state::InsState;
 use crate::eskf::update::{Linearization, Measurement};
-use crate::eskf::{EskfError, InsState};
 use crate::Real;
 use nalgebra::{Matrix1, SMatrix, Vector1};
 

@@ -1,7 +1,8 @@
 //! A known world landmark seen by a camera on the body.
 
+use crate::eskf::error::EskfError;
+use crate::eskf::state::InsState;
 use crate::eskf::update::{Linearization, Measurement};
-use crate::eskf::{EskfError, InsState};
 use crate::kernels::{all_finite, mat3};
 use crate::lie::{skew, LieGroup, Se3};
 use crate::Real;

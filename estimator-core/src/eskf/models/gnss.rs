@@ -1,8 +1,9 @@
 //! GNSS position (with the antenna lever arm) and GNSS velocity.
 
-use super::{isotropic, three_rows};
+use super::shared::{isotropic, three_rows};
+use crate::eskf::error::EskfError;
+use crate::eskf::state::InsState;
 use crate::eskf::update::{Linearization, Measurement};
-use crate::eskf::{EskfError, InsState};
 use crate::kernels::all_finite;
 use crate::lie::LieGroup;
 use crate::Real;

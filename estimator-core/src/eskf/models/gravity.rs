@@ -1,9 +1,10 @@
 //! The accelerometer as a gravity sensor: its direction (both filters), or the whole specific
 //! force of a body at rest with the accelerometer bias (15-state filter).
 
-use super::{attitude_only, in_body, isotropic, three_rows};
+use super::shared::{attitude_only, in_body, isotropic, three_rows};
+use crate::eskf::error::EskfError;
+use crate::eskf::state::{ErrorState, InsState};
 use crate::eskf::update::{Linearization, Measurement};
-use crate::eskf::{ErrorState, EskfError, InsState};
 use crate::kernels::{all_finite, mat3};
 use crate::lie::So3;
 use crate::Real;
@@ -79,6 +80,20 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for G
 /// `H = [[Rᵀ(−g)]×, 0, 0, 0, I]`. Unlike [`GravityDirection`] it models the accelerometer bias,
 /// so repeated updates at rest stay consistent (tilt and horizontal bias are separated only as
 /// far as the data allow).
+///
+/// ```
+/// use estimator_core::eskf::{AccelerometerAtRest, FilterConfig, Ins, InsState, UpdateOptions};
+/// use nalgebra::{SMatrix, Vector3};
+///
+/// let p0 = SMatrix::<f64, 15, 15>::identity() * 0.01;
+/// let mut ins = Ins::new(InsState::identity(), p0, FilterConfig::default()).unwrap();
+/// // Level and at rest, with a 0.05 m/s² bias on the vertical axis.
+/// let reading = Vector3::new(0.0, 0.0, 9.81 + 0.05);
+/// for _ in 0..50 {
+///     ins.update(&AccelerometerAtRest::new(reading, 0.01), &UpdateOptions::default()).unwrap();
+/// }
+/// assert!((ins.state().accel_bias.z - 0.05).abs() < 0.005);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AccelerometerAtRest<T: Real> {
     /// Measured specific force `f_m`, body frame, m/s².

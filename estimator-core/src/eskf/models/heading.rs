@@ -1,7 +1,8 @@
 //! Heading (yaw) of the body `x` axis, from a compass or a dual-antenna GNSS.
 
+use crate::eskf::error::EskfError;
+use crate::eskf::state::ErrorState;
 use crate::eskf::update::{Linearization, Measurement};
-use crate::eskf::{ErrorState, EskfError};
 use crate::lie::So3;
 use crate::Real;
 use nalgebra::{Matrix1, SMatrix, Vector1};

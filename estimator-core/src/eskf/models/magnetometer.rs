@@ -1,8 +1,9 @@
 //! Three-axis magnetometer against a world reference field.
 
-use super::{attitude_only, in_body, isotropic};
+use super::shared::{attitude_only, in_body, isotropic};
+use crate::eskf::error::EskfError;
+use crate::eskf::state::ErrorState;
 use crate::eskf::update::{Linearization, Measurement};
-use crate::eskf::{ErrorState, EskfError};
 use crate::kernels::all_finite;
 use crate::lie::So3;
 use crate::Real;

@@ -1,8 +1,9 @@
 //! The zero-velocity update of a body known to be at rest.
 
-use super::{isotropic, three_rows};
+use super::shared::{isotropic, three_rows};
+use crate::eskf::error::EskfError;
+use crate::eskf::state::InsState;
 use crate::eskf::update::{Linearization, Measurement};
-use crate::eskf::{EskfError, InsState};
 use crate::Real;
 use nalgebra::Matrix3;
 

@@ -1,7 +1,7 @@
 //! Steps 3–4 of the [update](super): the Joseph-form covariance, the injection `x⁺ = x̂ ⊕ δx`
 //! and the covariance reset.
 
-use super::{attitude_part, Work};
+use super::work::{attitude_part, Work};
 use crate::eskf::error::EskfError;
 use crate::eskf::state::ErrorState;
 use crate::kernels::slice::axpy;

@@ -1,7 +1,8 @@
 //! The gain `K = P H̃ᵀ S⁻¹`, the NIS and gate at the prior, and the Gauss-Newton step of the
 //! iterated update (steps 1–2 of the [module docs](super)).
 
-use super::{UpdateOptions, Work};
+use super::options::UpdateOptions;
+use super::work::Work;
 use crate::eskf::error::{EskfError, UpdateOutcome};
 use crate::kernels::cholesky::{factor_in_place, inverse_into};
 use crate::kernels::slice::{axpy, distance, dot};

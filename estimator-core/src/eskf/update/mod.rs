@@ -27,7 +27,11 @@
 mod commit;
 mod gain;
 pub(crate) mod gate;
+mod model;
+mod options;
+mod work;
 
+use super::covariance::is_spd;
 use super::error::{EskfError, UpdateOutcome};
 use super::state::ErrorState;
 use crate::kernels::slice::transpose_into;
@@ -36,89 +40,10 @@ use crate::lie::{LieGroup, So3};
 use crate::Real;
 use commit::commit;
 use gain::{gate_step, step};
-use gate::{Gate, GateProbability};
-use nalgebra::{SMatrix, SVector, Vector3};
-
-/// A measurement linearized at a state: the residual `r = z ⊖ h(x)` (for a vector measurement
-/// `z − h(x)`; angles wrapped) and `H`, with `h(x ⊕ δx) ≈ h(x) + H δx` (*Lie Groups and Smooth
-/// Manifolds for Robotic State Estimation*, eq. 4.3 and Definition 4.6).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Linearization<T: Real, const N: usize, const M: usize> {
-    /// `r = z ⊖ h(x)`.
-    pub residual: SVector<T, M>,
-    /// `H` (`M × N`), right Jacobian with respect to the error state.
-    pub jacobian: SMatrix<T, M, N>,
-}
-
-/// A fixed-size measurement model `z = h(x) + n`, `n ~ N(0, R)`, for the nominal state `S` with an
-/// `N`-dimensional error state. Implement it for a new sensor (one file in `eskf/models/`).
-pub trait Measurement<T: Real, S, const N: usize, const M: usize> {
-    /// `r = z ⊖ h(x)` and `H` at `x`.
-    ///
-    /// # Errors
-    /// Non-finite data, or a state where `h` is not defined (landmark behind the camera,
-    /// heading at ±90° pitch, ...).
-    fn linearize(&self, x: &S) -> Result<Linearization<T, N, M>, EskfError>;
-
-    /// The noise covariance `R` (must be symmetric positive definite).
-    #[must_use]
-    fn noise(&self) -> SMatrix<T, M, M>;
-}
-
-/// How an update is done: the gate, and the number of Gauss-Newton iterations.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct UpdateOptions<T: Real> {
-    /// The chi-square gate on the NIS at the prior.
-    pub gate: Gate<T>,
-    /// Iteration cap, `≥ 1`; `1` is the plain (extended) update, more is the iterated update.
-    pub max_iterations: u8,
-    /// The iterated update stops when `‖δx_{k+1} − δx_k‖ <` this.
-    pub step_tolerance: T,
-}
-
-impl<T: Real> Default for UpdateOptions<T> {
-    /// Single-step update gated at 99.9 %.
-    fn default() -> Self {
-        Self::ekf(Gate::Probability(GateProbability::P999))
-    }
-}
-
-impl<T: Real> UpdateOptions<T> {
-    /// The plain single-linearization update with `gate`.
-    #[must_use]
-    pub fn ekf(gate: Gate<T>) -> Self {
-        Self {
-            gate,
-            max_iterations: 1,
-            step_tolerance: T::lit(1e-6),
-        }
-    }
-
-    /// The iterated update (IEKF) with `gate`, at most `max_iterations` linearizations, stopping
-    /// when the step changes by less than `step_tolerance`.
-    #[must_use]
-    pub fn iterated(gate: Gate<T>, max_iterations: u8, step_tolerance: T) -> Self {
-        Self {
-            gate,
-            max_iterations,
-            step_tolerance,
-        }
-    }
-
-    /// `Ok` when the iteration cap is at least 1, the tolerance finite and a threshold gate
-    /// not NaN.
-    fn validate(&self) -> Result<(), EskfError> {
-        if self.max_iterations == 0 || !self.step_tolerance.is_finite() {
-            return Err(EskfError::InvalidOption);
-        }
-        if let Gate::Threshold(t) = self.gate {
-            if !(t.is_finite() || t > T::zero()) {
-                return Err(EskfError::InvalidOption);
-            }
-        }
-        Ok(())
-    }
-}
+pub use model::{Linearization, Measurement};
+use nalgebra::{SMatrix, SVector};
+pub use options::UpdateOptions;
+use work::{attitude_part, Gain, Work};
 
 /// Row capacity of the shared update core (see the module docs).
 pub(crate) const CORE_ROWS: usize = 3;
@@ -158,36 +83,6 @@ where
         );
         Ok(())
     }
-}
-
-/// The working set of one update, on the caller's stack and filled in place by the phases.
-/// `N × C` matrices hold one column per measurement row; columns and rows past `m` are zero.
-struct Work<T: Real, const N: usize, const C: usize> {
-    /// `H̃ᵀ` at the current iterate.
-    ht: SMatrix<T, N, C>,
-    /// Residual `r = z ⊖ h(x̂ ⊕ δx)` at the current iterate.
-    r: SVector<T, C>,
-    /// `U`, `S` and `K` at the current iterate.
-    g: Gain<T, N, C>,
-    /// `S⁻¹` (for the NIS at the prior).
-    s_inv: SMatrix<T, C, C>,
-    /// The current correction `δx`.
-    dx: SVector<T, N>,
-    /// `R` padded to `C × C` with the identity.
-    noise: SMatrix<T, C, C>,
-    /// The number of active rows, `M`.
-    m: usize,
-}
-
-/// The gain part of the working set, saved and restored as one block by the iterated update.
-#[derive(Clone, Copy)]
-struct Gain<T: Real, const N: usize, const C: usize> {
-    /// `U = P H̃ᵀ`.
-    u: SMatrix<T, N, C>,
-    /// `S = H̃ P H̃ᵀ + R` (identity past `m`).
-    s: SMatrix<T, C, C>,
-    /// `K = U S⁻¹`.
-    k: SMatrix<T, N, C>,
 }
 
 /// The update on `(x, P)` (module docs); `x` and `P` are written only when the result is
@@ -248,7 +143,7 @@ where
             }
         }
     }
-    if !super::covariance::is_spd(&w.noise) {
+    if !is_spd(&w.noise) {
         return Err(EskfError::NoiseNotPositiveDefinite);
     }
     linearize_into(model, x, &mut w, true)?;
@@ -325,12 +220,4 @@ where
         }
     }
     iterations
-}
-
-/// The attitude part `δθ` (entries 0..3) of an error vector or of a column of `Hᵀ`.
-fn attitude_part<T: Real>(s: &[T]) -> Vector3<T> {
-    match s.get(0..3) {
-        Some(&[a, b, c]) => Vector3::new(a, b, c),
-        _ => Vector3::zeros(),
-    }
 }

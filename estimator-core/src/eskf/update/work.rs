@@ -1,0 +1,42 @@
+//! The working set one update fills in place, phase by phase.
+
+use crate::Real;
+use nalgebra::{SMatrix, SVector, Vector3};
+
+/// The working set of one update, on the caller's stack and filled in place by the phases.
+/// `N × C` matrices hold one column per measurement row; columns and rows past `m` are zero.
+pub(super) struct Work<T: Real, const N: usize, const C: usize> {
+    /// `H̃ᵀ` at the current iterate.
+    pub(super) ht: SMatrix<T, N, C>,
+    /// Residual `r = z ⊖ h(x̂ ⊕ δx)` at the current iterate.
+    pub(super) r: SVector<T, C>,
+    /// `U`, `S` and `K` at the current iterate.
+    pub(super) g: Gain<T, N, C>,
+    /// `S⁻¹` (for the NIS at the prior).
+    pub(super) s_inv: SMatrix<T, C, C>,
+    /// The current correction `δx`.
+    pub(super) dx: SVector<T, N>,
+    /// `R` padded to `C × C` with the identity.
+    pub(super) noise: SMatrix<T, C, C>,
+    /// The number of active rows, `M`.
+    pub(super) m: usize,
+}
+
+/// The gain part of the working set, saved and restored as one block by the iterated update.
+#[derive(Clone, Copy)]
+pub(super) struct Gain<T: Real, const N: usize, const C: usize> {
+    /// `U = P H̃ᵀ`.
+    pub(super) u: SMatrix<T, N, C>,
+    /// `S = H̃ P H̃ᵀ + R` (identity past `m`).
+    pub(super) s: SMatrix<T, C, C>,
+    /// `K = U S⁻¹`.
+    pub(super) k: SMatrix<T, N, C>,
+}
+
+/// The attitude part `δθ` (entries 0..3) of an error vector or of a column of `Hᵀ`.
+pub(super) fn attitude_part<T: Real>(s: &[T]) -> Vector3<T> {
+    match s.get(0..3) {
+        Some(&[a, b, c]) => Vector3::new(a, b, c),
+        _ => Vector3::zeros(),
+    }
+}

@@ -22,7 +22,9 @@
 //! padded with zero rows and its noise with the identity, which leaves every result unchanged
 //! (`S_pad = [[S, 0], [0, I]]`, `K_pad = [K, 0]`, `NIS = rᵀ S⁻¹ r`), and the products whose cost
 //! grows with the rows run over the `M` active rows only. The core's phases are separate
-//! functions sharing one working set ([`Work`]), so their stack frames do not add up.
+//! functions sharing one working set ([`Work`]), each `#[inline(never)]` so that their stack
+//! frames do not add up (inlined into one another they exceed the 2 KiB stack a Cortex-M
+//! firmware gives them at opt-level `s`).
 
 mod commit;
 mod gain;

@@ -9,12 +9,15 @@
 //! * [`plot`]: the PNG plots.
 //! * [`montecarlo`]: consistency over seeds against chi-square bands.
 //! * [`replay`]: the filter over a dataset folder, with its outputs (trajectories, metrics, plots).
+//! * [`output`]: output folders written beside their target and moved into place on success;
+//!   nothing host-sim did not create is deleted or overwritten.
 #![warn(missing_docs)]
 
 pub mod baseline;
 pub mod dataset;
 pub mod metrics;
 pub mod montecarlo;
+pub mod output;
 pub mod plot;
 pub mod replay;
 pub mod scenario;

@@ -14,6 +14,7 @@ use clap::Parser;
 use cli::{Cli, Command};
 use host_sim::dataset::write::simulate;
 use host_sim::metrics::Metrics;
+use host_sim::output::Staging;
 use host_sim::replay::{replay, ReplayConfig};
 use host_sim::scenario::{builtin_scenarios, Scenario};
 use std::path::Path;
@@ -25,6 +26,7 @@ fn main() -> ExitCode {
         scenario: "default".into(),
         seed: 1,
         out: "out".into(),
+        force: false,
     });
     match execute(command) {
         Ok(()) => ExitCode::SUCCESS,
@@ -47,9 +49,12 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             scenario,
             seed,
             out,
+            force,
         } => {
             let sc = Scenario::load(&scenario)?;
-            simulate(&sc, seed, &out)?;
+            let staging = Staging::new(&out, force, "simulate")?;
+            simulate(&sc, seed, staging.dir())?;
+            staging.commit()?;
             out!(
                 "wrote {} ({} s of '{}', seed {seed})",
                 out.display(),
@@ -62,12 +67,15 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             scenario,
             seed,
             out,
+            force,
         } => {
             let sc = Scenario::load(&scenario)?;
-            let dataset = out.join("dataset");
+            let staging = Staging::new(&out, force, "run")?;
+            let dataset = staging.dir().join("dataset");
             simulate(&sc, seed, &dataset)?;
             let cfg = sc.replay.clone();
-            let m = replay(&dataset, &out, &cfg, &sc.name)?;
+            let m = replay(&dataset, staging.dir(), &cfg, &sc.name)?;
+            staging.commit()?;
             print_summary(&sc.name, seed, &cfg, &m, &out);
             Ok(())
         }
@@ -75,7 +83,18 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             dataset,
             out,
             config,
+            force,
         } => {
+            if let (Ok(d), Ok(o)) = (dataset.canonicalize(), out.canonicalize()) {
+                if d.starts_with(&o) {
+                    return Err(format!(
+                        "{}: the output folder holds the dataset {}; name another folder with --out",
+                        out.display(),
+                        dataset.display()
+                    )
+                    .into());
+                }
+            }
             let cfg = match config {
                 Some(path) => {
                     let text = std::fs::read_to_string(&path)
@@ -97,7 +116,9 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             let title = dataset
                 .file_name()
                 .map_or("dataset".into(), |n| n.to_string_lossy().into_owned());
-            let m = replay(&dataset, &out, &cfg, &title)?;
+            let staging = Staging::new(&out, force, "replay")?;
+            let m = replay(&dataset, staging.dir(), &cfg, &title)?;
+            staging.commit()?;
             print_summary(&title, 0, &cfg, &m, &out);
             Ok(())
         }

@@ -282,3 +282,171 @@ fn malformed_datasets_name_file_and_line() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("imu0/data.csv"));
     let _ = std::fs::remove_dir_all(ds);
 }
+
+/// `host-sim` run from `cwd`.
+fn host_sim_in(cwd: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("host-sim runs")
+}
+
+/// Every entry of `dir`, sorted, with the contents of its files.
+fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let p = e.unwrap().path();
+            let bytes = if p.is_file() { read(&p) } else { Vec::new() };
+            (p.file_name().unwrap().to_string_lossy().into_owned(), bytes)
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+fn partial_folders_in(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("host-sim-partial") || n.contains("host-sim-old"))
+        .collect()
+}
+
+/// `--out .` (or any folder holding the current one) is refused, and nothing in it changes.
+#[test]
+fn out_dot_is_refused_and_the_folder_is_untouched() {
+    let dir = tmp("dot");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("notes.txt"), "mine\n").unwrap();
+    let before = snapshot(&dir);
+    for args in [
+        &["simulate", "--scenario", "hover", "--out", "."][..],
+        &["simulate", "--scenario", "hover", "--out", ".", "--force"][..],
+        &["run", "--scenario", "hover", "--out", ".."][..],
+    ] {
+        let o = host_sim_in(&dir, args);
+        assert!(!o.status.success(), "{args:?} should fail");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("current folder"), "{args:?}: {err}");
+        assert_eq!(snapshot(&dir), before, "{args:?} changed the folder");
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// A folder with files host-sim did not write is refused, with or without `--force`, and kept
+/// as it was; an empty folder is written.
+#[test]
+fn a_folder_with_foreign_files_is_refused_even_with_force() {
+    let parent = tmp("foreign");
+    let dir = parent.join("data");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("notes.txt"), "my notes\n").unwrap();
+    let before = snapshot(&dir);
+    for force in [false, true] {
+        let mut args = vec![
+            "simulate",
+            "--scenario",
+            "hover",
+            "--out",
+            dir.to_str().unwrap(),
+        ];
+        if force {
+            args.push("--force");
+        }
+        let o = host_sim(&args);
+        assert!(!o.status.success(), "force {force}: should fail");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("did not write"), "force {force}: {err}");
+        assert_eq!(snapshot(&dir), before);
+        assert!(partial_folders_in(&parent).is_empty());
+    }
+    let empty = parent.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let o = host_sim(&[
+        "simulate",
+        "--scenario",
+        "hover",
+        "--out",
+        empty.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(empty.join("imu0/data.csv").is_file());
+    let _ = std::fs::remove_dir_all(parent);
+}
+
+/// An earlier host-sim output is replaced only with `--force`, and a failing run over it leaves
+/// it exactly as it was (the new output is written beside it and moved in only on success).
+#[test]
+fn an_earlier_output_survives_a_failing_run_and_needs_force_to_be_replaced() {
+    let parent = tmp("earlier");
+    let ds = parent.join("ds");
+    let out = parent.join("out");
+    let sim = |seed: &str, force: bool| {
+        let mut args = vec![
+            "simulate",
+            "--scenario",
+            "hover",
+            "--seed",
+            seed,
+            "--out",
+            ds.to_str().unwrap(),
+        ];
+        if force {
+            args.push("--force");
+        }
+        host_sim(&args)
+    };
+    assert!(sim("2", false).status.success());
+    let o = sim("3", false);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--force"));
+    assert!(sim("2", true).status.success());
+
+    let replay = |force: bool| {
+        let mut args = vec![
+            "replay",
+            ds.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if force {
+            args.push("--force");
+        }
+        host_sim(&args)
+    };
+    let o = replay(false);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let good = snapshot(&out);
+    assert!(good.iter().any(|(n, _)| n == "metrics.json"));
+    // Break the dataset: the next replay fails, and the earlier output is untouched.
+    let imu = ds.join("imu0/data.csv");
+    let text = std::fs::read_to_string(&imu).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines[5] = "1,2,3";
+    std::fs::write(&imu, lines.join("\n") + "\n").unwrap();
+    let o = replay(true);
+    assert!(!o.status.success());
+    assert_eq!(
+        snapshot(&out),
+        good,
+        "a failing run changed the earlier output"
+    );
+    assert!(
+        partial_folders_in(&parent).is_empty(),
+        "{:?}",
+        partial_folders_in(&parent)
+    );
+    // The output folder may not hold the dataset it replays.
+    let o = host_sim(&[
+        "replay",
+        ds.to_str().unwrap(),
+        "--out",
+        parent.to_str().unwrap(),
+        "--force",
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("holds the dataset"));
+    let _ = std::fs::remove_dir_all(parent);
+}

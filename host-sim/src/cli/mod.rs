@@ -2,11 +2,15 @@
 //!
 //! | command | does |
 //! |---|---|
-//! | `host-sim [run] [--scenario NAME] [--seed N] [--out DIR]` | simulate, filter, score, plot; prints a summary table (default: the `default` scenario into `out/`) |
-//! | `host-sim simulate --scenario NAME [--seed N] --out DIR` | write a dataset folder with ground truth ([`crate::dataset`]) |
-//! | `host-sim replay DATASET [--out DIR] [--config FILE]` | run the filter over a dataset folder, with or without ground truth |
+//! | `host-sim [run] [--scenario NAME] [--seed N] [--out DIR] [--force]` | simulate, filter, score, plot; prints a summary table (default: the `default` scenario into `out/`) |
+//! | `host-sim simulate --scenario NAME [--seed N] --out DIR [--force]` | write a dataset folder with ground truth ([`crate::dataset`]) |
+//! | `host-sim replay DATASET [--out DIR] [--config FILE] [--force]` | run the filter over a dataset folder, with or without ground truth |
 //! | `host-sim montecarlo --scenario NAME --runs N` | consistency over seeds: NEES / NIS against chi-square bands |
 //! | `host-sim scenarios` | list the built-in scenarios |
+//!
+//! Every output folder is written beside its target and moved into place when the command
+//! succeeds; an existing folder is replaced only if it holds an earlier host-sim output and
+//! `--force` is given (`host_sim::output`).
 //!
 //! Exit status 0 on success; bad input (a missing file, a malformed row, time going backwards)
 //! gives a one-line error naming the file and the line, and a non-zero exit status.
@@ -37,6 +41,10 @@ pub enum Command {
         /// Output folder.
         #[arg(long, default_value = "out")]
         out: PathBuf,
+        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
+        /// files is never replaced).
+        #[arg(long)]
+        force: bool,
     },
     /// Write a dataset folder (EuRoC layout) with ground truth.
     Simulate {
@@ -49,6 +57,10 @@ pub enum Command {
         /// Output dataset folder.
         #[arg(long)]
         out: PathBuf,
+        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
+        /// files is never replaced).
+        #[arg(long)]
+        force: bool,
     },
     /// Run the filter over a dataset folder.
     Replay {
@@ -60,6 +72,10 @@ pub enum Command {
         /// Filter configuration (TOML).
         #[arg(long)]
         config: Option<PathBuf>,
+        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
+        /// files is never replaced).
+        #[arg(long)]
+        force: bool,
     },
     /// Consistency over seeds: NEES/NIS against chi-square bounds.
     Montecarlo {

@@ -62,24 +62,19 @@ fn io(path: &Path) -> impl Fn(std::io::Error) -> DatasetError + '_ {
     move |e| DatasetError::file(path, e)
 }
 
-/// Writes the dataset of `scenario` with `seed` into `dir` (replacing it).
+/// Writes the dataset of `scenario` with `seed` into the folder `dir` (created if absent; the
+/// command line gives it a fresh folder, see [`crate::output`]).
 pub fn simulate(scenario: &Scenario, seed: u64, dir: &Path) -> Result<(), DatasetError> {
     let traj = scenario
         .trajectory()
         .map_err(|e| DatasetError::file(dir, e))?;
-    let tmp = dir.with_extension("partial");
-    if tmp.exists() {
-        std::fs::remove_dir_all(&tmp).map_err(io(&tmp))?;
-    }
-    std::fs::create_dir_all(&tmp).map_err(io(&tmp))?;
-    let out = Out { dir: tmp.clone() };
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let out = Out {
+        dir: dir.to_path_buf(),
+    };
     write_all(scenario, &traj, seed, &out)?;
     let replay = toml::to_string(&scenario.replay).map_err(|e| DatasetError::file(dir, e))?;
     out.write("replay.toml", &format!("# How host-sim runs the filter on this dataset (host-sim replay reads it when no --config is given).\n{replay}"))?;
-    if dir.exists() {
-        std::fs::remove_dir_all(dir).map_err(io(dir))?;
-    }
-    std::fs::rename(&tmp, dir).map_err(io(dir))?;
     Ok(())
 }
 

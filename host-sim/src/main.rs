@@ -17,7 +17,7 @@ use host_sim::metrics::Metrics;
 use host_sim::output::Staging;
 use host_sim::replay::{replay, ReplayConfig};
 use host_sim::scenario::{builtin_scenarios, Scenario};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -95,24 +95,30 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                     .into());
                 }
             }
-            let cfg = match config {
+            let (cfg, source): (ReplayConfig, PathBuf) = match config {
                 Some(path) => {
                     let text = std::fs::read_to_string(&path)
                         .map_err(|e| format!("{}: {e}", path.display()))?;
-                    toml::from_str(&text).map_err(|e| {
+                    let cfg = toml::from_str(&text).map_err(|e| {
                         format!("{}: {}", path.display(), e.to_string().replace('\n', " "))
-                    })?
+                    })?;
+                    (cfg, path)
                 }
                 None => {
                     let path = dataset.join("replay.toml");
                     match std::fs::read_to_string(&path) {
-                        Ok(text) => toml::from_str(&text).map_err(|e| {
-                            format!("{}: {}", path.display(), e.to_string().replace('\n', " "))
-                        })?,
-                        Err(_) => ReplayConfig::default(),
+                        Ok(text) => {
+                            let cfg = toml::from_str(&text).map_err(|e| {
+                                format!("{}: {}", path.display(), e.to_string().replace('\n', " "))
+                            })?;
+                            (cfg, path)
+                        }
+                        Err(_) => (ReplayConfig::default(), path),
                     }
                 }
             };
+            cfg.validate()
+                .map_err(|e| format!("{}: {e}", source.display()))?;
             let title = dataset
                 .file_name()
                 .map_or("dataset".into(), |n| n.to_string_lossy().into_owned());

@@ -450,3 +450,87 @@ fn an_earlier_output_survives_a_failing_run_and_needs_force_to_be_replaced() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("holds the dataset"));
     let _ = std::fs::remove_dir_all(parent);
 }
+
+/// A misspelt key in a scenario or a replay configuration is an error naming the key and the
+/// file; values out of their domain and unknown shapes are refused by name.
+#[test]
+fn unknown_keys_and_nonsense_values_are_errors_naming_key_and_file() {
+    let dir = tmp("keys");
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases = [
+        (
+            "typo.toml",
+            "duraton_s = 10.0\n",
+            &["typo.toml", "duraton_s"][..],
+        ),
+        (
+            "nested.toml",
+            "[imu]\nrate_hz = 100.0\nprecission = 1\n",
+            &["nested.toml", "precission"][..],
+        ),
+        (
+            "negative.toml",
+            "duration_s = -5.0\n",
+            &["negative.toml", "duration_s", "-5"][..],
+        ),
+        (
+            "rate.toml",
+            "[gnss]\nrate_hz = 0.0\n",
+            &["rate.toml", "gnss.rate_hz"][..],
+        ),
+        (
+            "shape.toml",
+            "shape = \"spiral\"\n",
+            &["shape.toml", "unknown shape 'spiral'", "figure8"][..],
+        ),
+    ];
+    for (file, text, expect) in cases {
+        let path = dir.join(file);
+        std::fs::write(&path, text).unwrap();
+        let out = dir.join(format!("out-{file}"));
+        let o = host_sim(&[
+            "run",
+            "--scenario",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!o.status.success(), "{file}: should fail");
+        let err = String::from_utf8_lossy(&o.stderr);
+        for e in expect {
+            assert!(err.contains(e), "{file}: '{e}' not in: {err}");
+        }
+        assert!(!out.exists(), "{file}: an output was left");
+    }
+    // The replay configuration too.
+    let ds = dir.join("ds");
+    assert!(host_sim(&[
+        "simulate",
+        "--scenario",
+        "hover",
+        "--out",
+        ds.to_str().unwrap()
+    ])
+    .status
+    .success());
+    for (file, text, expect) in [
+        ("cfg-typo.toml", "max_dtt = 0.1\n", "max_dtt"),
+        ("cfg-zero.toml", "max_dt = 0.0\n", "max_dt = 0"),
+    ] {
+        let cfg = dir.join(file);
+        std::fs::write(&cfg, text).unwrap();
+        let out = dir.join(format!("out-{file}"));
+        let o = host_sim(&[
+            "replay",
+            ds.to_str().unwrap(),
+            "--config",
+            cfg.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!o.status.success(), "{file}: should fail");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(file) && err.contains(expect), "{file}: {err}");
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}

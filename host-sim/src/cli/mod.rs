@@ -20,7 +20,16 @@ use std::path::PathBuf;
 
 /// Simulate, replay and score the estimator.
 #[derive(Debug, Parser)]
-#[command(name = "host-sim", version, about)]
+#[command(
+    name = "host-sim",
+    version,
+    about,
+    after_help = "Without a command, runs `host-sim run`: 60 s of the `default` scenario into out/ \
+(refused if out/ exists and is not empty; an earlier host-sim output is replaced by `host-sim run --force`).\n\n\
+Examples:\n  host-sim scenarios\n  host-sim run --scenario car --seed 3 --out out/car\n  \
+host-sim simulate --scenario car --out data/car\n  host-sim replay data/car --out out/car\n  \
+host-sim montecarlo --scenario matched_ins --runs 60 --check"
+)]
 pub struct Cli {
     /// What to do (default: `run`).
     #[command(subcommand)]
@@ -31,6 +40,11 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Simulate, filter, score and plot; prints a summary table.
+    #[command(
+        after_help = "Writes into --out: estimate.tum, estimate.csv, groundtruth.tum (TUM: t x y z qx qy qz qw), \
+metrics.json, trajectory.png, errors.png, biases.png, nis.png, and dataset/ (the simulated EuRoC-layout dataset).\n\n\
+Example: host-sim run --scenario handheld_ahrs --seed 2 --out out/ahrs"
+    )]
     Run {
         /// A built-in scenario name or a TOML file.
         #[arg(long, default_value = "default")]
@@ -47,6 +61,11 @@ pub enum Command {
         force: bool,
     },
     /// Write a dataset folder (EuRoC layout) with ground truth.
+    #[command(
+        after_help = "Writes into --out: imu0/, and mag0/, gnss0/, baro0/ as the scenario has them \
+(data.csv and sensor.yaml each), cam0/ (sensor.yaml, landmarks.csv, observations.csv), state_groundtruth_estimate0/data.csv, and replay.toml (how `replay` runs on it).\n\n\
+Example: host-sim simulate --scenario car --seed 3 --out data/car"
+    )]
     Simulate {
         /// A built-in scenario name or a TOML file.
         #[arg(long)]
@@ -63,6 +82,12 @@ pub enum Command {
         force: bool,
     },
     /// Run the filter over a dataset folder.
+    #[command(
+        after_help = "Reads DATASET (EuRoC layout: imu0/ required; mag0/, gnss0/, cam0/, baro0/, \
+state_groundtruth_estimate0/ when present) and its replay.toml unless --config is given.\n\
+Writes into --out the same files as `run` (without dataset/).\n\n\
+Example: host-sim replay data/car --out out/car"
+    )]
     Replay {
         /// The dataset folder.
         dataset: PathBuf,
@@ -78,6 +103,10 @@ pub enum Command {
         force: bool,
     },
     /// Consistency over seeds: NEES/NIS against chi-square bounds.
+    #[command(
+        after_help = "Prints the mean NEES and NIS over the runs against their 95 % chi-square bands; \
+writes nothing.\n\nExample: host-sim montecarlo --scenario matched_ins --runs 60 --check"
+    )]
     Montecarlo {
         /// A built-in scenario name or a TOML file.
         #[arg(long)]

@@ -37,6 +37,7 @@ use std::time::Instant;
 /// Replay options (a TOML file given with `--config`; every field optional).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct ReplayConfig {
     /// `"f32"` (the firmware's precision) or `"f64"`.
     pub precision: String,
@@ -65,6 +66,46 @@ pub struct ReplayConfig {
     pub instantaneous_imu: bool,
     /// Write the plots.
     pub plots: bool,
+}
+
+impl ReplayConfig {
+    /// `Ok` when every value is in its domain.
+    ///
+    /// # Errors
+    /// The first value out of its domain, named.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.precision != "f32" && self.precision != "f64" {
+            return Err(format!(
+                "precision = \"{}\": must be \"f32\" or \"f64\"",
+                self.precision
+            ));
+        }
+        let positive = [
+            ("align_window_s", self.align_window_s),
+            ("max_dt", self.max_dt),
+            ("gravity_gate", self.gravity_gate),
+        ];
+        for (name, x) in positive {
+            if !(x.is_finite() && x > 0.0) {
+                return Err(format!("{name} = {x}: must be a positive number"));
+            }
+        }
+        for (name, x) in [
+            ("gravity_floor", self.gravity_floor),
+            ("gravity_mismatch_gain", self.gravity_mismatch_gain),
+        ] {
+            if !(x.is_finite() && x >= 0.0) {
+                return Err(format!("{name} = {x}: must be 0 or more"));
+            }
+        }
+        if self.gravity_every == 0 {
+            return Err("gravity_every = 0: must be 1 or more".into());
+        }
+        if !self.gravity.iter().all(|g| g.is_finite()) {
+            return Err("gravity: must be finite".into());
+        }
+        Ok(())
+    }
 }
 
 impl Default for ReplayConfig {

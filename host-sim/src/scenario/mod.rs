@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 /// Accuracy ceilings the end-to-end tests hold a filter to on this scenario.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct Ceilings {
     /// Position RMSE (ATE), m.
     pub ate_m: f64,
@@ -35,6 +36,7 @@ impl Default for Ceilings {
 /// A complete scenario.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct Scenario {
     /// Name.
     pub name: String,
@@ -97,6 +99,24 @@ pub enum ScenarioError {
     /// No built-in scenario has that name and no such file exists.
     #[error("unknown scenario '{0}' (see `host-sim scenarios`, or give a .toml file)")]
     Unknown(String),
+    /// The scenario names a trajectory shape that does not exist.
+    #[error("{path}: unknown shape '{shape}' (one of: {known})")]
+    UnknownShape {
+        /// The scenario (file or name).
+        path: String,
+        /// The shape asked for.
+        shape: String,
+        /// The shapes that exist.
+        known: String,
+    },
+    /// A value out of its domain.
+    #[error("{path}: {message}")]
+    Invalid {
+        /// The scenario (file or name).
+        path: String,
+        /// Which value, and why.
+        message: String,
+    },
     /// The TOML file could not be read or parsed.
     #[error("{path}: {message}")]
     File {
@@ -112,9 +132,49 @@ impl Scenario {
     pub fn trajectory(&self) -> Result<Trajectory, ScenarioError> {
         match &self.trajectory {
             Some(t) => Ok(t.clone()),
-            None => builtin(&self.shape, self.static_s)
-                .ok_or_else(|| ScenarioError::Unknown(format!("shape {}", self.shape))),
+            None => {
+                builtin(&self.shape, self.static_s).ok_or_else(|| ScenarioError::UnknownShape {
+                    path: self.name.clone(),
+                    shape: self.shape.clone(),
+                    known: crate::trajectory::SHAPES.join(", "),
+                })
+            }
         }
+    }
+
+    /// `Ok` when every value is in its domain: a positive finite duration, a non-negative static
+    /// period, positive sensor rates, a finite gravity, and a valid replay configuration.
+    ///
+    /// # Errors
+    /// The first value out of its domain, named.
+    pub fn validate(&self) -> Result<(), String> {
+        let positive = |name: &str, x: f64| {
+            if x.is_finite() && x > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{name} = {x}: must be a positive number"))
+            }
+        };
+        positive("duration_s", self.duration_s)?;
+        if !(self.static_s.is_finite() && self.static_s >= 0.0) {
+            return Err(format!("static_s = {}: must be 0 or more", self.static_s));
+        }
+        if !self.gravity.iter().all(|g| g.is_finite()) {
+            return Err("gravity: must be finite".into());
+        }
+        positive("imu.rate_hz", self.imu.rate_hz)?;
+        let rates = [
+            ("mag.rate_hz", self.mag.as_ref().map(|c| c.rate_hz)),
+            ("gnss.rate_hz", self.gnss.as_ref().map(|c| c.rate_hz)),
+            ("camera.rate_hz", self.camera.as_ref().map(|c| c.rate_hz)),
+            ("baro.rate_hz", self.baro.as_ref().map(|c| c.rate_hz)),
+        ];
+        for (name, rate) in rates {
+            if let Some(r) = rate {
+                positive(name, r)?;
+            }
+        }
+        self.replay.validate().map_err(|e| format!("replay.{e}"))
     }
 
     /// A built-in scenario by name, or a TOML file by path.
@@ -134,7 +194,18 @@ impl Scenario {
             if s.name == "custom" {
                 s.name = name.into();
             }
-            s.trajectory()?;
+            s.validate().map_err(|message| ScenarioError::Invalid {
+                path: name.into(),
+                message,
+            })?;
+            s.trajectory().map_err(|e| match e {
+                ScenarioError::UnknownShape { shape, known, .. } => ScenarioError::UnknownShape {
+                    path: name.into(),
+                    shape,
+                    known,
+                },
+                e => e,
+            })?;
             return Ok(s);
         }
         Err(ScenarioError::Unknown(name.into()))

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 /// Barometer parameters.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct BaroConfig {
     /// Sample rate, Hz.
     pub rate_hz: f64,

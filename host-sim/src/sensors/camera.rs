@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 /// Camera parameters.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct CameraConfig {
     /// Frame rate, Hz.
     pub rate_hz: f64,

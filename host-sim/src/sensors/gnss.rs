@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 /// GNSS parameters.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct GnssConfig {
     /// Fix rate, Hz.
     pub rate_hz: f64,

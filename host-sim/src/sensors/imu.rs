@@ -24,6 +24,7 @@ use serde::{Deserialize, Serialize};
 /// IMU parameters.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct ImuConfig {
     /// Sample rate, Hz.
     pub rate_hz: f64,

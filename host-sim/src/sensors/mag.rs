@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 /// Magnetometer parameters.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct MagConfig {
     /// Sample rate, Hz.
     pub rate_hz: f64,

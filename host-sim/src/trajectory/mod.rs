@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 
 /// One term of a scalar signal: `amplitude · sin(2π·frequency_hz·τ + phase)`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Sine {
     /// Amplitude (m or rad).
     pub amplitude: f64,
@@ -30,6 +31,7 @@ pub struct Sine {
 
 /// A scalar signal `offset + rate·τ + Σ sines`, with its first two derivatives.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Signal {
     /// Constant offset.
     #[serde(default)]
@@ -97,6 +99,7 @@ pub struct Kinematics {
 
 /// An analytic trajectory: see the module docs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Trajectory {
     /// Length of the initial static period, s.
     pub static_s: f64,

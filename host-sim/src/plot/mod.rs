@@ -2,8 +2,8 @@
 //! errors inside their ±3σ bands, bias estimates against truth, and NIS per sensor against its
 //! chi-square bounds.
 //!
-//! Text needs a TrueType font: DejaVu Sans from the system (Debian's `fonts-dejavu-core`), or
-//! the file named by `HOST_SIM_FONT`. Without one the plots are skipped with a warning.
+//! Text needs a TrueType font: DejaVu Sans from the system (Debian's `fonts-dejavu-core`), Arial on
+//! macOS and Windows, or the file named by `HOST_SIM_FONT`. Without one the plots are skipped with a warning.
 
 use crate::metrics::{HistoryPoint, Scorer, BLOCKS};
 use crate::stats::chi2_quantile;
@@ -17,10 +17,16 @@ pub const FILES: [&str; 4] = ["trajectory.png", "errors.png", "biases.png", "nis
 
 type PlotResult = Result<(), Box<dyn std::error::Error>>;
 
-const FONT_PATHS: [&str; 3] = [
+/// Where the common systems keep a sans-serif TrueType font: Debian/Ubuntu, Fedora, Arch,
+/// macOS, Windows.
+const FONT_PATHS: [&str; 7] = [
     "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
     "/usr/share/fonts/dejavu/DejaVuSans.ttf",
     "/usr/share/fonts/TTF/DejaVuSans.ttf",
+    "/System/Library/Fonts/Supplemental/Arial.ttf",
+    "/Library/Fonts/Arial.ttf",
+    "C:\\Windows\\Fonts\\arial.ttf",
+    "C:\\Windows\\Fonts\\DejaVuSans.ttf",
 ];
 
 /// Registers a font once; `false` when none could be found.

@@ -124,6 +124,14 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                 .map_or("dataset".into(), |n| n.to_string_lossy().into_owned());
             let staging = Staging::new(&out, force, "replay")?;
             let m = replay(&dataset, staging.dir(), &cfg, &title)?;
+            let truth = dataset.join("state_groundtruth_estimate0/data.csv");
+            if m.samples_scored == 0 && truth.is_file() {
+                return Err(format!(
+                    "{}: no estimate could be scored against it (empty, or no time in common with the IMU); nothing written",
+                    truth.display()
+                )
+                .into());
+            }
             staging.commit()?;
             print_summary(&title, 0, &cfg, &m, &out);
             Ok(())
@@ -178,6 +186,9 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
 
 fn print_summary(name: &str, seed: u64, cfg: &ReplayConfig, m: &Metrics, out: &Path) {
     out!("scenario {name}  seed {seed}  precision {}", cfg.precision);
+    if m.samples_scored == 0 {
+        out!("  not scored: the dataset has no ground truth (the estimate is in the outputs)");
+    }
     out!(
         "  {:<28} {:>12}",
         "position RMSE (ATE) [m]",

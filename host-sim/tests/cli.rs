@@ -534,3 +534,38 @@ fn unknown_keys_and_nonsense_values_are_errors_naming_key_and_file() {
     }
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// An empty ground truth scores nothing: an error and no output, never an RMSE of 0.
+#[test]
+fn an_empty_ground_truth_is_an_error_not_a_zero_rmse() {
+    let dir = tmp("empty-gt");
+    let ds = dir.join("ds");
+    assert!(host_sim(&[
+        "simulate",
+        "--scenario",
+        "hover",
+        "--out",
+        ds.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let gt = ds.join("state_groundtruth_estimate0/data.csv");
+    let header = std::fs::read_to_string(&gt)
+        .unwrap()
+        .lines()
+        .next()
+        .unwrap()
+        .to_string();
+    std::fs::write(&gt, header + "\n").unwrap();
+    let out = dir.join("out");
+    let o = host_sim(&[
+        "replay",
+        ds.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no estimate could be scored"));
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -205,7 +205,7 @@ pub struct Scorer {
 pub struct Metrics {
     /// Position RMSE over the run, m (no alignment: the world frame is absolute).
     pub ate_position_rmse_m: f64,
-    /// Attitude RMSE, degrees.
+    /// Attitude RMSE, degrees (NaN, written `null`, when nothing was scored).
     pub attitude_rmse_deg: f64,
     /// Velocity RMSE, m/s.
     pub velocity_rmse_mps: f64,
@@ -324,7 +324,12 @@ impl Scorer {
             } else {
                 f64::NAN
             },
-            attitude_rmse_deg: rmse(0).to_degrees(),
+            // Nothing scored is no number (`null` in metrics.json), never 0.
+            attitude_rmse_deg: if self.n > 0 {
+                rmse(0).to_degrees()
+            } else {
+                f64::NAN
+            },
             velocity_rmse_mps: if self.nees_n[1] > 0 {
                 rmse(1)
             } else {

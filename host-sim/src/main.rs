@@ -17,7 +17,7 @@ use host_sim::metrics::Metrics;
 use host_sim::output::Staging;
 use host_sim::replay::{replay, ReplayConfig};
 use host_sim::scenario::{builtin_scenarios, Scenario};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -95,27 +95,17 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                     .into());
                 }
             }
-            let (cfg, source): (ReplayConfig, PathBuf) = match config {
-                Some(path) => {
-                    let text = std::fs::read_to_string(&path)
-                        .map_err(|e| format!("{}: {e}", path.display()))?;
-                    let cfg = toml::from_str(&text).map_err(|e| {
-                        format!("{}: {}", path.display(), e.to_string().replace('\n', " "))
-                    })?;
-                    (cfg, path)
+            // The given configuration, else the dataset's replay.toml, else the defaults.
+            let given = config.is_some();
+            let source = config.unwrap_or_else(|| dataset.join("replay.toml"));
+            let cfg = match std::fs::read_to_string(&source) {
+                Ok(text) => toml::from_str(&text).map_err(|e| {
+                    format!("{}: {}", source.display(), e.to_string().replace('\n', " "))
+                })?,
+                Err(e) if !given && e.kind() == std::io::ErrorKind::NotFound => {
+                    ReplayConfig::default()
                 }
-                None => {
-                    let path = dataset.join("replay.toml");
-                    match std::fs::read_to_string(&path) {
-                        Ok(text) => {
-                            let cfg = toml::from_str(&text).map_err(|e| {
-                                format!("{}: {}", path.display(), e.to_string().replace('\n', " "))
-                            })?;
-                            (cfg, path)
-                        }
-                        Err(_) => (ReplayConfig::default(), path),
-                    }
-                }
+                Err(e) => return Err(format!("{}: {e}", source.display()).into()),
             };
             cfg.validate()
                 .map_err(|e| format!("{}: {e}", source.display()))?;

@@ -152,12 +152,6 @@ impl Staging {
         &self.tmp
     }
 
-    /// The folder the output will have when committed.
-    #[must_use]
-    pub fn target(&self) -> &Path {
-        &self.target
-    }
-
     /// Moves the finished output into place: the target, if it is an empty folder or a previous
     /// host-sim output (checked again now), is moved aside, the new output renamed onto it, and
     /// only then the old one removed.

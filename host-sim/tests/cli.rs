@@ -18,6 +18,18 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
+/// `host-sim simulate --scenario NAME --out DIR`, which must succeed.
+fn simulate(scenario: &str, out: &Path) {
+    let o = host_sim(&[
+        "simulate",
+        "--scenario",
+        scenario,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 fn read(p: &Path) -> Vec<u8> {
     std::fs::read(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
@@ -504,15 +516,7 @@ fn unknown_keys_and_nonsense_values_are_errors_naming_key_and_file() {
     }
     // The replay configuration too.
     let ds = dir.join("ds");
-    assert!(host_sim(&[
-        "simulate",
-        "--scenario",
-        "hover",
-        "--out",
-        ds.to_str().unwrap()
-    ])
-    .status
-    .success());
+    simulate("hover", &ds);
     for (file, text, expect) in [
         ("cfg-typo.toml", "max_dtt = 0.1\n", "max_dtt"),
         ("cfg-zero.toml", "max_dt = 0.0\n", "max_dt = 0"),
@@ -540,15 +544,7 @@ fn unknown_keys_and_nonsense_values_are_errors_naming_key_and_file() {
 fn an_empty_ground_truth_is_an_error_not_a_zero_rmse() {
     let dir = tmp("empty-gt");
     let ds = dir.join("ds");
-    assert!(host_sim(&[
-        "simulate",
-        "--scenario",
-        "hover",
-        "--out",
-        ds.to_str().unwrap()
-    ])
-    .status
-    .success());
+    simulate("hover", &ds);
     let gt = ds.join("state_groundtruth_estimate0/data.csv");
     let header = std::fs::read_to_string(&gt)
         .unwrap()

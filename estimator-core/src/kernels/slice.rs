@@ -15,6 +15,14 @@ pub(crate) fn axpy<T: Real>(y: &mut [T], a: T, x: &[T]) {
     }
 }
 
+/// `out ← A x` for the column-major `out.len() × x.len()` matrix `a`.
+pub(crate) fn mat_vec<T: Real>(a: &[T], x: &[T], out: &mut [T]) {
+    out.fill(T::zero());
+    for (col, xj) in a.chunks_exact(out.len().max(1)).zip(x) {
+        axpy(out, *xj, col);
+    }
+}
+
 /// `‖a − b‖₂` over the common length.
 #[must_use]
 pub(crate) fn distance<T: Real>(a: &[T], b: &[T]) -> T {
@@ -110,6 +118,15 @@ mod tests {
         assert_eq!(&out[..6], m.transpose().as_slice());
         assert_eq!(&out[6..], &[0.0; 3]);
         assert_eq!(v, [7.0, 8.0, 0.0]);
+    }
+
+    #[test]
+    fn mat_vec_is_the_matrix_vector_product() {
+        let a = nalgebra::Matrix3x2::new(1.0, 2.0, 3.0, 4.0, 5.0, 6.0);
+        let x = nalgebra::Vector2::new(0.5, -1.0);
+        let mut out = [0.0; 3];
+        mat_vec(a.as_slice(), x.as_slice(), &mut out);
+        assert_eq!(out.as_slice(), (a * x).as_slice());
     }
 
     #[test]

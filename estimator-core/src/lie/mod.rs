@@ -370,8 +370,6 @@ pub(crate) fn skew_poly<T: Real>(s: T, p: T, q: T, w: &Vector3<T>) -> Matrix3<T>
     )
 }
 
-pub(crate) use crate::kernels::{all_finite, positive_finite};
-
 /// `true` when `m` is within [`ORTHOGONALITY_TOLERANCE`] of SO(N): `‖mᵀm − I‖_F ≤ tol` and
 /// `det m > 0`. `false` for a non-finite entry, whose square makes the error infinite or NaN.
 pub(crate) fn near_rotation<T: Real, const N: usize>(m: &SMatrix<T, N, N>) -> bool

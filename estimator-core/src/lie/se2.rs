@@ -20,7 +20,8 @@
 
 use super::so2::So2;
 use super::trig::{half_cot, poly, AngleCoeffs, Cutoff};
-use super::{all_finite, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use crate::kernels::all_finite;
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
 
 /// A planar rigid motion `T = (R, t) ∈ SE(2)`.

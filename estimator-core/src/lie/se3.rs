@@ -25,7 +25,8 @@
 
 use super::so3::So3;
 use super::trig::AngleCoeffs;
-use super::{all_finite, skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use super::{skew_poly, LieGroup, Real, ORTHOGONALITY_TOLERANCE};
+use crate::kernels::all_finite;
 use crate::kernels::block::set_block;
 use crate::kernels::mat3::{mul, mul_skew};
 use nalgebra::{Matrix3, Matrix3x6, Matrix4, Matrix6, Vector3, Vector6};

@@ -5,7 +5,8 @@
 //! `Ad = J_r = J_l = 1`. `act_jac(p) = (R p, R G¹ p, R)`: Theorem 5.1 of *Lie Groups and Smooth
 //! Manifolds for Robotic State Estimation*, `F = R [H(p) | I]` with `H(p) = G¹p`.
 
-use super::{all_finite, near_rotation, positive_finite, LieGroup, Real};
+use super::{near_rotation, LieGroup, Real};
+use crate::kernels::{all_finite, positive_finite};
 use nalgebra::{Matrix1, Matrix2, Matrix2x1, Vector1, Vector2};
 
 /// A planar rotation `R ∈ SO(2)`.

@@ -19,8 +19,9 @@
 //! `(1 − cos θ)/θ²`, `(θ − sin θ)/θ³`, `1/θ² − (1 + cos θ)/(2θ sin θ)`).
 
 use super::trig::{half_sinc, poly, AngleCoeffs, Cutoff};
-use super::{all_finite, near_rotation, positive_finite, skew, skew_poly, LieGroup, Real};
+use super::{near_rotation, skew, skew_poly, LieGroup, Real};
 use crate::kernels::mat3::{mul_skew, mul_vec};
+use crate::kernels::{all_finite, positive_finite};
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3, Vector4};
 
 /// A 3-D rotation `R ∈ SO(3)`, stored as a unit Hamilton quaternion.

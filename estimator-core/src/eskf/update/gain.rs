@@ -5,7 +5,7 @@ use super::options::UpdateOptions;
 use super::work::Work;
 use crate::eskf::error::{EskfError, UpdateOutcome};
 use crate::kernels::cholesky::{factor_in_place, inverse_into};
-use crate::kernels::slice::{axpy, distance, dot};
+use crate::kernels::slice::{axpy, distance, dot, mat_vec};
 use crate::kernels::{all_finite, slice::symmetrize};
 use crate::Real;
 use nalgebra::SVector;
@@ -87,14 +87,6 @@ pub(super) fn gate_step<T: Real, const N: usize, const C: usize>(
     Ok(UpdateOutcome::Accepted { nis, iterations: 1 })
 }
 
-/// `out = A x` for the column-major `out.len() × x.len()` matrix `a`.
-fn mat_vec<T: Real>(a: &[T], x: &[T], out: &mut [T]) {
-    out.fill(T::zero());
-    for (col, xj) in a.chunks_exact(out.len().max(1)).zip(x) {
-        axpy(out, *xj, col);
-    }
-}
-
 /// One Gauss-Newton step after a re-linearization: the gain there, then
 /// `δx_{k+1} = K_k (r_k + H̃_k δx_k)` into `w.dx`. `None` (with `U`, `S`, `K` and `δx` as they
 /// were) when the gain or the step failed, else whether `‖δx_{k+1} − δx_k‖ < tol`.
@@ -123,18 +115,4 @@ pub(super) fn step<T: Real, const N: usize, const C: usize>(
     let converged = distance(next.as_slice(), w.dx.as_slice()) < opts.step_tolerance;
     w.dx = next;
     Some(converged)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::mat_vec;
-
-    #[test]
-    fn mat_vec_is_the_matrix_vector_product() {
-        let a = nalgebra::Matrix3x2::new(1.0, 2.0, 3.0, 4.0, 5.0, 6.0);
-        let x = nalgebra::Vector2::new(0.5, -1.0);
-        let mut out = [0.0; 3];
-        mat_vec(a.as_slice(), x.as_slice(), &mut out);
-        assert_eq!(out.as_slice(), (a * x).as_slice());
-    }
 }

@@ -32,6 +32,7 @@ pub mod eskf;
 pub mod gn;
 mod kernels;
 pub mod lie;
+pub mod nav;
 pub mod scalar;
 // The unit tests share the integration tests' support module (and need `std` for it).
 #[cfg(test)]

@@ -62,6 +62,14 @@ pub trait Real: RealField + Copy + sealed::Sealed {
     /// Widens to `f64` (for casts between precisions, tests and host tools; never on an `f32`
     /// hot path).
     fn to_f64(self) -> f64;
+
+    /// Converts a count (a nanosecond interval, a number of samples), rounding to nearest: one
+    /// instruction on a Cortex-M4F for `f32`, no `f64` on the way.
+    fn from_count(x: u32) -> Self;
+
+    /// Converts to a count, truncating toward zero and saturating: `0` for a negative value or
+    /// NaN, `u32::MAX` above it. One instruction on a Cortex-M4F for `f32`.
+    fn to_count(self) -> u32;
 }
 
 impl Real for f64 {
@@ -82,6 +90,14 @@ impl Real for f64 {
     fn to_f64(self) -> f64 {
         self
     }
+
+    fn from_count(x: u32) -> Self {
+        f64::from(x)
+    }
+
+    fn to_count(self) -> u32 {
+        self as u32
+    }
 }
 
 impl Real for f32 {
@@ -101,6 +117,14 @@ impl Real for f32 {
 
     fn to_f64(self) -> f64 {
         self as f64
+    }
+
+    fn from_count(x: u32) -> Self {
+        x as f32
+    }
+
+    fn to_count(self) -> u32 {
+        self as u32
     }
 }
 

@@ -6,7 +6,8 @@ use super::covariance::{check_start, sigmas};
 use super::error::{EskfError, UpdateOutcome};
 use super::state::{sealed::Sealed, AhrsState, ErrorState, InsState};
 use super::update::{update, Measurement, UpdateOptions};
-use crate::kernels::block::{add_scaled_identity, set_block};
+use crate::kernels::block::{add_scaled_identity, block, set_block};
+use crate::kernels::{all_finite, non_negative_finite};
 use crate::Real;
 use nalgebra::{SMatrix, SVector, Vector3};
 
@@ -108,6 +109,44 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
     #[must_use]
     pub fn sigmas(&self) -> SVector<T, N> {
         sigmas(&self.covariance)
+    }
+
+    /// Widens the attitude uncertainty: adds `Rᵀ Σ_w R` to the attitude block of `P`, with
+    /// `Σ_w = σ_t² I + (σ_ψ² − σ_t²) u uᵀ` the world-frame covariance of `tilt` (about the
+    /// horizontal axes) and `yaw` (about the up direction `u = −g/‖g‖`), both in radians.
+    /// Adding a positive semi-definite matrix keeps `P` positive definite; a navigator calls it
+    /// when the data say the estimate is worse than `P` claims.
+    ///
+    /// # Errors
+    /// [`EskfError::NonFinite`] for a negative or non-finite sigma, [`EskfError::ZeroNorm`] for
+    /// a zero gravity, [`EskfError::NumericalFailure`] when `P` would overflow; `P` is then
+    /// unchanged.
+    pub fn widen_attitude(&mut self, tilt: T, yaw: T) -> Result<(), EskfError> {
+        if !(non_negative_finite(tilt) && non_negative_finite(yaw)) {
+            return Err(EskfError::NonFinite);
+        }
+        let sigmas = InitialSigmas {
+            tilt,
+            yaw,
+            ..InitialSigmas::default()
+        };
+        let alignment = Alignment {
+            attitude: *self.state.attitude(),
+            gyro_bias: Vector3::zeros(),
+            heading_from_magnetometer: false,
+        };
+        let extra = match prior_attitude_covariance(&alignment, &sigmas, &self.config) {
+            Ok(m) => m,
+            Err(e) => return Err(e),
+        };
+        let mut p = self.covariance;
+        let widened = block(&p, 0, 0) + extra;
+        set_block(&mut p, 0, 0, &widened);
+        if !all_finite(p.as_slice()) {
+            return Err(EskfError::NumericalFailure);
+        }
+        self.covariance = p;
+        Ok(())
     }
 
     /// Propagates with one IMU sample: nominal integration and `P⁺ = F P Fᵀ + Q` (equations in

@@ -136,7 +136,8 @@ pub use error::{EskfError, UpdateOutcome};
 pub use filter::{Ahrs, Filter, Ins};
 pub use models::{
     AccelerometerAtRest, BaroAltitude, CameraLandmark, GnssPosition, GnssVelocity,
-    GravityDirection, Heading, Magnetometer, PinholeIntrinsics, ZeroVelocity,
+    GravityDirection, Heading, MagneticHeading, Magnetometer, PinholeIntrinsics, ZeroRate,
+    ZeroVelocity,
 };
 pub use state::{AhrsState, ErrorState, InsState};
 pub use update::gate::{Gate, GateProbability, CHI_SQUARE_TABLE};

@@ -34,6 +34,11 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+mod attitude;
+mod output;
+
+use output::{write_estimate_csv, write_tum, Partials, TruthCursor};
+
 /// Replay options (a TOML file given with `--config`; every field optional).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -41,26 +46,26 @@ use std::time::Instant;
 pub struct ReplayConfig {
     /// `"f32"` (the firmware's precision) or `"f64"`.
     pub precision: String,
-    /// Length of the at-rest window used for alignment, s.
+    /// Length of the start-up window, s: averaged for the first attitude (at rest or moving).
     pub align_window_s: f64,
     /// Gravity, world frame, m/s².
     pub gravity: [f64; 3],
-    /// Largest accepted IMU interval, s.
+    /// Largest accepted IMU interval, s; a longer one is a gap (the attitude navigator starts
+    /// again).
     pub max_dt: f64,
-    /// Tilt aiding of the attitude-only filter: the unmodelled linear acceleration, as a floor
-    /// on the 1σ of the measured gravity direction, rad. The full 1σ is
-    /// `√(σ_w² + (k e/g)² + floor²)`, with `σ_w = accelerometer_noise_density·√rate / g` the white
-    /// noise of one sample and `e = max(0, |‖f‖ − g| − 3σ_w g)` the magnitude mismatch beyond the
-    /// noise, which reveals a linear acceleration along gravity; the floor stands for the part
-    /// across it, which the magnitude cannot show. Set it to 0 only where the body does not
-    /// accelerate (pure rotation).
-    pub gravity_floor: f64,
-    /// The factor `k` on `e` above (0 where the body is known not to accelerate).
-    pub gravity_mismatch_gain: f64,
-    /// Tilt aiding only while `|‖f‖ − g|` is below this, m/s².
-    pub gravity_gate: f64,
-    /// Tilt aiding every this many IMU samples.
-    pub gravity_every: u64,
+    /// Attitude navigator: length of an aiding block, s.
+    pub block_s: f64,
+    /// Attitude navigator: correlation time of the body's linear acceleration, s.
+    pub acceleration_correlation_s: f64,
+    /// Attitude navigator: 1σ of the accelerometer bias per axis, m/s² (the tilt floor is
+    /// this over g; 0 where the accelerometer has no bias).
+    pub accelerometer_bias_sigma: f64,
+    /// Attitude navigator: 1σ of the gyro bias at switch-on, °/s.
+    pub gyro_bias_sigma_dps: f64,
+    /// Attitude navigator: heading noise of one magnetometer block beyond the white noise, °.
+    pub heading_noise_deg: f64,
+    /// Attitude navigator: lower bound on the heading's 1σ with a magnetometer, °.
+    pub heading_floor_deg: f64,
     /// The IMU samples are instantaneous values (integrate with the trapezoidal rule) rather
     /// than means over the period ending at their timestamp.
     pub instantaneous_imu: bool,
@@ -83,7 +88,8 @@ impl ReplayConfig {
         let positive = [
             ("align_window_s", self.align_window_s),
             ("max_dt", self.max_dt),
-            ("gravity_gate", self.gravity_gate),
+            ("block_s", self.block_s),
+            ("acceleration_correlation_s", self.acceleration_correlation_s),
         ];
         for (name, x) in positive {
             if !(x.is_finite() && x > 0.0) {
@@ -91,15 +97,19 @@ impl ReplayConfig {
             }
         }
         for (name, x) in [
-            ("gravity_floor", self.gravity_floor),
-            ("gravity_mismatch_gain", self.gravity_mismatch_gain),
+            ("accelerometer_bias_sigma", self.accelerometer_bias_sigma),
+            ("gyro_bias_sigma_dps", self.gyro_bias_sigma_dps),
+            ("heading_noise_deg", self.heading_noise_deg),
+            ("heading_floor_deg", self.heading_floor_deg),
         ] {
             if !(x.is_finite() && x >= 0.0) {
                 return Err(format!("{name} = {x}: must be 0 or more"));
             }
         }
-        if self.gravity_every == 0 {
-            return Err("gravity_every = 0: must be 1 or more".into());
+        for (name, x) in [("align_window_s", self.align_window_s), ("block_s", self.block_s), ("max_dt", self.max_dt)] {
+            if x >= 4.0 {
+                return Err(format!("{name} = {x}: must be below 4 s"));
+            }
         }
         if !self.gravity.iter().all(|g| g.is_finite()) {
             return Err("gravity: must be finite".into());
@@ -115,10 +125,12 @@ impl Default for ReplayConfig {
             align_window_s: 1.0,
             gravity: [0.0, 0.0, -9.81],
             max_dt: 0.1,
-            gravity_floor: 0.02,
-            gravity_mismatch_gain: 2.0,
-            gravity_gate: 1.0,
-            gravity_every: 4,
+            block_s: 0.25,
+            acceleration_correlation_s: 0.3,
+            accelerometer_bias_sigma: 0.1,
+            gyro_bias_sigma_dps: 0.5,
+            heading_noise_deg: 2.0,
+            heading_floor_deg: 1.0,
             instantaneous_imu: true,
             plots: true,
         }
@@ -271,72 +283,6 @@ pub fn replay_scored(
     }
 }
 
-/// The truth at arbitrary times, streamed: keeps the two rows around the requested time.
-struct TruthCursor {
-    stream: TruthStream,
-    prev: Option<Truth>,
-    next: Option<Truth>,
-    tum: BufWriter<File>,
-    tum_path: PathBuf,
-}
-
-impl TruthCursor {
-    /// Reads one more row into `next`, copying it to `groundtruth.tum`.
-    fn advance(&mut self) -> Result<(), ReplayError> {
-        self.prev = self.next.take();
-        self.next = self.stream.next_truth()?;
-        if let Some(n) = &self.next {
-            write_tum(&mut self.tum, n.t_ns, &n.position, &n.attitude)
-                .map_err(out_err(&self.tum_path))?;
-        }
-        Ok(())
-    }
-
-    /// The truth at `t_ns`, interpolated between the rows around it; `None` outside the truth.
-    fn at(&mut self, t_ns: u64) -> Result<Option<Truth>, ReplayError> {
-        if self.prev.is_none() && self.next.is_none() {
-            self.advance()?;
-            self.prev = None;
-        }
-        while self.next.is_some_and(|n| n.t_ns < t_ns) {
-            self.advance()?;
-        }
-        Ok(match (self.prev, self.next) {
-            (_, Some(b)) if b.t_ns == t_ns => Some(b),
-            (Some(a), Some(b)) if a.t_ns <= t_ns => Some(interpolate_truth(&a, &b, t_ns)),
-            _ => None,
-        })
-    }
-
-    /// Copies the remaining rows to `groundtruth.tum`.
-    fn finish(&mut self) -> Result<(), ReplayError> {
-        while self.next.is_some() || self.prev.is_none() {
-            self.advance()?;
-            if self.next.is_none() {
-                break;
-            }
-        }
-        self.tum.flush().map_err(out_err(&self.tum_path))
-    }
-}
-
-fn write_tum(f: &mut impl Write, t_ns: u64, p: &Vector3<f64>, r: &So3<f64>) -> std::io::Result<()> {
-    let q = r.quaternion();
-    writeln!(
-        f,
-        "{}.{:09} {:.6} {:.6} {:.6} {:.9} {:.9} {:.9} {:.9}",
-        t_ns / 1_000_000_000,
-        t_ns % 1_000_000_000,
-        p.x,
-        p.y,
-        p.z,
-        q.i,
-        q.j,
-        q.k,
-        q.w
-    )
-}
-
 fn replay_in<T: Real>(
     dir: &Path,
     out: &Path,
@@ -346,6 +292,9 @@ fn replay_in<T: Real>(
 ) -> Result<Scorer, ReplayError> {
     let ds = Dataset::open(dir)?;
     std::fs::create_dir_all(out).map_err(out_err(out))?;
+    if ds.gnss.is_none() && ds.camera.is_none() {
+        return attitude::replay_attitude::<T>(&ds, dir, out, cfg, title, scorer);
+    }
     let gravity = Vector3::from(cfg.gravity);
     let config = FilterConfig::<T> {
         imu_noise: ImuNoise {
@@ -462,9 +411,10 @@ fn replay_in<T: Real>(
             Filter::Ins(Box::new(ins))
         }
         _ => {
-            let ahrs = Ahrs::from_alignment(&alignment, &sigmas, config)
-                .map_err(|e| ReplayError::Start(e.to_string()))?;
-            Filter::Ahrs(Box::new(ahrs))
+            return Err(ReplayError::Start(
+                "no GNSS fix (gnss0/data.csv) or camera frame with 6 known landmarks to take the position from"
+                    .into(),
+            ))
         }
     };
 
@@ -491,13 +441,7 @@ fn replay_in<T: Real>(
     };
     let (mut tum, tum_path) = open("estimate.tum")?;
     let (mut csv, csv_path) = open("estimate.csv")?;
-    writeln!(
-        csv,
-        "t_ns,p_x,p_y,p_z,q_w,q_x,q_y,q_z,v_x,v_y,v_z,bg_x,bg_y,bg_z,ba_x,ba_y,ba_z,\
-         sigma_att_x,sigma_att_y,sigma_att_z,sigma_v_x,sigma_v_y,sigma_v_z,sigma_p_x,sigma_p_y,sigma_p_z,\
-         sigma_bg_x,sigma_bg_y,sigma_bg_z,sigma_ba_x,sigma_ba_y,sigma_ba_z"
-    )
-    .map_err(out_err(&csv_path))?;
+    write_csv_header(&mut csv).map_err(out_err(&csv_path))?;
     let mut truth = if ds.has_groundtruth {
         let (gt_tum, gt_path) = open("groundtruth.tum")?;
         Some(TruthCursor {
@@ -515,13 +459,8 @@ fn replay_in<T: Real>(
     let ekf = UpdateOptions::<T>::default();
     // Projections are strongly nonlinear near the camera: re-linearize (iterated update).
     let camera_options = UpdateOptions::<T>::iterated(ekf.gate, 3, T::lit(1e-6));
-    let g_norm = gravity.norm();
-    // The white noise of one accelerometer sample, as a direction: σ_a √rate / g.
-    let white_dir_sq =
-        (ds.imu.accelerometer_noise_density * ds.imu.rate_hz.sqrt() / g_norm).powi(2);
     let mut last_gyro = Vector3::zeros();
     let mut last_sample: Option<(Vector3<f64>, Vector3<f64>)> = None;
-    let mut imu_count: u64 = 0;
     for ev in events {
         let ev = ev?;
         let started = Instant::now();
@@ -545,23 +484,6 @@ fn replay_in<T: Real>(
                 }
                 if filter.predict(&g_mid, &a_mid, dt).is_err() {
                     scorer.measurement("imu", t_ns, Outcome::Refused);
-                }
-                imu_count += 1;
-                if let Filter::Ahrs(f) = &mut filter {
-                    // Tilt aiding while the specific force is close to gravity.
-                    let mismatch = (accel.norm() - g_norm).abs();
-                    if imu_count.is_multiple_of(cfg.gravity_every.max(1))
-                        && mismatch < cfg.gravity_gate
-                    {
-                        // Only the mismatch beyond three sigmas of the white noise reveals motion.
-                        let excess = (mismatch - 3.0 * white_dir_sq.sqrt() * g_norm).max(0.0);
-                        let sigma = (white_dir_sq
-                            + (cfg.gravity_mismatch_gain * excess / g_norm).powi(2)
-                            + cfg.gravity_floor.powi(2))
-                        .sqrt();
-                        let r = f.update(&GravityDirection::new(lit3(&accel), T::lit(sigma)), &ekf);
-                        scorer.measurement("gravity", t_ns, outcome(r, 2));
-                    }
                 }
                 last_gyro = gyro;
                 scorer.filter_ns += started.elapsed().as_nanos();
@@ -661,6 +583,29 @@ fn replay_in<T: Real>(
     if let Some(tr) = truth.as_mut() {
         tr.finish()?;
     }
+    finish(out, cfg, title, &ds, &scorer)?;
+    partials.commit()?;
+    Ok(scorer)
+}
+
+/// The header of `estimate.csv`.
+fn write_csv_header(f: &mut impl Write) -> std::io::Result<()> {
+    writeln!(
+        f,
+        "t_ns,p_x,p_y,p_z,q_w,q_x,q_y,q_z,v_x,v_y,v_z,bg_x,bg_y,bg_z,ba_x,ba_y,ba_z,\
+         sigma_att_x,sigma_att_y,sigma_att_z,sigma_v_x,sigma_v_y,sigma_v_z,sigma_p_x,sigma_p_y,sigma_p_z,\
+         sigma_bg_x,sigma_bg_y,sigma_bg_z,sigma_ba_x,sigma_ba_y,sigma_ba_z"
+    )
+}
+
+/// Writes `metrics.json` (as a partial file) and the plots.
+fn finish(
+    out: &Path,
+    cfg: &ReplayConfig,
+    title: &str,
+    ds: &Dataset,
+    scorer: &Scorer,
+) -> Result<(), ReplayError> {
     let metrics = scorer.metrics();
     let mpath = out.join("metrics.json.partial");
     let json = serde_json::to_string_pretty(&metrics).map_err(|e| ReplayError::Output {
@@ -669,65 +614,12 @@ fn replay_in<T: Real>(
     })?;
     std::fs::write(&mpath, json).map_err(out_err(&mpath))?;
     if cfg.plots && ds.has_groundtruth {
-        crate::plot::write_all(out, &scorer, title).map_err(|e| ReplayError::Output {
+        crate::plot::write_all(out, scorer, title).map_err(|e| ReplayError::Output {
             path: out.to_path_buf(),
             message: e.to_string(),
         })?;
     }
-    partials.commit()?;
-    Ok(scorer)
-}
-
-/// The file outputs (the plots aside). They are written as `NAME.partial` and renamed together at the
-/// end; on any error (the guard drops uncommitted) the partial files are removed, so a failed
-/// run never leaves outputs that look complete.
-const OUTPUTS: [&str; 4] = [
-    "estimate.tum",
-    "estimate.csv",
-    "groundtruth.tum",
-    "metrics.json",
-];
-
-struct Partials<'a> {
-    out: &'a Path,
-    committed: bool,
-}
-
-impl<'a> Partials<'a> {
-    fn new(out: &'a Path) -> Self {
-        Self {
-            out,
-            committed: false,
-        }
-    }
-
-    /// Removes the outputs (and plots) of an earlier run in the same folder.
-    fn clear_previous(&mut self) {
-        for name in OUTPUTS.iter().chain(crate::plot::FILES.iter()) {
-            let _ = std::fs::remove_file(self.out.join(name));
-        }
-    }
-
-    fn commit(&mut self) -> Result<(), ReplayError> {
-        for name in OUTPUTS {
-            let from = self.out.join(format!("{name}.partial"));
-            if from.exists() {
-                std::fs::rename(&from, self.out.join(name)).map_err(out_err(&from))?;
-            }
-        }
-        self.committed = true;
-        Ok(())
-    }
-}
-
-impl Drop for Partials<'_> {
-    fn drop(&mut self) {
-        if !self.committed {
-            for name in OUTPUTS {
-                let _ = std::fs::remove_file(self.out.join(format!("{name}.partial")));
-            }
-        }
-    }
+    Ok(())
 }
 
 fn lit2<T: Real>(v: &Vector2<f64>) -> Vector2<T> {
@@ -771,20 +663,3 @@ fn pnp_pose(
         .compose(&cam.body_from_camera.inverse()))
 }
 
-fn write_estimate_csv(f: &mut impl Write, e: &Estimate) -> std::io::Result<()> {
-    let q = e.attitude.quaternion();
-    let (p, v, bg, ba) = (e.position, e.velocity, e.gyro_bias, e.accel_bias);
-    write!(
-        f,
-        "{},{:.6},{:.6},{:.6},{:.9},{:.9},{:.9},{:.9},{:.6},{:.6},{:.6},{:.9},{:.9},{:.9},{:.6},{:.6},{:.6}",
-        e.t_ns, p.x, p.y, p.z, q.w, q.i, q.j, q.k, v.x, v.y, v.z, bg.x, bg.y, bg.z, ba.x, ba.y, ba.z
-    )?;
-    for s in e.sigmas() {
-        if s.is_finite() {
-            write!(f, ",{s:.6e}")?;
-        } else {
-            write!(f, ",")?;
-        }
-    }
-    writeln!(f)
-}

@@ -332,8 +332,8 @@ pub fn builtin_scenarios() -> Vec<Scenario> {
             name: "matched_ahrs".into(),
             description: "noise exactly as the filter models it (Monte-Carlo consistency); hand-held rotation in place, IMU, magnetometer".into(),
             shape: "rotate".into(),
-            // In place, the accelerometer sees gravity and white noise only.
-            replay: ReplayConfig { gravity_floor: 0.0, gravity_mismatch_gain: 0.0, ..ReplayConfig::default() },
+            // No accelerometer bias and an ideal magnetometer: no floors.
+            replay: ReplayConfig { accelerometer_bias_sigma: 0.0, heading_floor_deg: 0.0, heading_noise_deg: 0.0, ..ReplayConfig::default() },
             // The attitude-only filter has no accelerometer-bias state: none is simulated.
             imu: ImuConfig { accel_turn_on_bias: 0.0, accelerometer_random_walk: 0.0, ..matched_imu },
             mag: Some(MagConfig::default()),

@@ -21,6 +21,7 @@ mod gravity;
 mod heading;
 mod magnetometer;
 mod shared;
+mod zero_rate;
 mod zero_velocity;
 
 pub use barometer::BaroAltitude;
@@ -28,5 +29,6 @@ pub use camera::{CameraLandmark, PinholeIntrinsics};
 pub use gnss::{GnssPosition, GnssVelocity};
 pub use gravity::{AccelerometerAtRest, GravityDirection};
 pub use heading::Heading;
-pub use magnetometer::Magnetometer;
+pub use magnetometer::{MagneticHeading, Magnetometer};
+pub use zero_rate::ZeroRate;
 pub use zero_velocity::ZeroVelocity;

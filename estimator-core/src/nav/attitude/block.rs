@@ -1,0 +1,83 @@
+//! One aiding block: the samples of one block, averaged in a frame the gyro carries along.
+//!
+//! Every accelerometer and magnetometer sample is rotated into the frame of the current
+//! estimate `R̂ᵢ` when it arrives and summed there. Inside a block the estimate only moves by
+//! the gyro (the updates wait for the block's end), so at the end `R̂ₑᵀ R̂ᵢ` is the rotation the
+//! gyro measured between sample `i` and the end, and `R̂ₑᵀ · mean(R̂ᵢ fᵢ)` is the block's mean
+//! specific force seen in the body at the end, without any attitude error in it.
+
+use crate::nav::mean::VectorMean;
+use crate::lie::LieGroup;
+use crate::Real;
+use nalgebra::Vector3;
+
+/// The sums of one block.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Block<T: Real> {
+    /// `R̂ᵢ fᵢ`: specific force in the estimate's world frame.
+    pub(super) accel: VectorMean<T>,
+    /// Raw gyro `ωᵢ`, body frame.
+    pub(super) gyro: VectorMean<T>,
+    /// `R̂ᵢ mᵢ`: field in the estimate's world frame.
+    pub(super) mag: VectorMean<T>,
+    /// Length so far, ns.
+    pub(super) elapsed_ns: u32,
+}
+
+/// The statistics of a finished block, seen in the body at its end.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct BlockStats<T: Real> {
+    /// IMU samples in it.
+    pub(super) n: u32,
+    /// Length, s.
+    pub(super) duration: T,
+    /// Mean specific force, body frame at the end.
+    pub(super) accel_body: Vector3<T>,
+    /// Its norm.
+    pub(super) accel_norm: T,
+    /// Total variance of the world-frame specific force about its mean, (m/s²)².
+    pub(super) accel_scatter_sq: T,
+    /// Mean raw gyro, rad/s.
+    pub(super) gyro_mean: Vector3<T>,
+    /// Total variance of the gyro about its mean, (rad/s)².
+    pub(super) gyro_scatter_sq: T,
+    /// Mean field in the body frame at the end, and the number of samples.
+    pub(super) mag_body: Option<(Vector3<T>, u32)>,
+}
+
+impl<T: Real> Default for Block<T> {
+    fn default() -> Self {
+        Self {
+            accel: VectorMean::default(),
+            gyro: VectorMean::default(),
+            mag: VectorMean::default(),
+            elapsed_ns: 0,
+        }
+    }
+}
+
+impl<T: Real> Block<T> {
+    /// The statistics, with `end` the estimate's attitude at the end (`R̂ₑ`); `None` for a
+    /// block without IMU samples.
+    pub(super) fn stats(&self, end: &crate::lie::So3<T>) -> Option<BlockStats<T>> {
+        let (Some(a), Some(w)) = (self.accel.mean(), self.gyro.mean()) else {
+            return None;
+        };
+        let to_body = end.inverse();
+        let accel_body = to_body.act(&a);
+        let mag_body = self
+            .mag
+            .mean()
+            .map(|m| (to_body.act(&m), self.mag.count()));
+        Some(BlockStats {
+            n: self.accel.count(),
+            duration: T::from_count(self.elapsed_ns) * T::lit(1e-9),
+            accel_norm: crate::kernels::mat3::norm(&accel_body),
+            accel_body,
+            accel_scatter_sq: self.accel.scatter_sq(),
+            gyro_mean: w,
+            gyro_scatter_sq: self.gyro.scatter_sq(),
+            mag_body,
+        })
+    }
+}

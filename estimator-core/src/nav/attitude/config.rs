@@ -1,0 +1,178 @@
+//! What an attitude navigator is told about its sensors and its motion.
+
+use crate::eskf::FilterConfig;
+use crate::kernels::{all_finite, non_negative_finite, positive_finite};
+use crate::nav::error::NavError;
+use crate::Real;
+use nalgebra::Vector3;
+
+/// The magnetometer, when there is one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MagneticConfig<T: Real> {
+    /// The world reference field (any unit, the magnetometer's), ENU: `[0, B_h, B_up]` with
+    /// north along world `y`. `None`: learned at start-up from the first samples, which then
+    /// define north.
+    pub reference: Option<Vector3<T>>,
+    /// White noise of one sample, per axis (the magnetometer's unit).
+    pub sigma: T,
+    /// Heading noise of one block beyond the white noise, rad: what a magnetometer reads wrong
+    /// for a while without the norm or the dip showing it (iron nearby, residual calibration).
+    /// It sets how fast the heading follows the magnetometer.
+    pub heading_noise: T,
+    /// The heading is never known better than this, rad: a lower bound on its 1σ, for the
+    /// calibration error that does not average out.
+    pub heading_floor: T,
+    /// A block whose field norm differs from the reference by more than this fraction is
+    /// disturbed and not fused.
+    pub norm_tolerance: T,
+    /// A block whose dip angle differs from the reference by more than this, rad, is disturbed.
+    pub dip_tolerance: T,
+    /// A disturbed field that stays the same (within the two tolerances) for this long, s,
+    /// becomes the new reference (norm and dip; north is kept).
+    pub new_field_s: T,
+}
+
+impl<T: Real> MagneticConfig<T> {
+    /// A magnetometer with white noise `sigma` per axis and an optional reference; the other
+    /// values are the defaults listed on each field's use: 2° heading noise per block, 1°
+    /// heading floor, 10 % norm and 10° dip tolerance, 20 s for a new field.
+    #[must_use]
+    pub fn new(sigma: T, reference: Option<Vector3<T>>) -> Self {
+        Self {
+            reference,
+            sigma,
+            heading_noise: T::lit(2.0_f64.to_radians()),
+            heading_floor: T::lit(1.0_f64.to_radians()),
+            norm_tolerance: T::lit(0.1),
+            dip_tolerance: T::lit(10.0_f64.to_radians()),
+            new_field_s: T::lit(20.0),
+        }
+    }
+
+    fn validate(&self) -> Result<(), NavError> {
+        let reference_ok = match &self.reference {
+            Some(r) => all_finite(r.as_slice()) && r.norm_squared() > T::zero(),
+            None => true,
+        };
+        let ok = reference_ok
+            && positive_finite(self.sigma)
+            && non_negative_finite(self.heading_noise)
+            && non_negative_finite(self.heading_floor)
+            && positive_finite(self.norm_tolerance)
+            && positive_finite(self.dip_tolerance)
+            && positive_finite(self.new_field_s);
+        if ok {
+            Ok(())
+        } else {
+            Err(NavError::InvalidConfig)
+        }
+    }
+}
+
+/// The configuration of an [`AttitudeNavigator`](super::AttitudeNavigator).
+///
+/// Every time is in seconds and every angle in radians. [`AttitudeConfig::new`] fills in
+/// defaults for a hand-held or body-worn MEMS IMU; the tuning guide in the module docs of
+/// [`crate::nav`] says which value does what.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AttitudeConfig<T: Real> {
+    /// The filter: IMU noise densities, gravity, and `max_dt`, the longest IMU interval that
+    /// is integrated; a longer one is a gap after which the navigator starts again.
+    pub filter: FilterConfig<T>,
+    /// The IMU samples are instantaneous values (integrated over an interval with the mean of
+    /// its two ends) rather than means over the interval ending at their timestamp.
+    pub instantaneous_imu: bool,
+    /// Length of the start-up window, s: the accelerometer, gyro and magnetometer are averaged
+    /// over it for the first attitude.
+    pub startup_s: T,
+    /// Length of one aiding block, s: the accelerometer and magnetometer are averaged over a
+    /// block (in a frame carried along by the gyro) and fused once at its end.
+    pub block_s: T,
+    /// Correlation time of the body's linear acceleration, s: the mean of a block of length
+    /// `T` keeps `min(1, 2τ/T)` of its variance.
+    pub acceleration_correlation_s: T,
+    /// 1σ of the accelerometer bias per axis, m/s²: the tilt is never known better than
+    /// `σ_ba/g`.
+    pub accelerometer_bias_sigma: T,
+    /// 1σ of the gyro bias at switch-on per axis, rad/s (used when the start is not at rest).
+    pub gyro_bias_sigma: T,
+    /// At rest when the RMS gyro rate about the bias estimate is below this, rad/s…
+    pub rest_gyro: T,
+    /// …and the RMS linear acceleration below this, m/s²…
+    pub rest_accel: T,
+    /// …for at least this long, s.
+    pub rest_min_s: T,
+    /// 1σ of the remaining rate of a body found at rest, rad/s (the floor of the zero-rate
+    /// update).
+    pub rest_rate_sigma: T,
+    /// After this many consecutive gated-out blocks of one aid, the navigator takes its own
+    /// estimate for wrong, widens its covariance to the innovation, and fuses again.
+    pub max_rejected_blocks: u16,
+    /// Tilt reported valid while its 1σ is below this, rad.
+    pub tilt_valid_sigma: T,
+    /// Heading reported valid while its 1σ is below this, rad.
+    pub heading_valid_sigma: T,
+    /// The magnetometer, if any.
+    pub magnetometer: Option<MagneticConfig<T>>,
+}
+
+impl<T: Real> AttitudeConfig<T> {
+    /// The defaults around a filter configuration: trapezoidal IMU integration; 1 s start-up;
+    /// 0.25 s blocks; 0.3 s acceleration correlation; 0.1 m/s² accelerometer bias (0.6° of
+    /// tilt); 0.5 °/s gyro bias at switch-on; rest below 2 °/s and 0.5 m/s² for 1.5 s with a
+    /// 0.1 °/s floor; widen after 8 rejected blocks (2 s); valid below 5° tilt and 10° heading;
+    /// no magnetometer.
+    #[must_use]
+    pub fn new(filter: FilterConfig<T>) -> Self {
+        Self {
+            filter,
+            instantaneous_imu: true,
+            startup_s: T::lit(1.0),
+            block_s: T::lit(0.25),
+            acceleration_correlation_s: T::lit(0.3),
+            accelerometer_bias_sigma: T::lit(0.1),
+            gyro_bias_sigma: T::lit(0.5_f64.to_radians()),
+            rest_gyro: T::lit(2.0_f64.to_radians()),
+            rest_accel: T::lit(0.5),
+            rest_min_s: T::lit(1.5),
+            rest_rate_sigma: T::lit(0.1_f64.to_radians()),
+            max_rejected_blocks: 8,
+            tilt_valid_sigma: T::lit(5.0_f64.to_radians()),
+            heading_valid_sigma: T::lit(10.0_f64.to_radians()),
+            magnetometer: None,
+        }
+    }
+
+    /// `Ok` when every value is in its domain: the filter configuration valid, every time and
+    /// sigma positive (the bias sigmas may be 0), `max_rejected_blocks ≥ 1`, and the block and
+    /// start-up shorter than 4 s (their length in nanoseconds fits 32 bits).
+    ///
+    /// # Errors
+    /// [`NavError::InvalidConfig`], or the filter's own error.
+    pub fn validate(&self) -> Result<(), NavError> {
+        self.filter.validate()?;
+        let four_seconds = T::lit(4.0);
+        let ok = positive_finite(self.startup_s)
+            && self.startup_s < four_seconds
+            && positive_finite(self.block_s)
+            && self.block_s < four_seconds
+            && positive_finite(self.acceleration_correlation_s)
+            && non_negative_finite(self.accelerometer_bias_sigma)
+            && non_negative_finite(self.gyro_bias_sigma)
+            && positive_finite(self.rest_gyro)
+            && positive_finite(self.rest_accel)
+            && non_negative_finite(self.rest_min_s)
+            && positive_finite(self.rest_rate_sigma)
+            && self.max_rejected_blocks >= 1
+            && positive_finite(self.tilt_valid_sigma)
+            && positive_finite(self.heading_valid_sigma)
+            && self.filter.max_dt < four_seconds;
+        if !ok {
+            return Err(NavError::InvalidConfig);
+        }
+        match &self.magnetometer {
+            Some(m) => m.validate(),
+            None => Ok(()),
+        }
+    }
+}

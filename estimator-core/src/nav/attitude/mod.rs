@@ -1,0 +1,479 @@
+//! The attitude navigator: an [`Ahrs`] filter with everything a sensor stream needs around it.
+//!
+//! One call per sample: [`AttitudeNavigator::imu`] for every IMU sample,
+//! [`AttitudeNavigator::magnetometer`] for every magnetometer sample, each with its own
+//! timestamp (ns). Each returns an [`AttitudeReport`]: the validity of tilt and heading, the
+//! magnetometer's state, rest, and what the navigator did on its own.
+//!
+//! What happens inside, in order (each step's model is in its file):
+//!
+//! 1. **Start-up** (`startup`): the first `startup_s` of samples are averaged in a frame the
+//!    gyro carries along, at rest or moving; tilt, heading, bias and their covariance come from
+//!    the means. A gap in the IMU longer than `max_dt` starts it again.
+//! 2. **Prediction**: every IMU interval is integrated by [`Ahrs::predict`] (trapezoidal for
+//!    instantaneous samples).
+//! 3. **Blocks** (`block`): accelerometer and magnetometer samples are averaged over
+//!    `block_s` in the same gyro-carried frame and fused once at the block's end:
+//!    * **rest** (`rest`): a still block, after `rest_min_s` of them, is a zero-rate update
+//!      of the gyro bias;
+//!    * **tilt** (`tilt`): the block's gravity direction, with a noise that follows the
+//!      measured linear acceleration; widened, never locked out, after repeated rejections;
+//!      floored at the accelerometer bias;
+//!    * **heading** (`magnetic`): the magnetometer's heading only, when its norm and dip agree
+//!      with the reference; a steady new field becomes the reference.
+//!
+//! Nothing allocates; the navigator is a plain value (`size_of::<AttitudeNavigator<f32>>()`
+//! is in the firmware table of the README).
+
+mod block;
+mod config;
+mod magnetic;
+mod report;
+mod rest;
+mod startup;
+mod tilt;
+
+pub use config::{AttitudeConfig, MagneticConfig};
+pub use report::{
+    AttitudeEstimate, AttitudeReport, Counters, Event, Fusion, Fusions, MagneticStatus, Reason,
+    Validity,
+};
+
+use crate::eskf::{Ahrs, ImuSample};
+use crate::kernels::{all_finite, mat3};
+use crate::lie::{LieGroup, So3};
+use crate::nav::clock::{Clock, Tick};
+use crate::nav::error::NavError;
+use crate::Real;
+use block::Block;
+use magnetic::Magnetic;
+use nalgebra::Vector3;
+
+/// Where the navigator is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Phase<T: Real> {
+    /// Collecting the start-up window; `frame` is the gyro-integrated rotation since its first
+    /// sample.
+    Starting { frame: So3<T> },
+    /// Filtering.
+    Running { filter: Ahrs<T> },
+}
+
+/// Durations of the configuration in nanoseconds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Durations {
+    startup: u32,
+    block: u32,
+    max_step: u32,
+}
+
+fn nanoseconds<T: Real>(s: T) -> u32 {
+    (s * T::lit(1e9)).to_count()
+}
+
+/// The attitude navigator (module docs).
+///
+/// ```
+/// use estimator_core::eskf::{FilterConfig, ImuNoise};
+/// use estimator_core::nav::{AttitudeConfig, AttitudeNavigator, MagneticConfig};
+/// use nalgebra::Vector3;
+///
+/// let mut config = AttitudeConfig::<f32>::new(FilterConfig::default());
+/// config.magnetometer = Some(MagneticConfig::new(0.5, None)); // µT; reference learned
+/// let mut nav = AttitudeNavigator::new(config).unwrap();
+/// // 3 s at rest and level at 100 Hz, facing north-east.
+/// let field = Vector3::new(15.0, 15.0, -40.0);
+/// for k in 0..300u64 {
+///     let t = 1_000_000_000 + k * 10_000_000;
+///     nav.imu(t, &Vector3::new(0.001, 0.0, 0.0), &Vector3::new(0.0, 0.0, 9.81)).unwrap();
+///     let report = nav.magnetometer(t + 1, &field).unwrap();
+///     if k == 299 {
+///         assert!(report.tilt.is_valid() && report.heading.is_valid());
+///     }
+/// }
+/// let estimate = nav.estimate().unwrap();
+/// assert!((estimate.gyro_bias.x - 0.001).abs() < 1e-4); // learned at rest
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AttitudeNavigator<T: Real> {
+    config: AttitudeConfig<T>,
+    durations: Durations,
+    phase: Phase<T>,
+    block: Block<T>,
+    imu_clock: Clock,
+    mag_clock: Clock,
+    /// The previous IMU sample (gyro, accel), for trapezoidal integration.
+    last_imu: Option<(Vector3<T>, Vector3<T>)>,
+    /// The bias to start from after a gap.
+    bias_prior: Vector3<T>,
+    /// The linear-acceleration power of the previous block, (m/s²)² per axis.
+    last_power: T,
+    /// Still blocks in a row, s.
+    still_s: T,
+    tilt_rejected: u16,
+    magnetic: Option<Magnetic<T>>,
+    report: AttitudeReport<T>,
+    counters: Counters,
+}
+
+impl<T: Real> AttitudeNavigator<T> {
+    /// A navigator waiting for its first sample.
+    ///
+    /// # Errors
+    /// [`NavError::InvalidConfig`] (or the filter configuration's error) for a configuration
+    /// out of its domain ([`AttitudeConfig::validate`]).
+    pub fn new(config: AttitudeConfig<T>) -> Result<Self, NavError> {
+        config.validate()?;
+        let magnetic = config.magnetometer.as_ref().map(Magnetic::new);
+        Ok(Self {
+            durations: Durations {
+                startup: nanoseconds(config.startup_s),
+                block: nanoseconds(config.block_s),
+                max_step: nanoseconds(config.filter.max_dt),
+            },
+            phase: Phase::Starting {
+                frame: So3::identity(),
+            },
+            block: Block::default(),
+            imu_clock: Clock::default(),
+            mag_clock: Clock::default(),
+            last_imu: None,
+            bias_prior: Vector3::zeros(),
+            last_power: T::zero(),
+            still_s: T::zero(),
+            tilt_rejected: 0,
+            report: AttitudeReport {
+                t_ns: 0,
+                tilt: Validity::Invalid(Reason::Starting),
+                heading: Validity::Invalid(Reason::Starting),
+                at_rest: false,
+                magnetic: if magnetic.is_some() {
+                    MagneticStatus::Waiting
+                } else {
+                    MagneticStatus::NotConfigured
+                },
+                event: None,
+                fused: Fusions::default(),
+            },
+            magnetic,
+            counters: Counters::default(),
+            config,
+        })
+    }
+
+    /// The configuration.
+    #[must_use]
+    pub fn config(&self) -> &AttitudeConfig<T> {
+        &self.config
+    }
+
+    /// The filter, once started.
+    #[must_use]
+    pub fn filter(&self) -> Option<&Ahrs<T>> {
+        match &self.phase {
+            Phase::Running { filter } => Some(filter),
+            Phase::Starting { .. } => None,
+        }
+    }
+
+    /// The report of the last call.
+    #[must_use]
+    pub fn report(&self) -> &AttitudeReport<T> {
+        &self.report
+    }
+
+    /// Counts since construction.
+    #[must_use]
+    pub fn counters(&self) -> &Counters {
+        &self.counters
+    }
+
+    /// The magnetometer's world reference field, once known.
+    #[must_use]
+    pub fn magnetic_reference(&self) -> Option<Vector3<T>> {
+        self.magnetic.and_then(|m| m.reference)
+    }
+
+    /// The estimate with its uncertainty, once started.
+    #[must_use]
+    pub fn estimate(&self) -> Option<AttitudeEstimate<T>> {
+        let filter = self.filter()?;
+        let w = tilt::world_attitude_covariance(filter);
+        let tilt = if w.m11 > w.m22 { w.m11 } else { w.m22 };
+        Some(AttitudeEstimate {
+            t_ns: self.report.t_ns,
+            attitude: filter.state().attitude,
+            gyro_bias: filter.state().gyro_bias,
+            sigma_tilt: tilt.sqrt(),
+            sigma_heading: w.m33.sqrt(),
+        })
+    }
+
+    /// Takes one IMU sample: gyro (rad/s) and accelerometer (m/s², specific force) in the body
+    /// frame at `t_ns`.
+    ///
+    /// # Errors
+    /// [`NavError::NonFinite`], [`NavError::ZeroVector`] (an all-zero accelerometer),
+    /// [`NavError::TimeNotIncreasing`], or [`NavError::Filter`] for a numerical failure; the
+    /// navigator is then unchanged.
+    pub fn imu(
+        &mut self,
+        t_ns: u64,
+        gyro: &Vector3<T>,
+        accel: &Vector3<T>,
+    ) -> Result<AttitudeReport<T>, NavError> {
+        let mut next = *self;
+        match next.take_imu(t_ns, gyro, accel) {
+            Ok(()) => {
+                *self = next;
+                Ok(self.report)
+            }
+            Err(e) => {
+                self.counters.refused = self.counters.refused.saturating_add(1);
+                Err(e)
+            }
+        }
+    }
+
+    /// Takes one magnetometer sample (body frame, the unit of the configured sigma) at `t_ns`.
+    /// It is fused at the end of the current block; without a configured magnetometer it is
+    /// ignored.
+    ///
+    /// # Errors
+    /// [`NavError::NonFinite`], [`NavError::ZeroVector`], [`NavError::TimeNotIncreasing`]
+    /// (against the previous magnetometer sample); the navigator is then unchanged.
+    pub fn magnetometer(
+        &mut self,
+        t_ns: u64,
+        field: &Vector3<T>,
+    ) -> Result<AttitudeReport<T>, NavError> {
+        let checked = check_vector(field).and_then(|()| self.mag_clock.tick(t_ns, u32::MAX));
+        if let Err(e) = checked {
+            self.counters.refused = self.counters.refused.saturating_add(1);
+            return Err(e);
+        }
+        self.mag_clock.set(t_ns);
+        self.counters.magnetometer = self.counters.magnetometer.saturating_add(1);
+        self.report.event = None;
+        self.report.fused = Fusions::default();
+        if self.magnetic.is_some() {
+            let frame = match &self.phase {
+                Phase::Starting { frame } => *frame,
+                Phase::Running { filter } => filter.state().attitude,
+            };
+            self.block.mag.add(&frame.act(field));
+        }
+        Ok(self.report)
+    }
+
+    /// The IMU step on a copy (committed by the caller only on `Ok`).
+    fn take_imu(
+        &mut self,
+        t_ns: u64,
+        gyro: &Vector3<T>,
+        accel: &Vector3<T>,
+    ) -> Result<(), NavError> {
+        if !all_finite(gyro.as_slice()) {
+            return Err(NavError::NonFinite);
+        }
+        check_vector(accel)?;
+        self.report.event = None;
+        self.report.fused = Fusions::default();
+        let dt_ns = match self.imu_clock.tick(t_ns, self.durations.max_step)? {
+            Tick::First => None,
+            Tick::Step(ns) => Some(ns),
+            Tick::Gap => {
+                self.restart();
+                self.report.event = Some(Event::Realigned);
+                self.counters.realigned = self.counters.realigned.saturating_add(1);
+                None
+            }
+        };
+        if let Some(ns) = dt_ns {
+            let dt = T::from_count(ns) * T::lit(1e-9);
+            let (g_mid, a_mid) = match (self.config.instantaneous_imu, self.last_imu) {
+                (true, Some((g0, a0))) => ((g0 + gyro) * T::lit(0.5), (a0 + accel) * T::lit(0.5)),
+                _ => (*gyro, *accel),
+            };
+            match &mut self.phase {
+                Phase::Starting { frame } => {
+                    let w = (g_mid - self.bias_prior) * dt;
+                    *frame = frame.compose(&So3::exp(&w)).normalize();
+                }
+                Phase::Running { filter } => filter.predict(&ImuSample {
+                    gyro: g_mid,
+                    accel: a_mid,
+                    dt,
+                })?,
+            }
+            self.block.elapsed_ns = self.block.elapsed_ns.saturating_add(ns);
+        }
+        let frame = match &self.phase {
+            Phase::Starting { frame } => *frame,
+            Phase::Running { filter } => filter.state().attitude,
+        };
+        self.block.accel.add(&frame.act(accel));
+        self.block.gyro.add(gyro);
+        self.imu_clock.set(t_ns);
+        self.last_imu = Some((*gyro, *accel));
+        self.counters.imu = self.counters.imu.saturating_add(1);
+        self.report.t_ns = t_ns;
+        let length = match self.phase {
+            Phase::Starting { .. } => self.durations.startup,
+            Phase::Running { .. } => self.durations.block,
+        };
+        if self.block.elapsed_ns >= length {
+            self.end_block()?;
+        }
+        self.refresh_validity();
+        Ok(())
+    }
+
+    /// Back to start-up (after a gap), keeping the bias estimate and the magnetic reference.
+    fn restart(&mut self) {
+        if let Phase::Running { filter } = &self.phase {
+            self.bias_prior = filter.state().gyro_bias;
+        }
+        self.phase = Phase::Starting {
+            frame: So3::identity(),
+        };
+        self.block = Block::default();
+        self.last_imu = None;
+        self.still_s = T::zero();
+        self.tilt_rejected = 0;
+    }
+
+    /// Fuses the finished block (or starts the filter from the start-up window).
+    fn end_block(&mut self) -> Result<(), NavError> {
+        let frame = match &self.phase {
+            Phase::Starting { frame } => *frame,
+            Phase::Running { filter } => filter.state().attitude,
+        };
+        let block = core::mem::take(&mut self.block);
+        let Some(stats) = block.stats(&frame) else {
+            return Ok(());
+        };
+        let g = mat3::norm(&self.config.filter.gravity);
+        if !tilt::has_direction(&stats.accel_body) {
+            // Free fall for a whole block: nothing to fuse.
+            return Ok(());
+        }
+        let power = tilt::acceleration_power(&stats, tilt::white_sq(&stats, &self.config));
+        let filter = match &mut self.phase {
+            Phase::Starting { .. } => {
+                let (filter, still) =
+                    startup::start(&stats, &self.config, &self.bias_prior, &mut self.magnetic)?;
+                self.phase = Phase::Running { filter };
+                self.still_s = if still { stats.duration } else { T::zero() };
+                self.last_power = power;
+                self.report.at_rest = still;
+                if self.report.event.is_none() {
+                    self.report.event = Some(Event::Started);
+                }
+                if stats.mag_body.is_some() && self.magnetic.is_some() {
+                    self.report.magnetic = MagneticStatus::Fused;
+                }
+                return Ok(());
+            }
+            Phase::Running { filter } => filter,
+        };
+        // Rest: zero-rate update of the gyro bias.
+        let still = rest::is_still(&stats, &filter.state().gyro_bias, &self.config, g);
+        self.still_s = if still {
+            self.still_s + stats.duration
+        } else {
+            T::zero()
+        };
+        self.report.at_rest = still && self.still_s >= self.config.rest_min_s;
+        if self.report.at_rest {
+            let fusion = rest::fuse(filter, &stats, &self.config)?;
+            if fusion.accepted {
+                self.counters.zero_rate = self.counters.zero_rate.saturating_add(1);
+            }
+            self.report.fused.zero_rate = Some(fusion);
+        }
+        // Tilt.
+        let used_power = if power > self.last_power {
+            power
+        } else {
+            self.last_power
+        };
+        self.last_power = power;
+        let sigma = tilt::direction_sigma(&stats, &self.config, used_power, g);
+        let (fusion, event) =
+            tilt::fuse(filter, &stats, sigma, &self.config, &mut self.tilt_rejected)?;
+        self.report.fused.gravity = Some(fusion);
+        if fusion.accepted {
+            self.counters.gravity_fused = self.counters.gravity_fused.saturating_add(1);
+        } else {
+            self.counters.gravity_rejected = self.counters.gravity_rejected.saturating_add(1);
+        }
+        if event.is_some() {
+            self.counters.widened = self.counters.widened.saturating_add(1);
+            self.report.event = event;
+        }
+        // Heading.
+        if let (Some(state), Some(mag), Some((m, n))) = (
+            self.magnetic.as_mut(),
+            self.config.magnetometer.as_ref(),
+            stats.mag_body,
+        ) {
+            let (status, fusion, event) =
+                state.fuse(filter, &m, n, stats.duration, &self.config, mag)?;
+            self.report.magnetic = status;
+            self.report.fused.heading = fusion;
+            let c = &mut self.counters;
+            match status {
+                MagneticStatus::Fused => c.heading_fused = c.heading_fused.saturating_add(1),
+                MagneticStatus::Rejected => {
+                    c.heading_rejected = c.heading_rejected.saturating_add(1);
+                }
+                MagneticStatus::Disturbed => {
+                    c.magnetic_disturbed = c.magnetic_disturbed.saturating_add(1);
+                }
+                MagneticStatus::NotConfigured | MagneticStatus::Waiting => {}
+            }
+            match event {
+                Some(Event::HeadingWidened) => c.widened = c.widened.saturating_add(1),
+                Some(Event::NewMagneticField) => c.new_fields = c.new_fields.saturating_add(1),
+                _ => {}
+            }
+            if event.is_some() {
+                self.report.event = event;
+            }
+        }
+        Ok(())
+    }
+
+    /// The validity of tilt and heading from the current covariance.
+    fn refresh_validity(&mut self) {
+        let Some(e) = self.estimate() else {
+            self.report.tilt = Validity::Invalid(Reason::Starting);
+            self.report.heading = Validity::Invalid(Reason::Starting);
+            return;
+        };
+        self.report.tilt = if e.sigma_tilt <= self.config.tilt_valid_sigma {
+            Validity::Valid
+        } else {
+            Validity::Invalid(Reason::Uncertain)
+        };
+        self.report.heading = if self.magnetic_reference().is_none() {
+            Validity::Invalid(Reason::NoMagnetometer)
+        } else if e.sigma_heading <= self.config.heading_valid_sigma {
+            Validity::Valid
+        } else {
+            Validity::Invalid(Reason::Uncertain)
+        };
+    }
+}
+
+/// `Ok` for a finite vector that is not all zero.
+fn check_vector<T: Real>(v: &Vector3<T>) -> Result<(), NavError> {
+    if !all_finite(v.as_slice()) {
+        Err(NavError::NonFinite)
+    } else if v.x == T::zero() && v.y == T::zero() && v.z == T::zero() {
+        Err(NavError::ZeroVector)
+    } else {
+        Ok(())
+    }
+}

@@ -1,0 +1,100 @@
+//! Start-up: the first attitude from the first window of samples, at rest or moving.
+//!
+//! The window is one long block (see `block`): its mean specific force and mean field are
+//! seen in the body at its end, carried by the gyro, so a body that moves during the window
+//! is aligned as well as one at rest; only the linear acceleration's mean stays in the tilt,
+//! and the tilt model of `tilt` gives its 1σ.
+//!
+//! * Tilt and heading: the triad of [`align_at_rest`] on the two means (the window's mean
+//!   field against the reference; without a magnetometer the body `x` axis points to world
+//!   `x` and the heading is unknown, 1σ = π).
+//! * Gyro bias: a still window (see `rest`) measures it, `b = ω̄` with the zero-rate
+//!   variance; a moving window leaves the prior (0 at switch-on, the last estimate after a
+//!   gap) with `gyro_bias_sigma`.
+//! * Heading 1σ: `σ_ψ² = σ_m²/(n ‖m_h‖²) + σ_hd² + (tan δ · σ_tilt)²`, the last term because a
+//!   tilt error `σ_tilt` moves the horizontal part of a field with dip `δ`.
+
+use super::block::BlockStats;
+use super::config::AttitudeConfig;
+use super::magnetic::Magnetic;
+use super::rest::{is_still, mean_rate_variance};
+use super::tilt::{acceleration_power, direction_sigma, white_sq};
+use crate::eskf::{align_at_rest, Ahrs, InitialSigmas, MagnetometerWindow};
+use crate::kernels::mat3;
+use crate::nav::error::NavError;
+use crate::Real;
+use nalgebra::Vector3;
+
+/// The filter started from a start-up window, and whether the window was still.
+pub(super) fn start<T: Real>(
+    stats: &BlockStats<T>,
+    config: &AttitudeConfig<T>,
+    bias_prior: &Vector3<T>,
+    magnetic: &mut Option<Magnetic<T>>,
+) -> Result<(Ahrs<T>, bool), NavError> {
+    let g = mat3::norm(&config.filter.gravity);
+    let still = is_still(stats, bias_prior, config, g);
+    let (bias, bias_sigma) = if still {
+        (stats.gyro_mean, mean_rate_variance(stats, config).sqrt())
+    } else {
+        (*bias_prior, config.gyro_bias_sigma)
+    };
+    let tilt_model = direction_sigma(stats, config, acceleration_power(stats, white_sq(stats, config)), g);
+    let tilt_floor = config.accelerometer_bias_sigma / g;
+    let tilt = (tilt_model * tilt_model + tilt_floor * tilt_floor).sqrt();
+
+    let up_body = stats.accel_body / stats.accel_norm;
+    // The field and its reference, when both exist (a missing reference is learned here).
+    let field = match (magnetic.as_mut(), config.magnetometer.as_ref(), stats.mag_body) {
+        (Some(state), Some(mag), Some((m, n))) => {
+            let vertical = m.dot(&up_body);
+            let reference = *state.reference.get_or_insert_with(|| {
+                let h = mat3::norm(&(m - up_body * vertical));
+                Vector3::new(T::zero(), h, vertical)
+            });
+            Some((m, n, reference, mag))
+        }
+        _ => None,
+    };
+    let window;
+    let mag_window = match &field {
+        Some((m, _, reference, _)) => {
+            window = [*m];
+            Some(MagnetometerWindow {
+                samples: &window,
+                reference: *reference,
+            })
+        }
+        None => None,
+    };
+    let alignment = align_at_rest(
+        &[stats.accel_body],
+        &[bias],
+        &config.filter.gravity,
+        mag_window.as_ref(),
+        g,
+    )?;
+    let yaw = match &field {
+        Some((m, n, reference, mag)) => {
+            let vertical = m.dot(&up_body);
+            let horizontal = mat3::norm(&(m - up_body * vertical));
+            let white = mag.sigma / horizontal;
+            let tan_dip = reference.z.abs() / (reference.x * reference.x + reference.y * reference.y).sqrt();
+            let coupling = tan_dip * tilt;
+            (white * white / T::from_count((*n).max(1))
+                + mag.heading_noise * mag.heading_noise
+                + mag.heading_floor * mag.heading_floor
+                + coupling * coupling)
+                .sqrt()
+        }
+        None => T::pi(),
+    };
+    let sigmas = InitialSigmas {
+        tilt,
+        yaw,
+        gyro_bias: bias_sigma,
+        ..InitialSigmas::default()
+    };
+    let filter = Ahrs::from_alignment(&alignment, &sigmas, config.filter)?;
+    Ok((filter, still))
+}

@@ -1,0 +1,39 @@
+//! Why a navigator refused a sample.
+
+use crate::eskf::EskfError;
+
+/// Why a call refused its input. Whenever one of these is returned, the navigator is bit for
+/// bit what it was before the call.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum NavError {
+    /// A NaN or infinite value in the sample.
+    NonFinite,
+    /// An all-zero accelerometer or magnetometer sample: no sensor reads exactly zero on
+    /// every axis, so the sample is taken for a fault.
+    ZeroVector,
+    /// A timestamp equal to or before the previous sample of the same sensor.
+    TimeNotIncreasing,
+    /// A configuration value out of its domain (named in the docs of the field).
+    InvalidConfig,
+    /// The filter refused a step the navigator built from valid samples (a numerical failure;
+    /// the navigator is unchanged and the next sample is taken normally).
+    Filter(EskfError),
+}
+
+impl core::fmt::Display for NavError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::NonFinite => f.write_str("non-finite value in the sample"),
+            Self::ZeroVector => f.write_str("all-zero sample"),
+            Self::TimeNotIncreasing => f.write_str("timestamp is not after the previous one"),
+            Self::InvalidConfig => f.write_str("configuration value out of its domain"),
+            Self::Filter(e) => write!(f, "filter: {e}"),
+        }
+    }
+}
+
+impl From<EskfError> for NavError {
+    fn from(e: EskfError) -> Self {
+        Self::Filter(e)
+    }
+}

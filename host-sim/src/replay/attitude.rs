@@ -1,0 +1,188 @@
+//! The attitude-only replay (a dataset with an IMU and optionally a magnetometer, without GNSS
+//! or camera): every sample goes to [`AttitudeNavigator`], exactly as a firmware main loop
+//! would call it; this file only reads, writes and scores.
+
+use super::output::{write_estimate_csv, write_tum, Partials, TruthCursor};
+use super::{lit3, out_err, up3, ReplayConfig, ReplayError};
+use crate::baseline::{Madgwick, Mahony};
+use crate::dataset::read::{Dataset, Event, TruthStream};
+use crate::metrics::{Estimate, Outcome, Scorer};
+use estimator_core::eskf::{FilterConfig, ImuNoise};
+use estimator_core::nav::{
+    AttitudeConfig, AttitudeNavigator, AttitudeReport, Fusion, MagneticConfig, NavError,
+};
+use estimator_core::Real;
+use nalgebra::{Matrix3, Vector3};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The navigator's configuration from the dataset's sensor files and the replay options.
+pub(super) fn navigator_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> AttitudeConfig<T> {
+    let filter = FilterConfig::<T> {
+        imu_noise: ImuNoise {
+            gyroscope_noise_density: T::lit(ds.imu.gyroscope_noise_density),
+            gyroscope_random_walk: T::lit(ds.imu.gyroscope_random_walk),
+            accelerometer_noise_density: T::lit(ds.imu.accelerometer_noise_density),
+            accelerometer_random_walk: T::lit(ds.imu.accelerometer_random_walk),
+        },
+        gravity: lit3(&Vector3::from(cfg.gravity)),
+        max_dt: T::lit(cfg.max_dt),
+    };
+    let mut c = AttitudeConfig::new(filter);
+    c.instantaneous_imu = cfg.instantaneous_imu;
+    c.startup_s = T::lit(cfg.align_window_s);
+    c.block_s = T::lit(cfg.block_s);
+    c.acceleration_correlation_s = T::lit(cfg.acceleration_correlation_s);
+    c.accelerometer_bias_sigma = T::lit(cfg.accelerometer_bias_sigma);
+    c.gyro_bias_sigma = T::lit(cfg.gyro_bias_sigma_dps.to_radians());
+    c.magnetometer = ds.mag.as_ref().map(|m| {
+        let mut mc = MagneticConfig::new(T::lit(m.sigma), Some(lit3(&m.reference_field)));
+        mc.heading_noise = T::lit(cfg.heading_noise_deg.to_radians());
+        mc.heading_floor = T::lit(cfg.heading_floor_deg.to_radians());
+        mc
+    });
+    c
+}
+
+fn estimate<T: Real>(nav: &AttitudeNavigator<T>, t_ns: u64) -> Option<Estimate> {
+    let f = nav.filter()?;
+    let s = f.state();
+    let p = f.covariance();
+    let block = |b: usize| Matrix3::from_fn(|i, j| p[(3 * b + i, 3 * b + j)].to_f64());
+    Some(Estimate {
+        t_ns,
+        position: Vector3::zeros(),
+        attitude: s.attitude.cast(),
+        velocity: Vector3::zeros(),
+        gyro_bias: up3(&s.gyro_bias),
+        accel_bias: Vector3::zeros(),
+        cov: [Some(block(0)), None, None, Some(block(1)), None],
+    })
+}
+
+fn score_fusion<T: Real>(scorer: &mut Scorer, name: &str, t_ns: u64, f: Option<Fusion<T>>, dof: usize) {
+    if let Some(f) = f {
+        let nis = f.nis.to_f64();
+        let outcome = if f.accepted {
+            Outcome::Accepted { nis, dof }
+        } else {
+            Outcome::Rejected { nis, dof }
+        };
+        scorer.measurement(name, t_ns, outcome);
+    }
+}
+
+fn score_report<T: Real>(scorer: &mut Scorer, r: &Result<AttitudeReport<T>, NavError>, sensor: &str, t_ns: u64) {
+    match r {
+        Ok(r) => {
+            score_fusion(scorer, "gravity", t_ns, r.fused.gravity, 2);
+            score_fusion(scorer, "mag", t_ns, r.fused.heading, 1);
+            score_fusion(scorer, "zero_rate", t_ns, r.fused.zero_rate, 3);
+        }
+        Err(_) => scorer.measurement(sensor, t_ns, Outcome::Refused),
+    }
+}
+
+/// Runs the navigator over the dataset and writes the outputs (see the module docs of
+/// `replay`).
+pub(super) fn replay_attitude<T: Real>(
+    ds: &Dataset,
+    dir: &Path,
+    out: &Path,
+    cfg: &ReplayConfig,
+    title: &str,
+    mut scorer: Scorer,
+) -> Result<Scorer, ReplayError> {
+    let mut nav = AttitudeNavigator::<T>::new(navigator_config(ds, cfg))
+        .map_err(|e| ReplayError::Config(format!("navigator: {e}")))?;
+    let mut partials = Partials::new(out);
+    partials.clear_previous();
+    let open = |name: &str| -> Result<(BufWriter<File>, PathBuf), ReplayError> {
+        let p = out.join(format!("{name}.partial"));
+        File::create(&p)
+            .map(|f| (BufWriter::new(f), p.clone()))
+            .map_err(|e| ReplayError::Output {
+                path: p,
+                message: e.to_string(),
+            })
+    };
+    let (mut tum, tum_path) = open("estimate.tum")?;
+    let (mut csv, csv_path) = open("estimate.csv")?;
+    super::write_csv_header(&mut csv).map_err(out_err(&csv_path))?;
+    let mut truth = if ds.has_groundtruth {
+        let (gt_tum, gt_path) = open("groundtruth.tum")?;
+        Some(TruthCursor {
+            stream: TruthStream::open(dir)?,
+            prev: None,
+            next: None,
+            tum: gt_tum,
+            tum_path: gt_path,
+        })
+    } else {
+        None
+    };
+    let mut baselines: Option<(Madgwick, Mahony)> = None;
+    let mut last_imu: Option<u64> = None;
+    for ev in ds.events()? {
+        let started = Instant::now();
+        match ev? {
+            Event::Imu { t_ns, gyro, accel } => {
+                let dt = last_imu.map_or(1.0 / ds.imu.rate_hz, |t| t_ns.saturating_sub(t) as f64 * 1e-9);
+                last_imu = Some(t_ns);
+                let r = nav.imu(t_ns, &lit3(&gyro), &lit3(&accel));
+                score_report(&mut scorer, &r, "imu", t_ns);
+                scorer.filter_ns += started.elapsed().as_nanos();
+                scorer.imu_samples += 1;
+                let Some(e) = estimate(&nav, t_ns) else {
+                    continue;
+                };
+                // The reference filters start where the navigator started, on the same samples.
+                match (&mut baselines, &ds.mag) {
+                    (None, Some(m)) => {
+                        baselines = Some((
+                            Madgwick::new(e.attitude, m.reference_field),
+                            Mahony::new(e.attitude, m.reference_field),
+                        ));
+                    }
+                    (Some((mw, mh)), _) => {
+                        mw.imu(&gyro, &accel, dt);
+                        mh.imu(&gyro, &accel, dt);
+                    }
+                    (None, None) => {}
+                }
+                write_tum(&mut tum, t_ns, &e.position, &e.attitude).map_err(out_err(&tum_path))?;
+                write_estimate_csv(&mut csv, &e).map_err(out_err(&csv_path))?;
+                if let Some(tr) = truth.as_mut() {
+                    if let Some(t) = tr.at(t_ns)? {
+                        scorer.add(&e, &t);
+                        if let Some((mw, mh)) = &baselines {
+                            scorer.add_baseline("madgwick", &mw.attitude, &t);
+                            scorer.add_baseline("mahony", &mh.attitude, &t);
+                        }
+                    }
+                }
+            }
+            Event::Mag { t_ns, field } => {
+                if let Some((mw, mh)) = baselines.as_mut() {
+                    mw.mag(&field);
+                    mh.mag(&field);
+                }
+                let r = nav.magnetometer(t_ns, &lit3(&field));
+                score_report(&mut scorer, &r, "mag", t_ns);
+                scorer.filter_ns += started.elapsed().as_nanos();
+            }
+            // Without GNSS and camera, the other sensors have nothing to aid.
+            _ => {}
+        }
+    }
+    tum.flush().map_err(out_err(&tum_path))?;
+    csv.flush().map_err(out_err(&csv_path))?;
+    if let Some(tr) = truth.as_mut() {
+        tr.finish()?;
+    }
+    super::finish(out, cfg, title, ds, &scorer)?;
+    partials.commit()?;
+    Ok(scorer)
+}

@@ -1,0 +1,147 @@
+//! The files a replay writes: the estimate (TUM and CSV), the truth (TUM) beside it, and the
+//! guard that renames them into place only when the whole run succeeded.
+
+use super::{out_err, ReplayError};
+use crate::dataset::read::{Truth, TruthStream};
+use crate::metrics::{interpolate_truth, Estimate};
+use estimator_core::lie::So3;
+use nalgebra::Vector3;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// The truth at arbitrary times, streamed: keeps the two rows around the requested time.
+pub(super) struct TruthCursor {
+    pub(super) stream: TruthStream,
+    pub(super) prev: Option<Truth>,
+    pub(super) next: Option<Truth>,
+    pub(super) tum: BufWriter<File>,
+    pub(super) tum_path: PathBuf,
+}
+
+impl TruthCursor {
+    /// Reads one more row into `next`, copying it to `groundtruth.tum`.
+    fn advance(&mut self) -> Result<(), ReplayError> {
+        self.prev = self.next.take();
+        self.next = self.stream.next_truth()?;
+        if let Some(n) = &self.next {
+            write_tum(&mut self.tum, n.t_ns, &n.position, &n.attitude)
+                .map_err(out_err(&self.tum_path))?;
+        }
+        Ok(())
+    }
+
+    /// The truth at `t_ns`, interpolated between the rows around it; `None` outside the truth.
+    pub(super) fn at(&mut self, t_ns: u64) -> Result<Option<Truth>, ReplayError> {
+        if self.prev.is_none() && self.next.is_none() {
+            self.advance()?;
+            self.prev = None;
+        }
+        while self.next.is_some_and(|n| n.t_ns < t_ns) {
+            self.advance()?;
+        }
+        Ok(match (self.prev, self.next) {
+            (_, Some(b)) if b.t_ns == t_ns => Some(b),
+            (Some(a), Some(b)) if a.t_ns <= t_ns => Some(interpolate_truth(&a, &b, t_ns)),
+            _ => None,
+        })
+    }
+
+    /// Copies the remaining rows to `groundtruth.tum`.
+    pub(super) fn finish(&mut self) -> Result<(), ReplayError> {
+        while self.next.is_some() || self.prev.is_none() {
+            self.advance()?;
+            if self.next.is_none() {
+                break;
+            }
+        }
+        self.tum.flush().map_err(out_err(&self.tum_path))
+    }
+}
+
+pub(super) fn write_tum(f: &mut impl Write, t_ns: u64, p: &Vector3<f64>, r: &So3<f64>) -> std::io::Result<()> {
+    let q = r.quaternion();
+    writeln!(
+        f,
+        "{}.{:09} {:.6} {:.6} {:.6} {:.9} {:.9} {:.9} {:.9}",
+        t_ns / 1_000_000_000,
+        t_ns % 1_000_000_000,
+        p.x,
+        p.y,
+        p.z,
+        q.i,
+        q.j,
+        q.k,
+        q.w
+    )
+}
+
+/// The file outputs (the plots aside). They are written as `NAME.partial` and renamed together at the
+/// end; on any error (the guard drops uncommitted) the partial files are removed, so a failed
+/// run never leaves outputs that look complete.
+pub(super) const OUTPUTS: [&str; 4] = [
+    "estimate.tum",
+    "estimate.csv",
+    "groundtruth.tum",
+    "metrics.json",
+];
+
+pub(super) struct Partials<'a> {
+    out: &'a Path,
+    committed: bool,
+}
+
+impl<'a> Partials<'a> {
+    pub(super) fn new(out: &'a Path) -> Self {
+        Self {
+            out,
+            committed: false,
+        }
+    }
+
+    /// Removes the outputs (and plots) of an earlier run in the same folder.
+    pub(super) fn clear_previous(&mut self) {
+        for name in OUTPUTS.iter().chain(crate::plot::FILES.iter()) {
+            let _ = std::fs::remove_file(self.out.join(name));
+        }
+    }
+
+    pub(super) fn commit(&mut self) -> Result<(), ReplayError> {
+        for name in OUTPUTS {
+            let from = self.out.join(format!("{name}.partial"));
+            if from.exists() {
+                std::fs::rename(&from, self.out.join(name)).map_err(out_err(&from))?;
+            }
+        }
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Partials<'_> {
+    fn drop(&mut self) {
+        if !self.committed {
+            for name in OUTPUTS {
+                let _ = std::fs::remove_file(self.out.join(format!("{name}.partial")));
+            }
+        }
+    }
+}
+
+pub(super) fn write_estimate_csv(f: &mut impl Write, e: &Estimate) -> std::io::Result<()> {
+    let q = e.attitude.quaternion();
+    let (p, v, bg, ba) = (e.position, e.velocity, e.gyro_bias, e.accel_bias);
+    write!(
+        f,
+        "{},{:.6},{:.6},{:.6},{:.9},{:.9},{:.9},{:.9},{:.6},{:.6},{:.6},{:.9},{:.9},{:.9},{:.6},{:.6},{:.6}",
+        e.t_ns, p.x, p.y, p.z, q.w, q.i, q.j, q.k, v.x, v.y, v.z, bg.x, bg.y, bg.z, ba.x, ba.y, ba.z
+    )?;
+    for s in e.sigmas() {
+        if s.is_finite() {
+            write!(f, ",{s:.6e}")?;
+        } else {
+            write!(f, ",")?;
+        }
+    }
+    writeln!(f)
+}

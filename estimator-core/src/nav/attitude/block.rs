@@ -41,8 +41,28 @@ pub(super) struct BlockStats<T: Real> {
     pub(super) gyro_mean: Vector3<T>,
     /// Total variance of the gyro about its mean, (rad/s)².
     pub(super) gyro_scatter_sq: T,
-    /// Mean field in the body frame at the end, and the number of samples.
-    pub(super) mag_body: Option<(Vector3<T>, u32)>,
+    /// The magnetometer samples of the block, if any.
+    pub(super) mag: Option<MagStats<T>>,
+}
+
+/// The magnetometer part of a finished block.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct MagStats<T: Real> {
+    /// Mean field in the body frame at the end.
+    pub(super) body: Vector3<T>,
+    /// Samples.
+    pub(super) n: u32,
+    /// Total variance of the world-frame field about its mean: a field fixed in the world
+    /// shows only the white noise, one that turns with the body (a magnet on it) shows more.
+    pub(super) scatter_sq: T,
+}
+
+impl<T: Real> BlockStats<T> {
+    /// The rotation of the block, rad: RMS rate about `bias` times the duration.
+    pub(super) fn rotation(&self, bias: &Vector3<T>) -> T {
+        let w = self.gyro_mean - bias;
+        (self.gyro_scatter_sq + w.dot(&w)).sqrt() * self.duration
+    }
 }
 
 impl<T: Real> Default for Block<T> {
@@ -65,10 +85,11 @@ impl<T: Real> Block<T> {
         };
         let to_body = end.inverse();
         let accel_body = to_body.act(&a);
-        let mag_body = self
-            .mag
-            .mean()
-            .map(|m| (to_body.act(&m), self.mag.count()));
+        let mag = self.mag.mean().map(|m| MagStats {
+            body: to_body.act(&m),
+            n: self.mag.count(),
+            scatter_sq: self.mag.scatter_sq(),
+        });
         Some(BlockStats {
             n: self.accel.count(),
             duration: T::from_count(self.elapsed_ns) * T::lit(1e-9),
@@ -77,7 +98,7 @@ impl<T: Real> Block<T> {
             accel_scatter_sq: self.accel.scatter_sq(),
             gyro_mean: w,
             gyro_scatter_sq: self.gyro.scatter_sq(),
-            mag_body,
+            mag,
         })
     }
 }

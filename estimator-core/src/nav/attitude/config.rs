@@ -27,15 +27,16 @@ pub struct MagneticConfig<T: Real> {
     pub norm_tolerance: T,
     /// A block whose dip angle differs from the reference by more than this, rad, is disturbed.
     pub dip_tolerance: T,
-    /// A disturbed field that stays the same (within the two tolerances) for this long, s,
-    /// becomes the new reference (norm and dip; north is kept).
+    /// A disturbed field that stays the same (within the two tolerances) for this long, s…
     pub new_field_s: T,
+    /// …while the body turned at a mean rate of at least this, rad/s.
+    pub new_field_min_rate: T,
 }
 
 impl<T: Real> MagneticConfig<T> {
     /// A magnetometer with white noise `sigma` per axis and an optional reference; the other
     /// values are the defaults listed on each field's use: 2° heading noise per block, 1°
-    /// heading floor, 10 % norm and 10° dip tolerance, 20 s for a new field.
+    /// heading floor, 10 % norm and 10° dip tolerance, 20 s turning at 20 °/s or more for a new field.
     #[must_use]
     pub fn new(sigma: T, reference: Option<Vector3<T>>) -> Self {
         Self {
@@ -46,6 +47,7 @@ impl<T: Real> MagneticConfig<T> {
             norm_tolerance: T::lit(0.1),
             dip_tolerance: T::lit(10.0_f64.to_radians()),
             new_field_s: T::lit(20.0),
+            new_field_min_rate: T::lit(20.0_f64.to_radians()),
         }
     }
 
@@ -60,7 +62,8 @@ impl<T: Real> MagneticConfig<T> {
             && non_negative_finite(self.heading_floor)
             && positive_finite(self.norm_tolerance)
             && positive_finite(self.dip_tolerance)
-            && positive_finite(self.new_field_s);
+            && positive_finite(self.new_field_s)
+            && non_negative_finite(self.new_field_min_rate);
         if ok {
             Ok(())
         } else {
@@ -94,6 +97,10 @@ pub struct AttitudeConfig<T: Real> {
     /// 1σ of the accelerometer bias per axis, m/s²: the tilt is never known better than
     /// `σ_ba/g`.
     pub accelerometer_bias_sigma: T,
+    /// 1σ of the gyro's scale-factor and cross-axis errors (a fraction): a block that turns
+    /// by `θ` adds `(σ_s θ)²` to the attitude variance on every axis. The noise densities of a
+    /// data sheet do not contain this error; it dominates during fast rotation.
+    pub gyro_scale_sigma: T,
     /// 1σ of the gyro bias at switch-on per axis, rad/s (used when the start is not at rest).
     pub gyro_bias_sigma: T,
     /// At rest when the RMS gyro rate about the bias estimate is below this, rad/s…
@@ -119,7 +126,7 @@ pub struct AttitudeConfig<T: Real> {
 impl<T: Real> AttitudeConfig<T> {
     /// The defaults around a filter configuration: trapezoidal IMU integration; 1 s start-up;
     /// 0.25 s blocks; 0.3 s acceleration correlation; 0.1 m/s² accelerometer bias (0.6° of
-    /// tilt); 0.5 °/s gyro bias at switch-on; rest below 2 °/s and 0.5 m/s² for 1.5 s with a
+    /// tilt); 1 % gyro scale and cross-axis error; 0.5 °/s gyro bias at switch-on; rest below 2 °/s and 0.5 m/s² for 1.5 s with a
     /// 0.1 °/s floor; widen after 8 rejected blocks (2 s); valid below 5° tilt and 10° heading;
     /// no magnetometer.
     #[must_use]
@@ -131,6 +138,7 @@ impl<T: Real> AttitudeConfig<T> {
             block_s: T::lit(0.25),
             acceleration_correlation_s: T::lit(0.3),
             accelerometer_bias_sigma: T::lit(0.1),
+            gyro_scale_sigma: T::lit(0.01),
             gyro_bias_sigma: T::lit(0.5_f64.to_radians()),
             rest_gyro: T::lit(2.0_f64.to_radians()),
             rest_accel: T::lit(0.5),
@@ -158,6 +166,7 @@ impl<T: Real> AttitudeConfig<T> {
             && self.block_s < four_seconds
             && positive_finite(self.acceleration_correlation_s)
             && non_negative_finite(self.accelerometer_bias_sigma)
+            && non_negative_finite(self.gyro_scale_sigma)
             && non_negative_finite(self.gyro_bias_sigma)
             && positive_finite(self.rest_gyro)
             && positive_finite(self.rest_accel)

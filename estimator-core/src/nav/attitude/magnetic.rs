@@ -15,14 +15,24 @@
 //! ```
 //!
 //! (`σ_m` the white noise of one sample, `n` samples, `σ_hd` the per-block heading noise of
-//! the configuration), gated at 99.9 %, with the same widening after repeated rejections as
-//! the tilt, and with the heading floor `σ_ψ ≥ heading_floor` applied afterwards.
+//! the configuration), gated at 99.9 %, and with the heading floor `σ_ψ ≥ heading_floor`
+//! applied afterwards. After `max_rejected_blocks` rejections in a row whose innovations agree
+//! within `4σ_hd` while the body turned by 90° or more (or for `new_field_s` without turning,
+//! with norm and dip agreeing all along), the estimate is taken for wrong (a disturbance would
+//! change with the orientation; a heading error does not), the heading covariance is widened
+//! to the innovation and the block fused.
 //!
-//! **A new field.** A disturbed field that stays the same (norm and dip within the tolerances
-//! of the first disturbed block) for `new_field_s` is taken as the new reference: its norm and
-//! dip, with the old reference's north. Without a configured reference, the first block
+//! A block is also disturbed when the field moved in the world during it: a world-frame
+//! scatter beyond the white noise, `s_m² − 3σ_m² > (ε_n ‖m_w‖)²` (a magnet carried by the body
+//! turns with it).
+//!
+//! **A new field.** A disturbed but steady field that stays the same (norm and dip within the
+//! tolerances of the first disturbed block) for `new_field_s`, while the body turned at a mean
+//! rate of at least `new_field_min_rate`, is taken as the new reference: its norm and dip, with
+//! the old reference's north. Without a configured reference, the first block
 //! defines it: `m_w = [0, ‖c_h‖, c_up]`, north is where the field points.
 
+use super::block::MagStats;
 use super::config::{AttitudeConfig, MagneticConfig};
 use super::report::{Event, Fusion, MagneticStatus};
 use super::tilt::world_attitude_covariance;
@@ -44,10 +54,54 @@ fn norm_dip<T: Real>(c: &Vector3<T>) -> (T, T, T) {
 pub(super) struct Magnetic<T: Real> {
     /// The world reference field, once known.
     pub(super) reference: Option<Vector3<T>>,
-    /// The first disturbed field of a run of similar ones, and how long the run has lasted, s.
-    candidate: Option<(Vector3<T>, T)>,
-    /// Consecutive gated-out blocks.
-    rejected: u16,
+    /// The first disturbed field of a run of similar ones, how long the run has lasted, s, and
+    /// how far the body turned meanwhile, rad.
+    candidate: Option<(Vector3<T>, T, T)>,
+    /// The run of consecutive gated-out blocks: how many, the first and the extreme heading
+    /// innovations (rad, relative to the first), and how far the body turned meanwhile, rad.
+    rejected: Rejections<T>,
+}
+
+/// A run of gated-out heading innovations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Rejections<T: Real> {
+    count: u16,
+    first: T,
+    low: T,
+    high: T,
+    turned: T,
+}
+
+impl<T: Real> Rejections<T> {
+    fn none() -> Self {
+        Self {
+            count: 0,
+            first: T::zero(),
+            low: T::zero(),
+            high: T::zero(),
+            turned: T::zero(),
+        }
+    }
+
+    /// Adds a rejected block with heading innovation `r` (wrapped) and rotation `turned`.
+    fn add(&mut self, r: T, turned: T) {
+        if self.count == 0 {
+            *self = Self {
+                count: 1,
+                first: r,
+                low: T::zero(),
+                high: T::zero(),
+                turned,
+            };
+            return;
+        }
+        let (s, c) = (r - self.first).sincos();
+        let d = s.arctan2(c);
+        self.low = if d < self.low { d } else { self.low };
+        self.high = if d > self.high { d } else { self.high };
+        self.turned += turned;
+        self.count = self.count.saturating_add(1);
+    }
 }
 
 impl<T: Real> Magnetic<T> {
@@ -55,7 +109,7 @@ impl<T: Real> Magnetic<T> {
         Self {
             reference: config.reference,
             candidate: None,
-            rejected: 0,
+            rejected: Rejections::none(),
         }
     }
 
@@ -72,23 +126,29 @@ impl<T: Real> Magnetic<T> {
         Vector3::new(T::zero(), h, c.z)
     }
 
-    /// Fuses one block's mean field `m_body` (from `n` samples, over `duration` s).
+    /// Fuses one block's magnetometer samples (a block of `duration` s during which the body
+    /// turned by `rotation` rad).
     pub(super) fn fuse(
         &mut self,
         filter: &mut Ahrs<T>,
-        m_body: &Vector3<T>,
-        n: u32,
+        stats: &MagStats<T>,
         duration: T,
+        rotation: T,
         config: &AttitudeConfig<T>,
         mag: &MagneticConfig<T>,
     ) -> Result<(MagneticStatus, Option<Fusion<T>>, Option<Event>), NavError> {
+        let (m_body, n) = (&stats.body, stats.n);
         let c = filter.state().attitude.act(m_body);
         let Some(reference) = self.reference else {
             self.reference = Some(Self::learn(&c));
             return Ok((MagneticStatus::Fused, None, Some(Event::NewMagneticField)));
         };
-        if !Self::agrees(&c, &reference, mag) {
-            let (status, event) = self.disturbed(&c, &reference, duration, mag);
+        // Beyond the white noise, the field moved in the world during the block.
+        let moving = stats.scatter_sq - T::lit(3.0) * mag.sigma * mag.sigma;
+        let tolerance = mag.norm_tolerance * mat3::norm(&reference);
+        let steady = moving <= tolerance * tolerance;
+        if !(steady && Self::agrees(&c, &reference, mag)) {
+            let (status, event) = self.disturbed(&c, &reference, duration, rotation, steady, mag);
             return Ok((status, None, event));
         }
         self.candidate = None;
@@ -103,16 +163,22 @@ impl<T: Real> Magnetic<T> {
         let mut event = None;
         let mut fusion = Fusion::from(filter.update(&model, &options)?);
         if fusion.accepted {
-            self.rejected = 0;
+            self.rejected = Rejections::none();
         } else {
-            self.rejected = self.rejected.saturating_add(1);
-            if self.rejected >= config.max_rejected_blocks {
-                let c_az = c.y.arctan2(c.x);
-                let r_az = reference.y.arctan2(reference.x);
-                let (s, co) = (r_az - c_az).sincos();
-                filter.widen_attitude(T::zero(), s.arctan2(co).abs())?;
+            let (s, co) = (reference.y.arctan2(reference.x) - c.y.arctan2(c.x)).sincos();
+            let innovation = s.arctan2(co);
+            self.rejected.add(innovation, rotation);
+            let run = &self.rejected;
+            // The estimate is what is wrong when the magnetometer keeps telling the same heading
+            // error while the body turns: a disturbance would change with the orientation.
+            let lasted = T::from_count(u32::from(run.count)) * duration;
+            let wrong_estimate = run.count >= config.max_rejected_blocks
+                && run.high - run.low <= T::lit(4.0) * mag.heading_noise
+                && (run.turned >= T::frac_pi_2() || lasted >= mag.new_field_s);
+            if wrong_estimate {
+                filter.widen_attitude(T::zero(), innovation.abs())?;
                 fusion = Fusion::from(filter.update(&model, &options)?);
-                self.rejected = 0;
+                self.rejected = Rejections::none();
                 event = Some(Event::HeadingWidened);
             }
         }
@@ -129,20 +195,30 @@ impl<T: Real> Magnetic<T> {
         Ok((status, Some(fusion), event))
     }
 
-    /// A disturbed block: tracks a run of similar fields and takes it as the new reference
-    /// once it has lasted `new_field_s`.
+    /// A disturbed block: tracks a run of similar, steady fields and takes it as the new
+    /// reference once it has lasted `new_field_s` while the body turned at a mean rate of at
+    /// least `new_field_min_rate` (a field that stays the same in the world while the body
+    /// turns is not a magnet carried by the body).
     fn disturbed(
         &mut self,
         c: &Vector3<T>,
         reference: &Vector3<T>,
         duration: T,
+        rotation: T,
+        steady: bool,
         mag: &MagneticConfig<T>,
     ) -> (MagneticStatus, Option<Event>) {
+        if !steady {
+            self.candidate = None;
+            return (MagneticStatus::Disturbed, None);
+        }
         let run = match self.candidate {
-            Some((first, t)) if Self::agrees(c, &first, mag) => (first, t + duration),
-            _ => (*c, duration),
+            Some((first, t, turned)) if Self::agrees(c, &first, mag) => {
+                (first, t + duration, turned + rotation)
+            }
+            _ => (*c, duration, rotation),
         };
-        if run.1 < mag.new_field_s {
+        if run.1 < mag.new_field_s || run.2 < mag.new_field_min_rate * run.1 {
             self.candidate = Some(run);
             return (MagneticStatus::Disturbed, None);
         }

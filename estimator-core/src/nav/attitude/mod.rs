@@ -370,13 +370,18 @@ impl<T: Real> AttitudeNavigator<T> {
                 if self.report.event.is_none() {
                     self.report.event = Some(Event::Started);
                 }
-                if stats.mag_body.is_some() && self.magnetic.is_some() {
+                if stats.mag.is_some() && self.magnetic.is_some() {
                     self.report.magnetic = MagneticStatus::Fused;
                 }
                 return Ok(());
             }
             Phase::Running { filter } => filter,
         };
+        // The gyro's scale and cross-axis errors over the block's rotation.
+        let turned = self.config.gyro_scale_sigma * stats.rotation(&filter.state().gyro_bias);
+        if turned > T::zero() {
+            filter.widen_attitude(turned, turned)?;
+        }
         // Rest: zero-rate update of the gyro bias.
         let still = rest::is_still(&stats, &filter.state().gyro_bias, &self.config, g);
         self.still_s = if still {
@@ -413,13 +418,14 @@ impl<T: Real> AttitudeNavigator<T> {
             self.report.event = event;
         }
         // Heading.
-        if let (Some(state), Some(mag), Some((m, n))) = (
+        if let (Some(state), Some(mag), Some(ms)) = (
             self.magnetic.as_mut(),
             self.config.magnetometer.as_ref(),
-            stats.mag_body,
+            stats.mag,
         ) {
+            let rotation = stats.rotation(&filter.state().gyro_bias);
             let (status, fusion, event) =
-                state.fuse(filter, &m, n, stats.duration, &self.config, mag)?;
+                state.fuse(filter, &ms, stats.duration, rotation, &self.config, mag)?;
             self.report.magnetic = status;
             self.report.fused.heading = fusion;
             let c = &mut self.counters;

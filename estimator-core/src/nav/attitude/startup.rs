@@ -45,8 +45,9 @@ pub(super) fn start<T: Real>(
 
     let up_body = stats.accel_body / stats.accel_norm;
     // The field and its reference, when both exist (a missing reference is learned here).
-    let field = match (magnetic.as_mut(), config.magnetometer.as_ref(), stats.mag_body) {
-        (Some(state), Some(mag), Some((m, n))) => {
+    let field = match (magnetic.as_mut(), config.magnetometer.as_ref(), stats.mag) {
+        (Some(state), Some(mag), Some(ms)) => {
+            let (m, n) = (ms.body, ms.n);
             let vertical = m.dot(&up_body);
             let reference = *state.reference.get_or_insert_with(|| {
                 let h = mat3::norm(&(m - up_body * vertical));

@@ -1,6 +1,7 @@
 //! `host-sim`: the host-side simulator, dataset replay and scoring for `estimator-core`.
 //!
 //! * [`baseline`]: Madgwick and Mahony, measured on the same data as the filter.
+//! * [`calibrate`]: IMU and magnetometer noise from a static recording (Allan deviation).
 //! * [`trajectory`]: smooth analytic SE(3) motions with exact derivatives.
 //! * [`sensors`]: IMU, magnetometer, GNSS, camera and barometer models.
 //! * [`scenario`]: named and TOML scenarios.
@@ -14,6 +15,7 @@
 #![warn(missing_docs)]
 
 pub mod baseline;
+pub mod calibrate;
 pub mod dataset;
 pub mod metrics;
 pub mod montecarlo;

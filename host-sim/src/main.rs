@@ -126,6 +126,31 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             print_summary(&title, 0, &cfg, &m, &out);
             Ok(())
         }
+        Command::Calibrate {
+            dir,
+            out,
+            from,
+            to,
+            force,
+        } => {
+            if let (Ok(d), Ok(o)) = (dir.canonicalize(), out.canonicalize()) {
+                if d.starts_with(&o) {
+                    return Err(format!(
+                        "{}: the output folder holds the dataset {}; name another folder with --out",
+                        out.display(),
+                        dir.display()
+                    )
+                    .into());
+                }
+            }
+            let staging = Staging::new(&out, force, "calibrate")?;
+            let cal = host_sim::calibrate::calibrate(&dir, from, to)?;
+            cal.write(staging.dir())?;
+            staging.commit()?;
+            out!("{}", cal.table());
+            out!("  outputs in {}", out.display());
+            Ok(())
+        }
         Command::Montecarlo {
             scenario,
             runs,

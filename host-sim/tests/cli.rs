@@ -565,3 +565,170 @@ fn an_empty_ground_truth_is_an_error_not_a_zero_rmse() {
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// `calibrate` on a simulated static recording: the table, the four outputs, `sensor.yaml` files
+/// the dataset reader parses, and per axis a white noise density within the Allan estimator's
+/// confidence of the simulated one.
+#[test]
+fn calibrate_a_static_recording() {
+    use host_sim::dataset::yaml::SensorYaml;
+    use host_sim::sensors::imu::ImuConfig;
+    let dir = tmp("calibrate");
+    let ds = dir.join("ds");
+    simulate("static", &ds);
+    let out = dir.join("noise");
+    let o = host_sim(&[
+        "calibrate",
+        ds.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for word in [
+        "gyroscope",
+        "accelerometer",
+        "magnetometer",
+        "rad/s/√Hz",
+        "K not resolved",
+        "imu0/sensor.yaml",
+    ] {
+        assert!(text.contains(word), "'{word}' not in:\n{text}");
+    }
+    for f in [
+        "imu0/sensor.yaml",
+        "mag0/sensor.yaml",
+        "allan.csv",
+        "calibration.json",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+
+    let imu = SensorYaml::read(&out.join("imu0/sensor.yaml")).expect("imu0/sensor.yaml parses");
+    assert!((imu.f64("rate_hz").unwrap() - 200.0).abs() < 1e-9);
+    let t_bs = imu.list("T_BS", 16).unwrap();
+    assert!(t_bs
+        .iter()
+        .enumerate()
+        .all(|(i, &x)| x == if i % 5 == 0 { 1.0 } else { 0.0 }));
+    let json: serde_json::Value = serde_json::from_slice(&read(&out.join("calibration.json")))
+        .expect("calibration.json parses");
+
+    // The simulated IMU: white noise, a bias random walk, and rounding to its LSB (white, of
+    // variance lsb²/12 per sample). At the τ each axis was read, σ(τ)·√τ exceeds the density
+    // by the walk's and the rounding's share; the estimate scatters by its relative error ε.
+    let c = ImuConfig::default();
+    for (sensor, key, n, k, lsb) in [
+        (
+            "gyroscope",
+            "gyroscope_noise_density",
+            c.gyroscope_noise_density,
+            c.gyroscope_random_walk,
+            c.gyro_lsb,
+        ),
+        (
+            "accelerometer",
+            "accelerometer_noise_density",
+            c.accelerometer_noise_density,
+            c.accelerometer_random_walk,
+            c.accel_lsb,
+        ),
+    ] {
+        let axes = json[sensor]["axes"].as_array().expect("axes");
+        assert_eq!(axes.len(), 3);
+        let mut largest = 0.0f64;
+        for a in axes {
+            let w = &a["white_noise"];
+            let (value, tau, eps) = (
+                w["value"].as_f64().unwrap(),
+                w["tau"].as_f64().unwrap(),
+                w["relative_error"].as_f64().unwrap(),
+            );
+            let rounding = lsb * lsb / 12.0 / c.rate_hz;
+            let share = ((n * n + rounding + k * k * tau * tau / 3.0) / (n * n)).sqrt() - 1.0;
+            let tol = 3.0 * eps + share;
+            assert!(
+                (value / n - 1.0).abs() <= tol,
+                "{sensor} {}: N = {value} at τ = {tau} s against {n} (tolerance {tol})",
+                a["axis"]
+            );
+            largest = largest.max(value);
+        }
+        let written = imu.f64(key).unwrap();
+        assert!(
+            (written / largest - 1.0).abs() < 1e-12,
+            "{key}: {written} is not the largest axis {largest}"
+        );
+        assert_eq!(
+            json[sensor]["random_walk_resolved"].as_bool(),
+            Some(false),
+            "60 s cannot resolve a {sensor} random walk"
+        );
+    }
+
+    // The magnetometer: 60 s at 50 Hz of white noise σ = 0.4 µT; a standard deviation over n
+    // samples scatters by 1/√(2(n − 1)).
+    let mag = SensorYaml::read(&out.join("mag0/sensor.yaml")).expect("mag0/sensor.yaml parses");
+    assert!((mag.f64("rate_hz").unwrap() - 50.0).abs() < 1e-9);
+    let n = json["mag"]["samples"].as_f64().unwrap();
+    let sigma = mag.f64("sigma").unwrap();
+    assert!(
+        (sigma / 0.4 - 1.0).abs() <= 3.0 / (2.0 * (n - 1.0)).sqrt(),
+        "sigma {sigma}"
+    );
+    assert!(
+        mag.list("reference_field", 3).is_err(),
+        "the reference field is not calibrated"
+    );
+    let csv = std::fs::read_to_string(out.join("allan.csv")).unwrap();
+    assert!(csv.starts_with("sensor,tau [s],m,sigma_x,sigma_y,sigma_z,unit,relative_error\n"));
+    for sensor in ["gyroscope,", "accelerometer,", "magnetometer,"] {
+        assert!(csv.lines().filter(|l| l.starts_with(sensor)).count() >= 5);
+    }
+
+    // An earlier output needs --force; the dataset folder is never the output.
+    let again = |extra: &[&str]| {
+        let mut args = vec!["calibrate", ds.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        host_sim(&args)
+    };
+    assert!(!again(&["--out", out.to_str().unwrap()]).status.success());
+    assert!(again(&["--out", out.to_str().unwrap(), "--force"])
+        .status
+        .success());
+    let o = again(&["--out", ds.to_str().unwrap(), "--force"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("holds the dataset"));
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// A reversed interval, or one too short for an Allan curve, is a one-line error naming the
+/// option or the file, and writes nothing.
+#[test]
+fn calibrate_refuses_bad_intervals() {
+    let dir = tmp("calibrate-bad");
+    let ds = dir.join("ds");
+    simulate("static", &ds);
+    let out = dir.join("noise");
+    for (args, expect) in [
+        (&["--from", "10", "--to", "5"][..], "--to 5"),
+        (&["--from=-1"][..], "--from -1"),
+        (&["--to", "0.1"][..], "imu0/data.csv"),
+        (&["--from", "100"][..], "imu0/data.csv"),
+    ] {
+        let mut all = vec![
+            "calibrate",
+            ds.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        all.extend_from_slice(args);
+        let o = host_sim(&all);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} should fail");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(expect), "{args:?}: '{expect}' not in {err}");
+        assert!(!out.exists(), "{args:?}: output left behind");
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}

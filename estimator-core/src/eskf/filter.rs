@@ -4,7 +4,7 @@ use super::align::{prior_attitude_covariance, Alignment, InitialSigmas};
 use super::config::{FilterConfig, ImuSample};
 use super::covariance::{check_start, sigmas};
 use super::error::{EskfError, UpdateOutcome};
-use super::state::{sealed::Sealed, AhrsState, ErrorState, InsState};
+use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use super::update::{update, Measurement, UpdateOptions};
 use crate::kernels::block::{add_scaled_identity, block, set_block};
 use crate::kernels::{all_finite, non_negative_finite};
@@ -67,6 +67,26 @@ pub type Ins<T> = Filter<T, InsState<T>, 15>;
 /// assert!((yaw - 0.5).abs() < 1e-3);
 /// ```
 pub type Ahrs<T> = Filter<T, AhrsState<T>, 6>;
+
+/// The attitude filter with both IMU biases, `x = (R, b_g, b_a)`, `δx ∈ R⁹`: an [`Ahrs`] that
+/// also estimates the accelerometer bias, aided by
+/// [`AccelerometerAtRest`](super::AccelerometerAtRest) (the specific force, bias included),
+/// [`MagneticHeading`](super::MagneticHeading) and [`ZeroRate`](super::ZeroRate). Its
+/// prediction reads only the gyro and `dt`.
+///
+/// ```
+/// use estimator_core::eskf::{AccelerometerAtRest, AhrsAccelBias, AhrsAccelBiasState, FilterConfig, UpdateOptions};
+/// use nalgebra::{SMatrix, Vector3};
+///
+/// let p0 = SMatrix::<f64, 9, 9>::identity() * 1e-2;
+/// let mut f = AhrsAccelBias::new(AhrsAccelBiasState::identity(), p0, FilterConfig::default()).unwrap();
+/// // Level, with a 0.2 m/s² bias on the vertical axis: only the bias can explain the norm.
+/// for _ in 0..20 {
+///     f.update(&AccelerometerAtRest::new(Vector3::new(0.0, 0.0, 10.01), 0.01), &UpdateOptions::default()).unwrap();
+/// }
+/// assert!((f.state().accel_bias.z - 0.2).abs() < 0.01);
+/// ```
+pub type AhrsAccelBias<T> = Filter<T, AhrsAccelBiasState<T>, 9>;
 
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
     /// From a given state and covariance.
@@ -233,6 +253,34 @@ impl<T: Real> Filter<T, AhrsState<T>, 6> {
         let state = AhrsState {
             attitude: alignment.attitude,
             gyro_bias: alignment.gyro_bias,
+        };
+        Self::new(state, p, config)
+    }
+}
+
+impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 9> {
+    /// From an [`Alignment`] (accelerometer bias zero), with `sigmas.tilt`, `sigmas.yaw`,
+    /// `sigmas.gyro_bias`, `sigmas.accel_bias`.
+    ///
+    /// # Errors
+    /// As [`Filter::new`], and [`EskfError::ZeroNorm`] for a zero gravity.
+    pub fn from_alignment(
+        alignment: &Alignment<T>,
+        sigmas: &InitialSigmas<T>,
+        config: FilterConfig<T>,
+    ) -> Result<Self, EskfError> {
+        config.validate()?;
+        let mut p = SMatrix::<T, 9, 9>::zeros();
+        match prior_attitude_covariance(alignment, sigmas, &config) {
+            Ok(attitude) => set_block(&mut p, 0, 0, &attitude),
+            Err(e) => return Err(e),
+        }
+        add_scaled_identity(&mut p, 1, 1, sigmas.gyro_bias * sigmas.gyro_bias);
+        add_scaled_identity(&mut p, 2, 2, sigmas.accel_bias * sigmas.accel_bias);
+        let state = AhrsAccelBiasState {
+            attitude: alignment.attitude,
+            gyro_bias: alignment.gyro_bias,
+            accel_bias: Vector3::zeros(),
         };
         Self::new(state, p, config)
     }

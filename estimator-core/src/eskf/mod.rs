@@ -133,12 +133,12 @@ mod update;
 pub use align::{align_at_rest, Alignment, InitialSigmas, MagnetometerWindow};
 pub use config::{FilterConfig, ImuNoise, ImuSample};
 pub use error::{EskfError, UpdateOutcome};
-pub use filter::{Ahrs, Filter, Ins};
+pub use filter::{Ahrs, AhrsAccelBias, Filter, Ins};
 pub use models::{
     AccelerometerAtRest, BaroAltitude, CameraLandmark, GnssPosition, GnssVelocity,
     GravityDirection, Heading, MagneticHeading, Magnetometer, PinholeIntrinsics, ZeroRate,
     ZeroVelocity,
 };
-pub use state::{AhrsState, ErrorState, InsState};
+pub use state::{AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 pub use update::gate::{Gate, GateProbability, CHI_SQUARE_TABLE};
 pub use update::{Linearization, Measurement, UpdateOptions};

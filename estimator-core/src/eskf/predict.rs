@@ -3,12 +3,12 @@
 
 use super::config::{check_dt, FilterConfig, ImuSample};
 use super::error::EskfError;
-use super::state::{sealed::Sealed, AhrsState, ErrorState, InsState};
+use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use crate::kernels::block::{add_scaled_identity, block, block_in, set_block};
 use crate::kernels::{all_finite, mat3};
 use crate::lie::{skew, LieGroup, So3};
 use crate::Real;
-use nalgebra::{Matrix3, SMatrix};
+use nalgebra::{Matrix3, SMatrix, Vector3};
 
 /// The nonzero blocks of the block rows θ, v, p (0, 1, 2) of the 15-state `F` (block indices
 /// θ=0, v=1, p=2, b_g=3, b_a=4):
@@ -151,12 +151,16 @@ fn predict_ins<T: Real>(
     Ok(())
 }
 
-/// The attitude-only prediction: `R⁺ = R exp((ω_m − b_g) dt)`, `P⁺ = F P Fᵀ + Q`,
-/// `F = [ΔRᵀ, −J_r dt; 0, I]`, `Q = diag(σ_g² dt I, σ_bg² dt I)`. Only the gyro and `dt` of the
-/// sample are read.
-fn predict_ahrs<T: Real>(
-    x: &mut AhrsState<T>,
-    p: &mut SMatrix<T, 6, 6>,
+/// The attitude-only prediction for the attitude states (`N = 6`: `(R, b_g)`; `N = 9`:
+/// `(R, b_g, b_a)`): `R⁺ = R exp((ω_m − b_g) dt)`, `P⁺ = F P Fᵀ + Q` with
+/// `F = [ΔRᵀ, −J_r dt, 0; 0, I, 0; 0, 0, I]` and `Q = diag(σ_g² dt I, σ_bg² dt I, σ_ba² dt I)`.
+/// Only the gyro and `dt` of the sample are read. Block row 0 of `F P` is
+/// `M0j = F00 P0j + F01 P1j`; then `P⁺00 = M00 F00ᵀ + M01 F01ᵀ`, `P⁺0j = M0j` (`j ≥ 1`), and
+/// the bias blocks are unchanged.
+fn predict_attitude<T: Real, const N: usize>(
+    attitude: &mut So3<T>,
+    gyro_bias: &Vector3<T>,
+    p: &mut SMatrix<T, N, N>,
     imu: &ImuSample<T>,
     cfg: &FilterConfig<T>,
 ) -> Result<(), EskfError> {
@@ -165,13 +169,12 @@ fn predict_ahrs<T: Real>(
     }
     let dt = imu.dt;
     check_dt(dt, cfg.max_dt)?;
-    let (dr, jr) = So3::exp_jac(&((imu.gyro - x.gyro_bias) * dt));
+    let (dr, jr) = So3::exp_jac(&((imu.gyro - gyro_bias) * dt));
     // F00 = ΔRᵀ, so F00ᵀ = ΔR.
     let f00t = dr.rotation_matrix();
     let f00 = f00t.transpose();
     let f01 = jr * -dt;
     let (p00, p01, p11) = (block(p, 0, 0), block(p, 0, 1), block(p, 1, 1));
-    // M0j = F00 P0j + F01 P1j; P⁺00 = M00 F00ᵀ + M01 F01ᵀ; P⁺01 = M01; P⁺11 = P11.
     let m00 = mat3::mul(&f00, &p00) + mat3::mul(&f01, &p01.transpose());
     let m01 = mat3::mul(&f00, &p01) + mat3::mul(&f01, &p11);
     // N00 is symmetric: its upper triangle, mirrored.
@@ -179,16 +182,23 @@ fn predict_ahrs<T: Real>(
     let n00 = Matrix3::new(
         n.m11, n.m12, n.m13, n.m12, n.m22, n.m23, n.m13, n.m23, n.m33,
     );
-    let attitude = x.attitude.compose(&dr).renormalize();
+    let next = attitude.compose(&dr).renormalize();
     // As in the 15-state prediction: a non-finite F or an overflow shows on the diagonal of
-    // N00, which bounds M01 through the positive semi-definite P⁺.
+    // N00, which bounds M01 and M02 through the positive semi-definite P⁺.
     let diagonal_finite = (0..3).all(|k| n00.get((k, k)).is_some_and(|d| d.is_finite()));
-    if !(diagonal_finite && attitude.is_finite()) {
+    if !(diagonal_finite && next.is_finite()) {
         return Err(EskfError::NonFinite);
     }
     set_block(p, 0, 0, &n00);
     set_block(p, 0, 1, &m01);
     set_block(p, 1, 0, &m01.transpose());
+    // The accelerometer-bias column, when there is one (`N` is a constant: the 6-state
+    // filter compiles without it).
+    if N >= 9 {
+        let m02 = mat3::mul(&f00, &block(p, 0, 2)) + mat3::mul(&f01, &block(p, 1, 2));
+        set_block(p, 0, 2, &m02);
+        set_block(p, 2, 0, &m02.transpose());
+    }
     let n = &cfg.imu_noise;
     add_scaled_identity(
         p,
@@ -202,7 +212,13 @@ fn predict_ahrs<T: Real>(
         1,
         n.gyroscope_random_walk * n.gyroscope_random_walk * dt,
     );
-    x.attitude = attitude;
+    add_scaled_identity(
+        p,
+        2,
+        2,
+        n.accelerometer_random_walk * n.accelerometer_random_walk * dt,
+    );
+    *attitude = next;
     Ok(())
 }
 
@@ -224,6 +240,17 @@ impl<T: Real> Sealed<T, 6> for AhrsState<T> {
         imu: &ImuSample<T>,
         config: &FilterConfig<T>,
     ) -> Result<(), EskfError> {
-        predict_ahrs(self, p, imu, config)
+        predict_attitude(&mut self.attitude, &self.gyro_bias, p, imu, config)
+    }
+}
+
+impl<T: Real> Sealed<T, 9> for AhrsAccelBiasState<T> {
+    fn propagate(
+        &mut self,
+        p: &mut SMatrix<T, 9, 9>,
+        imu: &ImuSample<T>,
+        config: &FilterConfig<T>,
+    ) -> Result<(), EskfError> {
+        predict_attitude(&mut self.attitude, &self.gyro_bias, p, imu, config)
     }
 }

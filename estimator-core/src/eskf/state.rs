@@ -12,7 +12,8 @@ use nalgebra::{Matrix3x4, SVector, Vector3};
 /// Manifolds for Robotic State Estimation*, eq. 4.5: `a ⊕ τ = a·exp(τ^)`) and whose other
 /// components are additive (`x = x̂ + δx`).
 ///
-/// Sealed: implemented by [`InsState`] (`N = 15`) and [`AhrsState`] (`N = 6`).
+/// Sealed: implemented by [`InsState`] (`N = 15`), [`AhrsState`] (`N = 6`) and
+/// [`AhrsAccelBiasState`] (`N = 9`).
 pub trait ErrorState<T: Real, const N: usize>: Copy + sealed::Sealed<T, N> {
     /// `x ⊕ δx`: `R ← R·exp(δθ^)`, every other block `+ δ`.
     #[must_use]
@@ -96,6 +97,52 @@ impl<T: Real> AhrsState<T> {
             attitude: So3::identity(),
             gyro_bias: Vector3::zeros(),
         }
+    }
+}
+
+/// The attitude nominal state with both IMU biases, `x = (R, b_g, b_a)`,
+/// `δx = (δθ, δb_g, δb_a) ∈ R⁹` (indices 0–2, 3–5, 6–8): an AHRS that also estimates the
+/// accelerometer bias, which the accelerometer's readings in different orientations separate
+/// from the tilt.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AhrsAccelBiasState<T: Real> {
+    /// `R`: world from body.
+    pub attitude: So3<T>,
+    /// `b_g`: gyroscope bias (body frame), rad/s.
+    pub gyro_bias: Vector3<T>,
+    /// `b_a`: accelerometer bias (body frame), m/s²; `f = f_m − b_a`.
+    pub accel_bias: Vector3<T>,
+}
+
+impl<T: Real> AhrsAccelBiasState<T> {
+    /// Level, zero biases.
+    #[must_use]
+    pub fn identity() -> Self {
+        Self {
+            attitude: So3::identity(),
+            gyro_bias: Vector3::zeros(),
+            accel_bias: Vector3::zeros(),
+        }
+    }
+}
+
+impl<T: Real> ErrorState<T, 9> for AhrsAccelBiasState<T> {
+    fn oplus(&self, dx: &SVector<T, 9>) -> Self {
+        Self {
+            attitude: self.attitude.rplus(&segment(dx, 0)).normalize(),
+            gyro_bias: self.gyro_bias + segment(dx, 3),
+            accel_bias: self.accel_bias + segment(dx, 6),
+        }
+    }
+
+    fn is_finite(&self) -> bool {
+        self.attitude.is_finite()
+            && all_finite(self.gyro_bias.as_slice())
+            && all_finite(self.accel_bias.as_slice())
+    }
+
+    fn attitude(&self) -> &So3<T> {
+        &self.attitude
     }
 }
 

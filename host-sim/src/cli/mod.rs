@@ -6,6 +6,7 @@
 //! | `host-sim simulate --scenario NAME [--seed N] --out DIR [--force]` | write a dataset folder with ground truth ([`crate::dataset`]) |
 //! | `host-sim replay DATASET [--out DIR] [--config FILE] [--force]` | run the filter over a dataset folder, with or without ground truth |
 //! | `host-sim montecarlo --scenario NAME --runs N` | consistency over seeds: NEES / NIS against chi-square bands |
+//! | `host-sim calibrate DIR [--out DIR] [--from S] [--to S] [--force]` | IMU and magnetometer noise from a static recording (Allan deviation, `host_sim::calibrate`) |
 //! | `host-sim scenarios` | list the built-in scenarios |
 //!
 //! Every output folder is written beside its target and moved into place when the command
@@ -117,6 +118,34 @@ writes nothing.\n\nExample: host-sim montecarlo --scenario matched_ins --runs 60
         /// Exit non-zero when a band is missed.
         #[arg(long)]
         check: bool,
+    },
+    /// IMU and magnetometer noise from a static recording (Allan deviation).
+    #[command(
+        after_help = "Reads DIR/imu0/data.csv and, when present, DIR/mag0/data.csv (EuRoC layout), between --from \
+and --to seconds after the first IMU sample (default: all of it); the sensor must be at rest there.\n\
+Prints per sensor and axis the white noise density N, bias instability B and rate random walk K with the \
+cluster time each was read at.\n\
+Writes into --out: imu0/sensor.yaml (rate_hz, gyroscope_/accelerometer_noise_density and _random_walk, the \
+largest over the axes, T_BS identity), mag0/sensor.yaml (rate_hz, sigma; reference_field is left to you), \
+allan.csv (tau and sigma per axis per sensor) and calibration.json (everything printed).\n\n\
+Example: host-sim calibrate data/bench_static --to 30 --out out/imu_noise"
+    )]
+    Calibrate {
+        /// The dataset folder (imu0/data.csv required, mag0/data.csv optional).
+        dir: PathBuf,
+        /// Output folder.
+        #[arg(long, default_value = "out/calibration")]
+        out: PathBuf,
+        /// Start of the static interval, seconds after the first IMU sample.
+        #[arg(long)]
+        from: Option<f64>,
+        /// End of the static interval, seconds after the first IMU sample (default: the end).
+        #[arg(long)]
+        to: Option<f64>,
+        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
+        /// files is never replaced).
+        #[arg(long)]
+        force: bool,
     },
     /// List the built-in scenarios.
     Scenarios,

@@ -60,9 +60,11 @@ pub struct ReplayConfig {
     /// Attitude navigator: 1σ of the accelerometer bias per axis, m/s² (the tilt floor is
     /// this over g; 0 where the accelerometer has no bias).
     pub accelerometer_bias_sigma: f64,
+    /// Attitude navigator: 1σ of the gyro's scale-factor and cross-axis errors (fraction).
+    pub gyro_scale_sigma: f64,
     /// Attitude navigator: 1σ of the gyro bias at switch-on, °/s.
     pub gyro_bias_sigma_dps: f64,
-    /// Attitude navigator: heading noise of one magnetometer block beyond the white noise, °.
+    /// Attitude navigator: heading noise density beyond the magnetometer's white noise, °·√s.
     pub heading_noise_deg: f64,
     /// Attitude navigator: lower bound on the heading's 1σ with a magnetometer, °.
     pub heading_floor_deg: f64,
@@ -99,6 +101,7 @@ impl ReplayConfig {
         for (name, x) in [
             ("accelerometer_bias_sigma", self.accelerometer_bias_sigma),
             ("gyro_bias_sigma_dps", self.gyro_bias_sigma_dps),
+            ("gyro_scale_sigma", self.gyro_scale_sigma),
             ("heading_noise_deg", self.heading_noise_deg),
             ("heading_floor_deg", self.heading_floor_deg),
         ] {
@@ -129,7 +132,8 @@ impl Default for ReplayConfig {
             acceleration_correlation_s: 0.3,
             accelerometer_bias_sigma: 0.1,
             gyro_bias_sigma_dps: 0.5,
-            heading_noise_deg: 2.0,
+            gyro_scale_sigma: 0.01,
+            heading_noise_deg: 6.0,
             heading_floor_deg: 1.0,
             instantaneous_imu: true,
             plots: true,

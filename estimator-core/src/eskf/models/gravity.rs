@@ -3,7 +3,7 @@
 
 use super::shared::{attitude_only, in_body, isotropic, three_rows};
 use crate::eskf::error::EskfError;
-use crate::eskf::state::{ErrorState, InsState};
+use crate::eskf::state::{AhrsAccelBiasState, ErrorState, InsState};
 use crate::eskf::update::{Linearization, Measurement};
 use crate::kernels::{all_finite, mat3};
 use crate::lie::So3;
@@ -76,8 +76,9 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for G
     }
 }
 
-/// The accelerometer of a body at rest (15-state filter): `h(x) = Rᵀ(−g) + b_a`,
-/// `H = [[Rᵀ(−g)]×, 0, 0, 0, I]`. Unlike [`GravityDirection`] it models the accelerometer bias,
+/// The accelerometer of a body at rest (or its mean over a while, with the mean linear
+/// acceleration in the noise), for the filters with an accelerometer bias: `h(x) = Rᵀ(−g) + b_a`,
+/// `H = [[Rᵀ(−g)]×, 0, …, I]` (the identity on the `b_a` columns). Unlike [`GravityDirection`] it models the accelerometer bias,
 /// so repeated updates at rest stay consistent (tilt and horizontal bias are separated only as
 /// far as the data allow).
 ///
@@ -116,17 +117,40 @@ impl<T: Real> AccelerometerAtRest<T> {
     }
 }
 
-impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
-    fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
+impl<T: Real> AccelerometerAtRest<T> {
+    /// `z − (Rᵀ(−g) + b_a)` and `H`, with the bias columns starting at `column`.
+    fn linearization<const N: usize>(
+        &self,
+        attitude: &So3<T>,
+        accel_bias: &Vector3<T>,
+        column: usize,
+    ) -> Result<Linearization<T, N, 3>, EskfError> {
         if !(all_finite(self.accel.as_slice()) && all_finite(self.gravity.as_slice())) {
             return Err(EskfError::NonFinite);
         }
         if self.accel.norm_squared() <= T::zero() {
             return Err(EskfError::ZeroNorm);
         }
-        let (predicted, d_attitude) = in_body(&x.attitude, &-self.gravity);
-        let residual = self.accel - (predicted + x.accel_bias);
-        Ok(three_rows(residual, &[(0, &d_attitude)], &[12]))
+        let (predicted, d_attitude) = in_body(attitude, &-self.gravity);
+        let residual = self.accel - (predicted + accel_bias);
+        Ok(three_rows(residual, &[(0, &d_attitude)], &[column]))
+    }
+}
+
+impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
+    fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
+        self.linearization(&x.attitude, &x.accel_bias, 12)
+    }
+
+    fn noise(&self) -> Matrix3<T> {
+        self.noise
+    }
+}
+
+/// The attitude filter with both biases: the bias columns are 6–8.
+impl<T: Real> Measurement<T, AhrsAccelBiasState<T>, 9, 3> for AccelerometerAtRest<T> {
+    fn linearize(&self, x: &AhrsAccelBiasState<T>) -> Result<Linearization<T, 9, 3>, EskfError> {
+        self.linearization(&x.attitude, &x.accel_bias, 6)
     }
 
     fn noise(&self) -> Matrix3<T> {

@@ -2,7 +2,7 @@
 
 use super::shared::{isotropic, three_rows};
 use crate::eskf::error::EskfError;
-use crate::eskf::state::{AhrsState, InsState};
+use crate::eskf::state::{AhrsAccelBiasState, AhrsState, InsState};
 use crate::eskf::update::{Linearization, Measurement};
 use crate::kernels::all_finite;
 use crate::Real;
@@ -68,6 +68,16 @@ impl<T: Real> Measurement<T, AhrsState<T>, 6, 3> for ZeroRate<T> {
 impl<T: Real> Measurement<T, InsState<T>, 15, 3> for ZeroRate<T> {
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 3>, EskfError> {
         self.linearization(&x.gyro_bias, 9)
+    }
+
+    fn noise(&self) -> Matrix3<T> {
+        self.noise
+    }
+}
+
+impl<T: Real> Measurement<T, AhrsAccelBiasState<T>, 9, 3> for ZeroRate<T> {
+    fn linearize(&self, x: &AhrsAccelBiasState<T>) -> Result<Linearization<T, 9, 3>, EskfError> {
+        self.linearization(&x.gyro_bias, 3)
     }
 
     fn noise(&self) -> Matrix3<T> {

@@ -15,9 +15,10 @@ pub struct MagneticConfig<T: Real> {
     pub reference: Option<Vector3<T>>,
     /// White noise of one sample, per axis (the magnetometer's unit).
     pub sigma: T,
-    /// Heading noise of one block beyond the white noise, rad: what a magnetometer reads wrong
-    /// for a while without the norm or the dip showing it (iron nearby, residual calibration).
-    /// It sets how fast the heading follows the magnetometer.
+    /// Heading noise beyond the white noise, as a density, rad·√s (a block of length `T` gets
+    /// `σ² = N²/T`): what a magnetometer reads wrong for a while without the norm or the dip
+    /// showing it (iron nearby, residual calibration, the tilt error seen through the dip). It
+    /// sets how fast the heading follows the magnetometer, whatever the block length.
     pub heading_noise: T,
     /// The heading is never known better than this, rad: a lower bound on its 1σ, for the
     /// calibration error that does not average out.
@@ -35,14 +36,14 @@ pub struct MagneticConfig<T: Real> {
 
 impl<T: Real> MagneticConfig<T> {
     /// A magnetometer with white noise `sigma` per axis and an optional reference; the other
-    /// values are the defaults listed on each field's use: 2° heading noise per block, 1°
+    /// values are the defaults listed on each field's use: 6°·√s heading noise, 1°
     /// heading floor, 10 % norm and 10° dip tolerance, 20 s turning at 20 °/s or more for a new field.
     #[must_use]
     pub fn new(sigma: T, reference: Option<Vector3<T>>) -> Self {
         Self {
             reference,
             sigma,
-            heading_noise: T::lit(2.0_f64.to_radians()),
+            heading_noise: T::lit(6.0_f64.to_radians()),
             heading_floor: T::lit(1.0_f64.to_radians()),
             norm_tolerance: T::lit(0.1),
             dip_tolerance: T::lit(10.0_f64.to_radians()),
@@ -94,8 +95,8 @@ pub struct AttitudeConfig<T: Real> {
     /// Correlation time of the body's linear acceleration, s: the mean of a block of length
     /// `T` keeps `min(1, 2τ/T)` of its variance.
     pub acceleration_correlation_s: T,
-    /// 1σ of the accelerometer bias per axis, m/s²: the tilt is never known better than
-    /// `σ_ba/g`.
+    /// 1σ of the accelerometer bias per axis at switch-on, m/s² (the bias is estimated; its
+    /// random walk is the filter configuration's).
     pub accelerometer_bias_sigma: T,
     /// 1σ of the gyro's scale-factor and cross-axis errors (a fraction): a block that turns
     /// by `θ` adds `(σ_s θ)²` to the attitude variance on every axis. The noise densities of a

@@ -11,13 +11,13 @@
 //! azimuth of `m_w`; it moves the heading only, never the tilt) with
 //!
 //! ```text
-//! σ_ψ² = σ_m²/(n ‖c_h‖²) + σ_hd²
+//! σ_ψ² = σ_m²/(n ‖c_h‖²) + N_hd²/T
 //! ```
 //!
-//! (`σ_m` the white noise of one sample, `n` samples, `σ_hd` the per-block heading noise of
-//! the configuration), gated at 99.9 %, and with the heading floor `σ_ψ ≥ heading_floor`
+//! (`σ_m` the white noise of one sample, `n` samples, `N_hd` the heading noise density of the
+//! configuration, `T` the block's length), gated at 99.9 %, and with the heading floor `σ_ψ ≥ heading_floor`
 //! applied afterwards. After `max_rejected_blocks` rejections in a row whose innovations agree
-//! within `4σ_hd` while the body turned by 90° or more (or for `new_field_s` without turning,
+//! within `4N_hd/√T` while the body turned by 90° or more (or for `new_field_s` without turning,
 //! with norm and dip agreeing all along), the estimate is taken for wrong (a disturbance would
 //! change with the orientation; a heading error does not), the heading covariance is widened
 //! to the innovation and the block fused.
@@ -36,7 +36,7 @@ use super::block::MagStats;
 use super::config::{AttitudeConfig, MagneticConfig};
 use super::report::{Event, Fusion, MagneticStatus};
 use super::tilt::world_attitude_covariance;
-use crate::eskf::{Ahrs, MagneticHeading, UpdateOptions};
+use crate::eskf::{AhrsAccelBias, MagneticHeading, UpdateOptions};
 use crate::kernels::mat3;
 use crate::lie::LieGroup;
 use crate::nav::error::NavError;
@@ -130,7 +130,7 @@ impl<T: Real> Magnetic<T> {
     /// turned by `rotation` rad).
     pub(super) fn fuse(
         &mut self,
-        filter: &mut Ahrs<T>,
+        filter: &mut AhrsAccelBias<T>,
         stats: &MagStats<T>,
         duration: T,
         rotation: T,
@@ -157,7 +157,8 @@ impl<T: Real> Magnetic<T> {
             return Ok((MagneticStatus::Disturbed, None, None));
         }
         let white = mag.sigma / horizontal;
-        let var = white * white / T::from_count(n.max(1)) + mag.heading_noise * mag.heading_noise;
+        let var = white * white / T::from_count(n.max(1))
+            + mag.heading_noise * mag.heading_noise / duration;
         let model = MagneticHeading::new(*m_body, reference, var.sqrt());
         let options = UpdateOptions::default();
         let mut event = None;
@@ -173,7 +174,7 @@ impl<T: Real> Magnetic<T> {
             // error while the body turns: a disturbance would change with the orientation.
             let lasted = T::from_count(u32::from(run.count)) * duration;
             let wrong_estimate = run.count >= config.max_rejected_blocks
-                && run.high - run.low <= T::lit(4.0) * mag.heading_noise
+                && run.high - run.low <= T::lit(4.0) * mag.heading_noise / duration.sqrt()
                 && (run.turned >= T::frac_pi_2() || lasted >= mag.new_field_s);
             if wrong_estimate {
                 filter.widen_attitude(T::zero(), innovation.abs())?;

@@ -1,4 +1,5 @@
-//! The attitude navigator: an [`Ahrs`] filter with everything a sensor stream needs around it.
+//! The attitude navigator: an [`AhrsAccelBias`] filter (attitude, gyro and accelerometer
+//! biases) with everything a sensor stream needs around it.
 //!
 //! One call per sample: [`AttitudeNavigator::imu`] for every IMU sample,
 //! [`AttitudeNavigator::magnetometer`] for every magnetometer sample, each with its own
@@ -10,15 +11,15 @@
 //! 1. **Start-up** (`startup`): the first `startup_s` of samples are averaged in a frame the
 //!    gyro carries along, at rest or moving; tilt, heading, bias and their covariance come from
 //!    the means. A gap in the IMU longer than `max_dt` starts it again.
-//! 2. **Prediction**: every IMU interval is integrated by [`Ahrs::predict`] (trapezoidal for
+//! 2. **Prediction**: every IMU interval is integrated by [`AhrsAccelBias::predict`](crate::eskf::Filter::predict) (trapezoidal for
 //!    instantaneous samples).
 //! 3. **Blocks** (`block`): accelerometer and magnetometer samples are averaged over
 //!    `block_s` in the same gyro-carried frame and fused once at the block's end:
 //!    * **rest** (`rest`): a still block, after `rest_min_s` of them, is a zero-rate update
 //!      of the gyro bias;
-//!    * **tilt** (`tilt`): the block's gravity direction, with a noise that follows the
-//!      measured linear acceleration; widened, never locked out, after repeated rejections;
-//!      floored at the accelerometer bias;
+//!    * **tilt** (`tilt`): the block's mean specific force (gravity and the accelerometer
+//!      bias), with a noise that follows the measured linear acceleration; widened, never
+//!      locked out, after repeated rejections;
 //!    * **heading** (`magnetic`): the magnetometer's heading only, when its norm and dip agree
 //!      with the reference; a steady new field becomes the reference.
 //!
@@ -39,7 +40,7 @@ pub use report::{
     Validity,
 };
 
-use crate::eskf::{Ahrs, ImuSample};
+use crate::eskf::{AhrsAccelBias, ImuSample};
 use crate::kernels::{all_finite, mat3};
 use crate::lie::{LieGroup, So3};
 use crate::nav::clock::{Clock, Tick};
@@ -56,7 +57,7 @@ enum Phase<T: Real> {
     /// sample.
     Starting { frame: So3<T> },
     /// Filtering.
-    Running { filter: Ahrs<T> },
+    Running { filter: AhrsAccelBias<T> },
 }
 
 /// Durations of the configuration in nanoseconds.
@@ -169,7 +170,7 @@ impl<T: Real> AttitudeNavigator<T> {
 
     /// The filter, once started.
     #[must_use]
-    pub fn filter(&self) -> Option<&Ahrs<T>> {
+    pub fn filter(&self) -> Option<&AhrsAccelBias<T>> {
         match &self.phase {
             Phase::Running { filter } => Some(filter),
             Phase::Starting { .. } => None,
@@ -204,6 +205,7 @@ impl<T: Real> AttitudeNavigator<T> {
             t_ns: self.report.t_ns,
             attitude: filter.state().attitude,
             gyro_bias: filter.state().gyro_bias,
+            accel_bias: filter.state().accel_bias,
             sigma_tilt: tilt.sqrt(),
             sigma_heading: w.m33.sqrt(),
         })
@@ -404,7 +406,7 @@ impl<T: Real> AttitudeNavigator<T> {
             self.last_power
         };
         self.last_power = power;
-        let sigma = tilt::direction_sigma(&stats, &self.config, used_power, g);
+        let sigma = tilt::specific_force_sigma(&stats, &self.config, used_power, g);
         let (fusion, event) =
             tilt::fuse(filter, &stats, sigma, &self.config, &mut self.tilt_rejected)?;
         self.report.fused.gravity = Some(fusion);

@@ -139,6 +139,8 @@ pub struct AttitudeEstimate<T: Real> {
     pub attitude: So3<T>,
     /// Gyro bias, rad/s.
     pub gyro_bias: Vector3<T>,
+    /// Accelerometer bias, m/s².
+    pub accel_bias: Vector3<T>,
     /// 1σ of the tilt: the larger of the two horizontal axes, rad.
     pub sigma_tilt: T,
     /// 1σ of the heading (about world up), rad.

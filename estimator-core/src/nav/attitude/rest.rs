@@ -15,7 +15,7 @@
 use super::block::BlockStats;
 use super::config::AttitudeConfig;
 use super::report::Fusion;
-use crate::eskf::{Ahrs, UpdateOptions, ZeroRate};
+use crate::eskf::{AhrsAccelBias, UpdateOptions, ZeroRate};
 use crate::nav::error::NavError;
 use crate::Real;
 use nalgebra::Vector3;
@@ -47,7 +47,7 @@ pub(super) fn mean_rate_variance<T: Real>(stats: &BlockStats<T>, config: &Attitu
 
 /// The zero-rate update of a block at rest.
 pub(super) fn fuse<T: Real>(
-    filter: &mut Ahrs<T>,
+    filter: &mut AhrsAccelBias<T>,
     stats: &BlockStats<T>,
     config: &AttitudeConfig<T>,
 ) -> Result<Fusion<T>, NavError> {

@@ -8,18 +8,20 @@
 //! * Tilt and heading: the triad of [`align_at_rest`] on the two means (the window's mean
 //!   field against the reference; without a magnetometer the body `x` axis points to world
 //!   `x` and the heading is unknown, 1σ = π).
+//! * Accelerometer bias: zero, with `accelerometer_bias_sigma` (the tilt's 1σ includes it as
+//!   `σ_ba/g`; the first blocks in other orientations separate the two).
 //! * Gyro bias: a still window (see `rest`) measures it, `b = ω̄` with the zero-rate
 //!   variance; a moving window leaves the prior (0 at switch-on, the last estimate after a
 //!   gap) with `gyro_bias_sigma`.
-//! * Heading 1σ: `σ_ψ² = σ_m²/(n ‖m_h‖²) + σ_hd² + (tan δ · σ_tilt)²`, the last term because a
+//! * Heading 1σ: `σ_ψ² = σ_m²/(n ‖m_h‖²) + N_hd²/T + (tan δ · σ_tilt)²`, the last term because a
 //!   tilt error `σ_tilt` moves the horizontal part of a field with dip `δ`.
 
 use super::block::BlockStats;
 use super::config::AttitudeConfig;
 use super::magnetic::Magnetic;
 use super::rest::{is_still, mean_rate_variance};
-use super::tilt::{acceleration_power, direction_sigma, white_sq};
-use crate::eskf::{align_at_rest, Ahrs, InitialSigmas, MagnetometerWindow};
+use super::tilt::{acceleration_power, specific_force_sigma, white_sq};
+use crate::eskf::{align_at_rest, AhrsAccelBias, InitialSigmas, MagnetometerWindow};
 use crate::kernels::mat3;
 use crate::nav::error::NavError;
 use crate::Real;
@@ -31,17 +33,18 @@ pub(super) fn start<T: Real>(
     config: &AttitudeConfig<T>,
     bias_prior: &Vector3<T>,
     magnetic: &mut Option<Magnetic<T>>,
-) -> Result<(Ahrs<T>, bool), NavError> {
+) -> Result<(AhrsAccelBias<T>, bool), NavError> {
     let g = mat3::norm(&config.filter.gravity);
     let still = is_still(stats, bias_prior, config, g);
-    let (bias, bias_sigma) = if still {
+    let (gyro_bias, bias_sigma) = if still {
         (stats.gyro_mean, mean_rate_variance(stats, config).sqrt())
     } else {
         (*bias_prior, config.gyro_bias_sigma)
     };
-    let tilt_model = direction_sigma(stats, config, acceleration_power(stats, white_sq(stats, config)), g);
-    let tilt_floor = config.accelerometer_bias_sigma / g;
-    let tilt = (tilt_model * tilt_model + tilt_floor * tilt_floor).sqrt();
+    // The mean specific force's error per axis: the motion's and the bias's, as an angle.
+    let motion = specific_force_sigma(stats, config, acceleration_power(stats, white_sq(stats, config)), g);
+    let bias = config.accelerometer_bias_sigma;
+    let tilt = (motion * motion + bias * bias).sqrt() / g;
 
     let up_body = stats.accel_body / stats.accel_norm;
     // The field and its reference, when both exist (a missing reference is learned here).
@@ -70,7 +73,7 @@ pub(super) fn start<T: Real>(
     };
     let alignment = align_at_rest(
         &[stats.accel_body],
-        &[bias],
+        &[gyro_bias],
         &config.filter.gravity,
         mag_window.as_ref(),
         g,
@@ -83,7 +86,7 @@ pub(super) fn start<T: Real>(
             let tan_dip = reference.z.abs() / (reference.x * reference.x + reference.y * reference.y).sqrt();
             let coupling = tan_dip * tilt;
             (white * white / T::from_count((*n).max(1))
-                + mag.heading_noise * mag.heading_noise
+                + mag.heading_noise * mag.heading_noise / stats.duration
                 + mag.heading_floor * mag.heading_floor
                 + coupling * coupling)
                 .sqrt()
@@ -94,8 +97,9 @@ pub(super) fn start<T: Real>(
         tilt,
         yaw,
         gyro_bias: bias_sigma,
+        accel_bias: config.accelerometer_bias_sigma,
         ..InitialSigmas::default()
     };
-    let filter = Ahrs::from_alignment(&alignment, &sigmas, config.filter)?;
+    let filter = AhrsAccelBias::from_alignment(&alignment, &sigmas, config.filter)?;
     Ok((filter, still))
 }

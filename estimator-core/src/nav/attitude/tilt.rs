@@ -1,12 +1,12 @@
-//! The accelerometer as a gravity sensor over a block, with a noise that follows the motion.
+//! The accelerometer over a block, with a noise that follows the motion.
 //!
 //! The mean specific force of a block, seen in the body at its end (see `block`), is
-//! `f̄ = Rᵀ(ā − g)`: gravity plus the block's mean linear acceleration `ā`. Its direction is a
-//! [`GravityDirection`] measurement whose error is `ā⊥/‖g‖` (the part of `ā` across gravity)
-//! plus the white noise. The variance per axis is taken as
+//! `f̄ = Rᵀ(ā − g) + b_a`: gravity, the block's mean linear acceleration `ā`, and the
+//! accelerometer bias. It is an [`AccelerometerAtRest`] measurement (`h(x) = Rᵀ(−g) + b_a`)
+//! whose noise is the mean linear acceleration plus the white noise, per axis
 //!
 //! ```text
-//! σ² = σ_s²/n  +  q·min(1, 2τ/T)  +  (‖f̄‖ − ‖g‖)²            (m/s²)², then / ‖g‖² for radians
+//! σ² = σ_s²/n  +  q·min(1, 2τ/T)  +  (‖f̄‖ − ‖g‖)²            (m/s²)²
 //! ```
 //!
 //! * `σ_s² = N_a²/Δt`: the white noise of one sample (density `N_a`, interval `Δt`), `n`
@@ -22,17 +22,16 @@
 //!   size of the horizontal part the norm cannot show.
 //!
 //! No threshold throws a block away: a block taken during strong motion simply weighs little.
-//! The update is gated (chi-square, 99.9 %); when `max_rejected_blocks` blocks in a row fail
-//! the gate, the estimate is what is wrong, not the data, and the tilt covariance is widened
-//! by the innovation before the block is fused.
-//!
-//! The tilt is never known better than the accelerometer bias allows, `σ_ba/‖g‖`: after each
-//! update the world-frame tilt variance is raised to that floor if it fell below it.
+//! Because the bias is a state, blocks in different orientations separate it from the tilt
+//! (a body-fixed bias turns with the body, gravity does not). The update is gated
+//! (chi-square, 99.9 %); when `max_rejected_blocks` blocks in a row fail the gate, the
+//! estimate is what is wrong, not the data, and the tilt covariance is widened by the
+//! innovation angle before the block is fused.
 
 use super::block::BlockStats;
 use super::config::AttitudeConfig;
 use super::report::{Event, Fusion};
-use crate::eskf::{Ahrs, GravityDirection, UpdateOptions};
+use crate::eskf::{AccelerometerAtRest, AhrsAccelBias, ErrorState, Filter, UpdateOptions};
 use crate::kernels::mat3;
 use crate::lie::LieGroup;
 use crate::nav::error::NavError;
@@ -61,9 +60,9 @@ pub(super) fn white_sq<T: Real>(stats: &BlockStats<T>, config: &AttitudeConfig<T
     }
 }
 
-/// The 1σ of the block's gravity direction, rad (module docs), with `power` the per-axis
-/// linear-acceleration variance to use.
-pub(super) fn direction_sigma<T: Real>(
+/// The 1σ per axis of the block's mean specific force, m/s² (module docs), with `power` the
+/// per-axis linear-acceleration variance to use.
+pub(super) fn specific_force_sigma<T: Real>(
     stats: &BlockStats<T>,
     config: &AttitudeConfig<T>,
     power: T,
@@ -77,29 +76,33 @@ pub(super) fn direction_sigma<T: Real>(
         T::one()
     };
     let vertical = stats.accel_norm - g;
-    let var = white + power * keep + vertical * vertical;
-    var.sqrt() / g
+    (white + power * keep + vertical * vertical).sqrt()
 }
 
-/// The world-frame attitude covariance `R P_θθ Rᵀ` of the filter.
-pub(super) fn world_attitude_covariance<T: Real>(filter: &Ahrs<T>) -> nalgebra::Matrix3<T> {
-    let r = filter.state().attitude.rotation_matrix();
+/// The world-frame attitude covariance `R P_θθ Rᵀ` of a filter.
+pub(super) fn world_attitude_covariance<T: Real, S: ErrorState<T, N>, const N: usize>(
+    filter: &Filter<T, S, N>,
+) -> nalgebra::Matrix3<T> {
+    let r = filter.state().attitude().rotation_matrix();
     let p = crate::kernels::block::block(filter.covariance(), 0, 0);
     mat3::mul(&mat3::mul(&r, &p), &r.transpose())
 }
 
-/// Fuses the block's gravity direction with 1σ `sigma`; widens the tilt after
-/// `max_rejected_blocks` rejections in a row (`rejected` counts them); applies the tilt floor.
+/// Fuses the block's mean specific force with 1σ `sigma` per axis; widens the tilt after
+/// `max_rejected_blocks` rejections in a row (`rejected` counts them).
 /// Returns the update's outcome (after the widening, if there was one), and the event if the
 /// covariance was widened.
 pub(super) fn fuse<T: Real>(
-    filter: &mut Ahrs<T>,
+    filter: &mut AhrsAccelBias<T>,
     stats: &BlockStats<T>,
     sigma: T,
     config: &AttitudeConfig<T>,
     rejected: &mut u16,
 ) -> Result<(Fusion<T>, Option<Event>), NavError> {
-    let model = GravityDirection::new(stats.accel_body, sigma);
+    let model = AccelerometerAtRest {
+        gravity: config.filter.gravity,
+        ..AccelerometerAtRest::new(stats.accel_body, sigma)
+    };
     let options = UpdateOptions::default();
     let mut event = None;
     let mut fusion = Fusion::from(filter.update(&model, &options)?);
@@ -108,24 +111,17 @@ pub(super) fn fuse<T: Real>(
     } else {
         *rejected = rejected.saturating_add(1);
         if *rejected >= config.max_rejected_blocks {
-            // The innovation angle: between the measured and the predicted up direction.
+            // The innovation angle: between the measured (bias removed) and the predicted up
+            // direction.
             let up = -config.filter.gravity / mat3::norm(&config.filter.gravity);
             let predicted = filter.state().attitude.inverse().act(&up);
-            let measured = stats.accel_body / stats.accel_norm;
-            let angle = mat3::norm(&(measured - predicted));
+            let f = stats.accel_body - filter.state().accel_bias;
+            let angle = mat3::norm(&(f / mat3::norm(&f) - predicted));
             filter.widen_attitude(angle, T::zero())?;
             fusion = Fusion::from(filter.update(&model, &options)?);
             *rejected = 0;
             event = Some(Event::TiltWidened);
         }
-    }
-    let g = mat3::norm(&config.filter.gravity);
-    let floor = config.accelerometer_bias_sigma / g;
-    let w = world_attitude_covariance(filter);
-    let smallest = if w.m11 < w.m22 { w.m11 } else { w.m22 };
-    let deficit = floor * floor - smallest;
-    if deficit > T::zero() {
-        filter.widen_attitude(deficit.sqrt(), T::zero())?;
     }
     Ok((fusion, event))
 }

@@ -10,11 +10,13 @@
 //! * [`plot`]: the PNG plots.
 //! * [`montecarlo`]: consistency over seeds against chi-square bands.
 //! * [`replay`]: the filter over a dataset folder, with its outputs (trajectories, metrics, plots).
+//! * [`bench`](mod@bench): the filter over every dataset under a folder, against published references.
 //! * [`output`]: output folders written beside their target and moved into place on success;
 //!   nothing host-sim did not create is deleted or overwritten.
 #![warn(missing_docs)]
 
 pub mod baseline;
+pub mod bench;
 pub mod calibrate;
 pub mod dataset;
 pub mod metrics;

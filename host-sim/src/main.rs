@@ -12,6 +12,7 @@ macro_rules! out {
 
 use clap::Parser;
 use cli::{Cli, Command};
+use host_sim::bench::{replay_config, BenchOptions};
 use host_sim::dataset::write::simulate;
 use host_sim::metrics::Metrics;
 use host_sim::output::Staging;
@@ -96,19 +97,7 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
             // The given configuration, else the dataset's replay.toml, else the defaults.
-            let given = config.is_some();
-            let source = config.unwrap_or_else(|| dataset.join("replay.toml"));
-            let cfg = match std::fs::read_to_string(&source) {
-                Ok(text) => toml::from_str(&text).map_err(|e| {
-                    format!("{}: {}", source.display(), e.to_string().replace('\n', " "))
-                })?,
-                Err(e) if !given && e.kind() == std::io::ErrorKind::NotFound => {
-                    ReplayConfig::default()
-                }
-                Err(e) => return Err(format!("{}: {e}", source.display()).into()),
-            };
-            cfg.validate()
-                .map_err(|e| format!("{}: {e}", source.display()))?;
+            let cfg = replay_config(config.as_deref(), &dataset)?;
             let title = dataset
                 .file_name()
                 .map_or("dataset".into(), |n| n.to_string_lossy().into_owned());
@@ -125,6 +114,30 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             staging.commit()?;
             print_summary(&title, 0, &cfg, &m, &out);
             Ok(())
+        }
+        Command::Bench {
+            dir,
+            out,
+            config,
+            force,
+        } => {
+            let opts = BenchOptions {
+                dir,
+                out,
+                config,
+                force,
+            };
+            let report = host_sim::bench::run(&opts, |i, n, dataset| {
+                eprintln!("bench [{}/{n}] {}", i + 1, dataset.display());
+            })?;
+            out!("{}", report.render().trim_start());
+            out!("outputs in {}", opts.out.display());
+            let failures = report.failures();
+            if failures.is_empty() {
+                Ok(())
+            } else {
+                Err(format!("{} failure(s): {}", failures.len(), failures.join("; ")).into())
+            }
         }
         Command::Calibrate {
             dir,
@@ -214,6 +227,21 @@ fn print_summary(name: &str, seed: u64, cfg: &ReplayConfig, m: &Metrics, out: &P
         "attitude RMSE [deg]",
         fmt(m.attitude_rmse_deg)
     );
+    out!(
+        "  {:<28} {:>12}",
+        "attitude RMSE after 2 s [deg]",
+        fmt(m.attitude_rmse_after_2s_deg)
+    );
+    if let Some(b) = &m.broad {
+        out!(
+            "  {:<28} {:>12}   heading {}, inclination {} ({} samples in movement.csv)",
+            "BROAD total RMSE [deg]",
+            fmt(b.total_deg),
+            fmt(b.heading_deg),
+            fmt(b.inclination_deg),
+            b.samples
+        );
+    }
     out!(
         "  {:<28} {:>12}",
         "velocity RMSE [m/s]",

@@ -566,6 +566,183 @@ fn an_empty_ground_truth_is_an_error_not_a_zero_rmse() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
+/// Copies a dataset folder into `to` (created).
+fn copy_dataset(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let p = entry.unwrap().path();
+        let target = to.join(p.file_name().unwrap());
+        if p.is_dir() {
+            copy_dataset(&p, &target);
+        } else {
+            std::fs::copy(&p, &target).unwrap();
+        }
+    }
+}
+
+/// `bench` over a folder of tiny simulated datasets: a BROAD-like group (movement.csv and a
+/// `trials` references.json) and an attitude group (a `datasets` references.json naming one of
+/// its two datasets). Prints both tables, writes bench.json; a broken dataset is reported in its
+/// row, the others still run, and the exit status is non-zero.
+#[test]
+fn bench_prints_tables_and_writes_bench_json() {
+    let dir = tmp("bench");
+    let data = dir.join("data");
+    std::fs::create_dir_all(&data).unwrap();
+    let scenario = dir.join("tiny.toml");
+    std::fs::write(
+        &scenario,
+        "name = \"tiny\"\nduration_s = 8.0\nstatic_s = 3.0\n[mag]\nrate_hz = 25.0\n",
+    )
+    .unwrap();
+    let sim = dir.join("sim");
+    simulate(scenario.to_str().unwrap(), &sim);
+    for (group, name) in [("broadlike", "trial_a"), ("indep", "one"), ("indep", "two")] {
+        copy_dataset(&sim, &data.join(group).join(name));
+    }
+    std::fs::write(
+        data.join("broadlike/trial_a/movement.csv"),
+        "#start [ns],end [ns]\n4000000000,8000000000\n",
+    )
+    .unwrap();
+    std::fs::write(
+        data.join("broadlike/references.json"),
+        r#"{"trials": {"trial_a": {"vqf_9d": {"total": 2.5}, "madgwick_tagp_published": {"total": 4.25}}}}"#,
+    )
+    .unwrap();
+    std::fs::write(
+        data.join("indep/references.json"),
+        r#"{"datasets": {"one": {"vqf_9d": {"attitude_rmse_deg": 1.75}}}}"#,
+    )
+    .unwrap();
+
+    let out = dir.join("out");
+    let o = host_sim(&[
+        "bench",
+        data.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{}\n{text}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(text.contains("BROAD RMSE"), "{text}");
+    assert!(text.contains("attitude RMSE [deg] from 2 s"), "{text}");
+    let row = |name: &str| {
+        text.lines()
+            .find(|l| l.starts_with(name))
+            .unwrap_or_else(|| panic!("no row {name}:\n{text}"))
+            .to_string()
+    };
+    assert!(row("trial_a").contains("2.500") && row("trial_a").contains("4.250"));
+    assert!(row("one").contains("1.750"));
+    // No reference entry: ours only, the reference and the ratio not computed.
+    assert_eq!(row("two").matches('–').count(), 2, "{}", row("two"));
+    for f in [
+        "trial_a/metrics.json",
+        "one/estimate.tum",
+        "two/metrics.json",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let json: serde_json::Value = serde_json::from_slice(&read(&out.join("bench.json"))).unwrap();
+    let tables = json["tables"].as_array().expect("tables");
+    assert_eq!(tables.len(), 2);
+    let broad = &tables[0]["rows"][0];
+    assert_eq!(tables[0]["kind"], "broad");
+    assert_eq!(broad["vqf_total_deg"], 2.5);
+    let total = broad["ours"]["total_deg"].as_f64().expect("BROAD total");
+    assert!(total.is_finite() && total >= 0.0);
+    assert!(broad["samples"].as_u64().expect("samples") > 0);
+    assert_eq!(tables[1]["kind"], "attitude");
+    let two = &tables[1]["rows"][1];
+    assert!(two["attitude_rmse_after_2s_deg"].as_f64().is_some());
+    assert!(two["vqf_attitude_rmse_deg"].is_null() && two["ratio_to_vqf"].is_null());
+
+    // An earlier output needs --force; a broken dataset fails in its row only.
+    let o = host_sim(&[
+        "bench",
+        data.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--force"));
+    let bad = data.join("indep/bad");
+    copy_dataset(&sim, &bad);
+    let imu = bad.join("imu0/data.csv");
+    let imu_text = std::fs::read_to_string(&imu).unwrap();
+    let mut lines: Vec<&str> = imu_text.lines().collect();
+    lines[9] = "1,2,3";
+    std::fs::write(&imu, lines.join("\n") + "\n").unwrap();
+    let o = host_sim(&[
+        "bench",
+        data.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--force",
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(!o.status.success(), "a failed dataset is a failure");
+    let bad_row = text
+        .lines()
+        .find(|l| l.starts_with("bad"))
+        .unwrap_or_else(|| panic!("no row bad:\n{text}"));
+    assert!(
+        bad_row.contains("failed") && bad_row.contains("imu0/data.csv:10:"),
+        "{bad_row}"
+    );
+    assert!(text.lines().any(|l| l.starts_with("one")), "{text}");
+    let json: serde_json::Value = serde_json::from_slice(&read(&out.join("bench.json"))).unwrap();
+    assert!(json["tables"][1]["rows"][0]["error"].is_string());
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// `bench` on one BROAD trial of the shared datasets, when they are present: BROAD's metric is
+/// computed and below 20°.
+#[test]
+fn bench_on_a_broad_trial_scores_it() {
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/datasets/broad");
+    let trial = "05_undisturbed_slow_rotation_with_breaks_B";
+    if !shared.join(trial).join("imu0/data.csv").is_file() {
+        eprintln!(
+            "skipped: {} is absent (the shared datasets are not on this machine)",
+            shared.join(trial).display()
+        );
+        return;
+    }
+    // DIR may be the dataset folder itself; the references are those of its parent folder.
+    let dir = tmp("bench-broad");
+    let out = dir.join("out");
+    let o = host_sim(&[
+        "bench",
+        shared.join(trial).to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{}\n{text}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&read(&out.join("bench.json"))).unwrap();
+    let row = &json["tables"][0]["rows"][0];
+    assert_eq!(row["dataset"], trial);
+    let total = row["ours"]["total_deg"]
+        .as_f64()
+        .expect("BROAD total computed");
+    assert!(
+        total.is_finite() && total < 20.0,
+        "BROAD total {total}°\n{text}"
+    );
+    assert!(row["vqf_total_deg"].as_f64().is_some(), "{text}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 /// `calibrate` on a simulated static recording: the table, the four outputs, `sensor.yaml` files
 /// the dataset reader parses, and per axis a white noise density within the Allan estimator's
 /// confidence of the simulated one.

@@ -5,6 +5,7 @@
 //! | `host-sim [run] [--scenario NAME] [--seed N] [--out DIR] [--force]` | simulate, filter, score, plot; prints a summary table (default: the `default` scenario into `out/`) |
 //! | `host-sim simulate --scenario NAME [--seed N] --out DIR [--force]` | write a dataset folder with ground truth ([`crate::dataset`]) |
 //! | `host-sim replay DATASET [--out DIR] [--config FILE] [--force]` | run the filter over a dataset folder, with or without ground truth |
+//! | `host-sim bench DIR [--out OUT] [--config FILE] [--force]` | replay every dataset folder under `DIR` (one and two levels deep) and print its scores beside the `references.json` of its folder ([`host_sim::bench`]; default `OUT`: `out/bench`) |
 //! | `host-sim montecarlo --scenario NAME --runs N` | consistency over seeds: NEES / NIS against chi-square bands |
 //! | `host-sim calibrate DIR [--out DIR] [--from S] [--to S] [--force]` | IMU and magnetometer noise from a static recording (Allan deviation, `host_sim::calibrate`) |
 //! | `host-sim scenarios` | list the built-in scenarios |
@@ -29,7 +30,7 @@ use std::path::PathBuf;
 (refused if out/ exists and is not empty; an earlier host-sim output is replaced by `host-sim run --force`).\n\n\
 Examples:\n  host-sim scenarios\n  host-sim run --scenario car --seed 3 --out out/car\n  \
 host-sim simulate --scenario car --out data/car\n  host-sim replay data/car --out out/car\n  \
-host-sim montecarlo --scenario matched_ins --runs 60 --check"
+host-sim bench ../shared/datasets --out out/bench\n  host-sim montecarlo --scenario matched_ins --runs 60 --check"
 )]
 pub struct Cli {
     /// What to do (default: `run`).
@@ -96,6 +97,35 @@ Example: host-sim replay data/car --out out/car"
         #[arg(long, default_value = "out")]
         out: PathBuf,
         /// Filter configuration (TOML).
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
+        /// files is never replaced).
+        #[arg(long)]
+        force: bool,
+    },
+    /// Replay every dataset folder under DIR and print its scores beside the published
+    /// references.
+    #[command(
+        after_help = "Finds every dataset folder (one holding imu0/data.csv) in DIR or one or two levels below, \
+replays each (plots off; --config, else the dataset's replay.toml, else the defaults) and prints one table per parent folder, \
+against that folder's references.json when present:\n\
+  BROAD (references.json with \"trials\"): BROAD's total / heading / inclination RMSE [deg] inside movement.csv, \
+real-time VQF's and Madgwick's total, the mean and the worst trial;\n\
+  otherwise (\"datasets\", or none): the attitude RMSE [deg] from 2 s after the first ground-truth sample, \
+the attitude ANEES, VQF's RMSE and ours/VQF.\n\
+A figure not computed is printed '–' (null in bench.json).\n\
+Writes into --out: one folder per dataset (estimate.tum, estimate.csv, groundtruth.tum, metrics.json) and bench.json (every figure of the tables).\n\
+Exit status non-zero when a dataset fails to run (its error is in its row; the others still run) or a references.json cannot be read.\n\n\
+Example: host-sim bench ../shared/datasets --out out/bench"
+    )]
+    Bench {
+        /// The folder holding the dataset folders.
+        dir: PathBuf,
+        /// Output folder.
+        #[arg(long, default_value = "out/bench")]
+        out: PathBuf,
+        /// Filter configuration (TOML) for every dataset.
         #[arg(long)]
         config: Option<PathBuf>,
         /// Replace the output folder if it holds an earlier host-sim output (a folder with other

@@ -79,6 +79,8 @@ pub struct Dataset {
     pub baro: Option<BaroParams>,
     /// Whether ground truth is present.
     pub has_groundtruth: bool,
+    /// The scored intervals of `movement.csv` (`[start, end]` ns, inclusive), if present.
+    pub movement: Option<Vec<(u64, u64)>>,
 }
 
 /// One sensor event.
@@ -340,6 +342,7 @@ impl Dataset {
             camera,
             baro,
             has_groundtruth: dir.join("state_groundtruth_estimate0/data.csv").is_file(),
+            movement: movement(dir)?,
         })
     }
 
@@ -526,5 +529,148 @@ impl TruthStream {
             gyro_bias: v3(&v, 10),
             accel_bias: v3(&v, 13),
         }))
+    }
+}
+
+/// The intervals of `DIR/movement.csv`, or `None` when the file is absent.
+///
+/// The file holds one interval a line, `start [ns],end [ns]`, both inclusive (BROAD's scored
+/// movement phases); lines starting with `#`, blank lines and a first line that is not a number
+/// (a header) are skipped. The intervals must be ordered and disjoint, each with `start ≤ end`.
+///
+/// # Errors
+/// An unreadable file, or a line that is not two integers in order, naming the file and line.
+pub fn movement(dir: &Path) -> Result<Option<Vec<(u64, u64)>>, DatasetError> {
+    let path = dir.join("movement.csv");
+    let text = match std::fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(DatasetError::file(&path, e)),
+    };
+    parse_movement(&path, &text).map(Some)
+}
+
+/// Parses the text of a `movement.csv` (see [`movement`]); `path` names it in errors.
+///
+/// # Errors
+/// A line that is not two integers `start,end` with `start ≤ end`, after the previous interval.
+pub fn parse_movement(path: &Path, text: &str) -> Result<Vec<(u64, u64)>, DatasetError> {
+    let mut intervals: Vec<(u64, u64)> = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = i as u64 + 1;
+        let row = raw.trim();
+        if row.is_empty() || row.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = row.split(',').map(str::trim).collect();
+        if line == 1 && fields.first().is_some_and(|f| f.parse::<u64>().is_err()) {
+            continue; // a header without '#'
+        }
+        if fields.len() != 2 {
+            return Err(DatasetError::at(
+                path,
+                line,
+                format!(
+                    "expected 2 columns (start [ns],end [ns]), got {}",
+                    fields.len()
+                ),
+            ));
+        }
+        let parse = |f: &str, what: &str| {
+            f.parse::<u64>().map_err(|_| {
+                DatasetError::at(
+                    path,
+                    line,
+                    format!("{what} '{f}' is not an integer number of ns"),
+                )
+            })
+        };
+        let start = parse(fields[0], "start")?;
+        let end = parse(fields[1], "end")?;
+        if end < start {
+            return Err(DatasetError::at(
+                path,
+                line,
+                format!("end {end} before start {start}"),
+            ));
+        }
+        if let Some(&(_, last_end)) = intervals.last() {
+            if start <= last_end {
+                return Err(DatasetError::at(
+                    path,
+                    line,
+                    format!("interval starting at {start} overlaps or precedes the previous one (ending at {last_end})"),
+                ));
+            }
+        }
+        intervals.push((start, end));
+    }
+    Ok(intervals)
+}
+
+/// The timestamp of the first row of `DIR/state_groundtruth_estimate0/data.csv`, or `None`
+/// when the file is absent or has no rows.
+///
+/// # Errors
+/// An unreadable file or a malformed first row, naming the file and line.
+pub fn first_truth_ns(dir: &Path) -> Result<Option<u64>, DatasetError> {
+    if !dir.join("state_groundtruth_estimate0/data.csv").is_file() {
+        return Ok(None);
+    }
+    Ok(TruthStream::open(dir)?.next_truth()?.map(|t| t.t_ns))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn movement_intervals_are_read_with_header_comments_and_blank_lines() {
+        let text = "#start [ns],end [ns]  (inclusive)\n10,20\n\n 30 , 40 \n# a note\n40000000001,40000000001\n";
+        let got = parse_movement(Path::new("d/movement.csv"), text).expect("parses");
+        assert_eq!(
+            got,
+            vec![(10, 20), (30, 40), (40_000_000_001, 40_000_000_001)]
+        );
+        let plain_header = "start,end\n1,2\n";
+        assert_eq!(
+            parse_movement(Path::new("m.csv"), plain_header).expect("parses"),
+            vec![(1, 2)]
+        );
+        assert!(parse_movement(Path::new("m.csv"), "")
+            .expect("parses")
+            .is_empty());
+    }
+
+    #[test]
+    fn malformed_movement_lines_name_file_and_line() {
+        let cases = [
+            ("#h\n1,2\n3\n", "movement.csv:3:", "expected 2 columns"),
+            (
+                "#h\n1,2\n3,x4\n",
+                "movement.csv:3:",
+                "'x4' is not an integer",
+            ),
+            ("#h\n5,4\n", "movement.csv:2:", "end 4 before start 5"),
+            ("#h\n1,10\n10,20\n", "movement.csv:3:", "overlaps"),
+            ("#h\n1,2\n-3,4\n", "movement.csv:3:", "'-3'"),
+        ];
+        for (text, at, what) in cases {
+            let err = parse_movement(Path::new("d/movement.csv"), text)
+                .expect_err(text)
+                .to_string();
+            assert!(err.contains(at) && err.contains(what), "{text:?}: {err}");
+        }
+    }
+
+    #[test]
+    fn a_missing_movement_file_is_none() {
+        let dir = std::env::temp_dir().join(format!("host-sim-movement-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("tmp");
+        assert_eq!(movement(&dir).expect("absent is fine"), None);
+        std::fs::write(dir.join("movement.csv"), "#s,e\n1,2\nbad\n").expect("write");
+        let err = movement(&dir).expect_err("malformed").to_string();
+        assert!(err.contains("movement.csv:3:"), "{err}");
+        let _ = std::fs::remove_dir_all(dir);
     }
 }

@@ -5,12 +5,24 @@
 //! `δθ = log(R̂ᵀ R)`, `δv = v − v̂`, `δp = p − p̂`, `δb = b − b̂`. The NEES of a block is
 //! `δᵀ P_block⁻¹ δ` with the filter's own 3×3 covariance block; for a consistent filter its mean
 //! over a run is near 3.
+//!
+//! Two further figures compare with published references: the attitude RMSE from 2 s after the
+//! first ground-truth sample (so that every filter is judged after the same start), and BROAD's
+//! total / heading / inclination RMSEs inside a trial's movement intervals ([`broad`]).
+
+pub mod broad;
 
 use crate::dataset::read::Truth;
+use crate::dataset::DatasetError;
+use broad::{broad_error, in_intervals, BroadAccumulator, BroadRmse};
 use estimator_core::lie::{LieGroup, So3};
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The attitude RMSE after the start scores from this long after the first truth sample, ns.
+pub const AFTER_START_NS: u64 = 2_000_000_000;
 
 /// The blocks of the 15-dimensional error state, in order.
 pub const BLOCKS: [&str; 5] = [
@@ -198,6 +210,14 @@ pub struct Scorer {
     pub nees_steps: Vec<[f64; 5]>,
     /// Sum of squared attitude errors and count, per reference filter (`baseline`).
     pub baselines: BTreeMap<String, (f64, u64)>,
+    /// BROAD's movement intervals (ns, inclusive); `None`: BROAD's metric is not computed.
+    movement: Option<Vec<(u64, u64)>>,
+    /// BROAD's errors inside the movement intervals.
+    broad: BroadAccumulator,
+    /// Time of the first ground-truth sample, ns (else the first scored sample's).
+    truth_start_ns: Option<u64>,
+    /// Sum of squared attitude errors and count from [`AFTER_START_NS`] after the truth start.
+    after_start: (f64, u64),
 }
 
 /// The figures of one run (`metrics.json`).
@@ -207,6 +227,14 @@ pub struct Metrics {
     pub ate_position_rmse_m: f64,
     /// Attitude RMSE, degrees (NaN, written `null`, when nothing was scored).
     pub attitude_rmse_deg: f64,
+    /// Attitude RMSE (geodesic angle) from 2 s after the first ground-truth sample, degrees
+    /// (NaN, written `null`, when nothing was scored there).
+    pub attitude_rmse_after_2s_deg: f64,
+    /// Samples scored from 2 s after the first ground-truth sample.
+    pub samples_scored_after_2s: u64,
+    /// BROAD's RMSEs inside the movement intervals ([`broad`]); `None` (`null`) without
+    /// movement intervals.
+    pub broad: Option<BroadRmse>,
     /// Velocity RMSE, m/s.
     pub velocity_rmse_mps: f64,
     /// Mean NEES per block (expected 3 for a consistent filter).
@@ -228,10 +256,50 @@ pub struct Metrics {
 }
 
 impl Scorer {
+    /// Scores BROAD's metric inside these intervals (ns, inclusive, ordered and disjoint, as
+    /// `movement.csv` holds them); `None` turns it off.
+    pub fn set_movement(&mut self, intervals: Option<Vec<(u64, u64)>>) {
+        self.movement = intervals;
+    }
+
+    /// The time of the first ground-truth sample, from which [`AFTER_START_NS`] is counted
+    /// (without it, the first scored sample's time).
+    pub fn set_truth_start(&mut self, t_ns: u64) {
+        self.truth_start_ns = Some(t_ns);
+    }
+
+    /// This scorer with the dataset's movement intervals (`movement.csv`) and first
+    /// ground-truth time, for what was not set already.
+    ///
+    /// # Errors
+    /// A malformed `movement.csv` or first ground-truth row, naming the file and line.
+    pub fn for_dataset(mut self, dir: &Path) -> Result<Self, DatasetError> {
+        if self.movement.is_none() {
+            self.movement = crate::dataset::read::movement(dir)?;
+        }
+        if self.truth_start_ns.is_none() {
+            self.truth_start_ns = crate::dataset::read::first_truth_ns(dir)?;
+        }
+        Ok(self)
+    }
+
     /// Scores one estimate against the truth at the same time.
     pub fn add(&mut self, e: &Estimate, truth: &Truth) {
         let t0 = *self.t0_ns.get_or_insert(e.t_ns);
+        let truth_start = *self.truth_start_ns.get_or_insert(truth.t_ns);
         let errs = errors(e, truth);
+        if truth.t_ns >= truth_start.saturating_add(AFTER_START_NS) {
+            self.after_start.0 += errs[0].norm_squared();
+            self.after_start.1 += 1;
+        }
+        if let Some(intervals) = &self.movement {
+            if in_intervals(intervals, truth.t_ns) {
+                self.broad.add(&broad_error(
+                    &e.attitude.quaternion(),
+                    &truth.attitude.quaternion(),
+                ));
+            }
+        }
         let mut error = [0.0; 15];
         let mut step = [f64::NAN; 5];
         for (b, d) in errs.iter().enumerate() {
@@ -330,6 +398,15 @@ impl Scorer {
             } else {
                 f64::NAN
             },
+            attitude_rmse_after_2s_deg: if self.after_start.1 > 0 {
+                (self.after_start.0 / self.after_start.1 as f64)
+                    .sqrt()
+                    .to_degrees()
+            } else {
+                f64::NAN
+            },
+            samples_scored_after_2s: self.after_start.1,
+            broad: self.movement.as_ref().map(|_| self.broad.rmse()),
             velocity_rmse_mps: if self.nees_n[1] > 0 {
                 rmse(1)
             } else {
@@ -395,5 +472,93 @@ pub fn interpolate_truth(a: &Truth, b: &Truth, t_ns: u64) -> Truth {
         velocity: lerp(&a.velocity, &b.velocity),
         gyro_bias: lerp(&a.gyro_bias, &b.gyro_bias),
         accel_bias: lerp(&a.accel_bias, &b.accel_bias),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn truth(t_ns: u64) -> Truth {
+        Truth {
+            t_ns,
+            position: Vector3::zeros(),
+            attitude: So3::identity(),
+            velocity: Vector3::zeros(),
+            gyro_bias: Vector3::zeros(),
+            accel_bias: Vector3::zeros(),
+        }
+    }
+
+    /// An attitude-only estimate rotated by `deg` about the world vertical.
+    fn heading_off(t_ns: u64, deg: f64) -> Estimate {
+        Estimate {
+            t_ns,
+            position: Vector3::zeros(),
+            attitude: So3::exp(&Vector3::new(0.0, 0.0, deg.to_radians())),
+            velocity: Vector3::zeros(),
+            gyro_bias: Vector3::zeros(),
+            accel_bias: Vector3::zeros(),
+            cov: [Some(Matrix3::identity()), None, None, None, None],
+        }
+    }
+
+    const S: u64 = 1_000_000_000;
+
+    #[test]
+    fn broad_scores_only_inside_the_movement_intervals() {
+        let mut scorer = Scorer::default();
+        scorer.set_movement(Some(vec![(2 * S, 3 * S)]));
+        for (t, deg) in [(S, 50.0), (2 * S, 3.0), (3 * S, 4.0), (4 * S, 50.0)] {
+            scorer.add(&heading_off(t, deg), &truth(t));
+        }
+        let m = scorer.metrics();
+        let b = m.broad.expect("movement given");
+        assert_eq!(b.samples, 2);
+        assert!((b.total_deg - 12.5_f64.sqrt()).abs() < 1e-9, "{b:?}");
+        assert!((b.heading_deg - 12.5_f64.sqrt()).abs() < 1e-9, "{b:?}");
+        assert!(b.inclination_deg.abs() < 1e-6, "{b:?}");
+        assert_eq!(m.samples_scored, 4);
+    }
+
+    #[test]
+    fn nothing_in_the_intervals_is_null_not_zero_and_no_intervals_is_no_broad() {
+        let mut scorer = Scorer::default();
+        scorer.set_movement(Some(vec![(10 * S, 11 * S)]));
+        scorer.add(&heading_off(S, 5.0), &truth(S));
+        let b = scorer.metrics().broad.expect("movement given");
+        assert_eq!(b.samples, 0);
+        assert!(b.total_deg.is_nan() && b.heading_deg.is_nan() && b.inclination_deg.is_nan());
+        let json = serde_json::to_value(scorer.metrics()).expect("json");
+        assert!(json["broad"]["total_deg"].is_null(), "{json}");
+
+        let mut plain = Scorer::default();
+        plain.add(&heading_off(S, 5.0), &truth(S));
+        assert!(plain.metrics().broad.is_none());
+    }
+
+    #[test]
+    fn the_after_start_rmse_counts_from_two_seconds_after_the_first_truth() {
+        let mut scorer = Scorer::default();
+        // The first truth is at 0; scoring starts later (after the filter's alignment).
+        scorer.set_truth_start(0);
+        for (t, deg) in [(S, 30.0), (2 * S - 1, 30.0), (2 * S, 3.0), (5 * S, 4.0)] {
+            scorer.add(&heading_off(t, deg), &truth(t));
+        }
+        let m = scorer.metrics();
+        assert_eq!(m.samples_scored_after_2s, 2);
+        assert!((m.attitude_rmse_after_2s_deg - 12.5_f64.sqrt()).abs() < 1e-9);
+
+        // Without a truth start, the first scored sample starts the count.
+        let mut scorer = Scorer::default();
+        for t in [S, 2 * S, 3 * S] {
+            scorer.add(&heading_off(t, 1.0), &truth(t));
+        }
+        let m = scorer.metrics();
+        assert_eq!(m.samples_scored_after_2s, 1);
+        assert!(Scorer::default()
+            .metrics()
+            .attitude_rmse_after_2s_deg
+            .is_nan());
     }
 }

@@ -1,0 +1,751 @@
+//! `host-sim bench DIR`: the filter over every dataset folder under `DIR`, scored and set beside
+//! the published references of the same data.
+//!
+//! A dataset folder is one holding `imu0/data.csv`: `DIR` itself, or a folder one or two levels
+//! below it (so `bench ../shared/datasets` covers `broad/` and `independent/`). Each is replayed
+//! with [`crate::replay::replay_scored`], plots off, into `OUT/<dataset name>`; the datasets of
+//! one parent folder make one table, against the `references.json` of that folder when there is
+//! one:
+//!
+//! | `references.json` | table |
+//! |---|---|
+//! | `trials.{name}.{anchor}.{total,heading,inclination}` (BROAD) | BROAD's total / heading / inclination RMSE inside `movement.csv` ([`crate::metrics::broad`]), real-time VQF's and Madgwick's total, with the mean and the worst trial |
+//! | `datasets.{name}.{anchor}.attitude_rmse_deg` | the attitude RMSE from 2 s after the first ground-truth sample, the ANEES of the attitude, VQF's RMSE and ours / VQF |
+//! | none | the same columns as the kind of data suggests (BROAD where every dataset has `movement.csv`), ours only |
+//!
+//! A figure that was not computed (no reference, nothing scored, a failed run) is printed `–`
+//! and written `null`, never as a number. `OUT/bench.json` holds every figure of the tables.
+
+use crate::metrics::Metrics;
+use crate::output::{OutputError, Staging};
+use crate::replay::{replay_scored, ReplayConfig};
+use serde::Serialize;
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The anchor of BROAD's `references.json` used as the main comparison (real-time VQF 9D).
+pub const VQF: &str = "vqf_9d";
+/// BROAD's published Madgwick at its trial-agnostic good parameter.
+pub const MADGWICK: &str = "madgwick_tagp_published";
+
+/// What to bench.
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    /// The folder searched for datasets.
+    pub dir: PathBuf,
+    /// The output folder (one subfolder per dataset, and `bench.json`).
+    pub out: PathBuf,
+    /// A replay configuration for every dataset (else each dataset's `replay.toml`, else the
+    /// defaults); plots are turned off either way.
+    pub config: Option<PathBuf>,
+    /// Replace `out` if it holds an earlier host-sim output.
+    pub force: bool,
+}
+
+/// Errors that stop the bench before or after the datasets run (a dataset that fails is
+/// reported in its row instead).
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// No dataset folder was found.
+    #[error("{}: no dataset folder (one holding imu0/data.csv) in it or one or two levels below", .0.display())]
+    NoDatasets(PathBuf),
+    /// The folder cannot be listed.
+    #[error("{}: {source}", path.display())]
+    Read {
+        /// The folder.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The output folder would hold the datasets.
+    #[error("{}: the output folder holds the datasets {}; name another folder with --out", out.display(), dir.display())]
+    OutHoldsDatasets {
+        /// The output folder.
+        out: PathBuf,
+        /// The dataset folder.
+        dir: PathBuf,
+    },
+    /// The given configuration is unreadable or invalid.
+    #[error("{0}")]
+    Config(String),
+    /// The output folder may not be written, or moving it into place failed.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// `bench.json` could not be written.
+    #[error("{}: {message}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
+}
+
+/// The replay configuration for `dataset`: the `given` file, else the dataset's `replay.toml`,
+/// else the defaults (the order of `host-sim replay`).
+///
+/// # Errors
+/// An unreadable or malformed file, or a value out of its domain, naming the file.
+pub fn replay_config(given: Option<&Path>, dataset: &Path) -> Result<ReplayConfig, String> {
+    let source = given.map_or_else(|| dataset.join("replay.toml"), Path::to_path_buf);
+    let cfg: ReplayConfig = match std::fs::read_to_string(&source) {
+        Ok(text) => toml::from_str(&text)
+            .map_err(|e| format!("{}: {}", source.display(), e.to_string().replace('\n', " ")))?,
+        Err(e) if given.is_none() && e.kind() == std::io::ErrorKind::NotFound => {
+            ReplayConfig::default()
+        }
+        Err(e) => return Err(format!("{}: {e}", source.display())),
+    };
+    cfg.validate()
+        .map_err(|e| format!("{}: {e}", source.display()))?;
+    Ok(cfg)
+}
+
+fn is_dataset(dir: &Path) -> bool {
+    dir.join("imu0/data.csv").is_file()
+}
+
+fn subfolders(dir: &Path) -> Result<Vec<PathBuf>, BenchError> {
+    let entries = std::fs::read_dir(dir).map_err(|e| BenchError::Read {
+        path: dir.to_path_buf(),
+        source: e,
+    })?;
+    let mut out = Vec::new();
+    for entry in entries {
+        let path = entry
+            .map_err(|e| BenchError::Read {
+                path: dir.to_path_buf(),
+                source: e,
+            })?
+            .path();
+        let hidden = path
+            .file_name()
+            .is_some_and(|n| n.to_string_lossy().starts_with('.'));
+        if path.is_dir() && !hidden {
+            out.push(path);
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// The dataset folders (holding `imu0/data.csv`): `dir` itself, or its subfolders one and two
+/// levels deep (hidden folders skipped, nothing searched inside a dataset), sorted.
+///
+/// # Errors
+/// A folder that cannot be listed.
+pub fn find_datasets(dir: &Path) -> Result<Vec<PathBuf>, BenchError> {
+    if is_dataset(dir) {
+        return Ok(vec![dir.to_path_buf()]);
+    }
+    let mut found = Vec::new();
+    for sub in subfolders(dir)? {
+        if is_dataset(&sub) {
+            found.push(sub);
+        } else {
+            found.extend(subfolders(&sub)?.into_iter().filter(|d| is_dataset(d)));
+        }
+    }
+    Ok(found)
+}
+
+/// `Some(x)` when `x` is finite: a figure that was computed.
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+/// BROAD's figures of one trial.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct BroadFigures {
+    /// Total error RMSE, degrees.
+    pub total_deg: Option<f64>,
+    /// Heading error RMSE, degrees.
+    pub heading_deg: Option<f64>,
+    /// Inclination error RMSE, degrees.
+    pub inclination_deg: Option<f64>,
+}
+
+/// One row of a BROAD table.
+#[derive(Clone, Debug, Serialize)]
+pub struct BroadRow {
+    /// The trial (dataset folder name).
+    pub dataset: String,
+    /// Why the run failed, if it did.
+    pub error: Option<String>,
+    /// This project's figures.
+    pub ours: BroadFigures,
+    /// IMU samples scored inside the movement intervals.
+    pub samples: Option<u64>,
+    /// Real-time VQF 9D's total RMSE from `references.json`, degrees.
+    pub vqf_total_deg: Option<f64>,
+    /// BROAD's published Madgwick's total RMSE, degrees.
+    pub madgwick_total_deg: Option<f64>,
+}
+
+/// The mean or the maximum over the trials of a BROAD table (each `null` unless every trial has
+/// the figure).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct BroadSummary {
+    /// This project's figures.
+    pub ours: BroadFigures,
+    /// Real-time VQF 9D's total RMSE, degrees.
+    pub vqf_total_deg: Option<f64>,
+}
+
+/// One row of a table of attitude RMSEs.
+#[derive(Clone, Debug, Serialize)]
+pub struct AttitudeRow {
+    /// The dataset folder name.
+    pub dataset: String,
+    /// Why the run failed, if it did.
+    pub error: Option<String>,
+    /// Attitude RMSE from 2 s after the first ground-truth sample, degrees.
+    pub attitude_rmse_after_2s_deg: Option<f64>,
+    /// Mean NEES of the attitude block (3 for a consistent filter).
+    pub anees_attitude: Option<f64>,
+    /// Real-time VQF 9D's attitude RMSE from `references.json`, degrees.
+    pub vqf_attitude_rmse_deg: Option<f64>,
+    /// Ours / VQF.
+    pub ratio_to_vqf: Option<f64>,
+}
+
+/// The rows of one table.
+#[derive(Clone, Debug, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Rows {
+    /// BROAD's metric.
+    Broad {
+        /// One row per trial.
+        rows: Vec<BroadRow>,
+        /// The mean over the trials.
+        mean: BroadSummary,
+        /// The worst trial per column.
+        max: BroadSummary,
+    },
+    /// Attitude RMSE from 2 s after the start.
+    Attitude {
+        /// One row per dataset.
+        rows: Vec<AttitudeRow>,
+    },
+}
+
+/// The datasets of one parent folder.
+#[derive(Clone, Debug, Serialize)]
+pub struct Table {
+    /// The parent folder.
+    pub folder: PathBuf,
+    /// Its `references.json`, when present.
+    pub references: Option<PathBuf>,
+    /// Why `references.json` could not be used, if so.
+    pub references_error: Option<String>,
+    /// The rows.
+    #[serde(flatten)]
+    pub rows: Rows,
+}
+
+/// The outcome of a bench (`bench.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// The folder searched.
+    pub dir: PathBuf,
+    /// The output folder.
+    pub out: PathBuf,
+    /// The replay configuration file given for every dataset, if any.
+    pub config: Option<PathBuf>,
+    /// One table per parent folder.
+    pub tables: Vec<Table>,
+}
+
+/// One dataset's run.
+struct Outcome {
+    name: String,
+    result: Result<Metrics, String>,
+}
+
+/// The references of one folder, by dataset name.
+enum References {
+    Broad(BTreeMap<String, Value>),
+    Attitude(BTreeMap<String, Value>),
+}
+
+fn read_references(path: &Path) -> Result<Option<References>, String> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(format!("{}: {e}", path.display())),
+    };
+    let v: Value = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let entries = |key: &str| {
+        v.get(key)
+            .and_then(Value::as_object)
+            .map(|m| m.iter().map(|(k, v)| (k.clone(), v.clone())).collect())
+    };
+    if let Some(t) = entries("trials") {
+        Ok(Some(References::Broad(t)))
+    } else if let Some(d) = entries("datasets") {
+        Ok(Some(References::Attitude(d)))
+    } else {
+        Err(format!(
+            "{}: neither a \"trials\" nor a \"datasets\" object",
+            path.display()
+        ))
+    }
+}
+
+fn reference(entries: &BTreeMap<String, Value>, dataset: &str, path: &[&str]) -> Option<f64> {
+    let mut v = entries.get(dataset)?;
+    for key in path {
+        v = v.get(key)?;
+    }
+    v.as_f64().and_then(finite)
+}
+
+/// The mean and the maximum of a column.
+type MeanMax = (Option<f64>, Option<f64>);
+
+/// Mean and maximum of a column, `None` unless every row has a value.
+fn aggregate(values: &[Option<f64>]) -> MeanMax {
+    let all: Option<Vec<f64>> = values.iter().copied().collect();
+    match all {
+        Some(v) if !v.is_empty() => (
+            Some(v.iter().sum::<f64>() / v.len() as f64),
+            v.iter().copied().reduce(f64::max),
+        ),
+        _ => (None, None),
+    }
+}
+
+fn broad_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Value>>) -> Rows {
+    let rows: Vec<BroadRow> = runs
+        .iter()
+        .map(|(_, o)| {
+            let r = |anchor: &str| refs.and_then(|m| reference(m, &o.name, &[anchor, "total"]));
+            let (ours, samples, error) = match &o.result {
+                Ok(m) => match &m.broad {
+                    Some(b) => (
+                        BroadFigures {
+                            total_deg: finite(b.total_deg),
+                            heading_deg: finite(b.heading_deg),
+                            inclination_deg: finite(b.inclination_deg),
+                        },
+                        Some(b.samples),
+                        None,
+                    ),
+                    None => (BroadFigures::default(), None, None),
+                },
+                Err(e) => (BroadFigures::default(), None, Some(e.clone())),
+            };
+            BroadRow {
+                dataset: o.name.clone(),
+                error,
+                ours,
+                samples,
+                vqf_total_deg: r(VQF),
+                madgwick_total_deg: r(MADGWICK),
+            }
+        })
+        .collect();
+    let column =
+        |f: &dyn Fn(&BroadRow) -> Option<f64>| aggregate(&rows.iter().map(f).collect::<Vec<_>>());
+    let total = column(&|r| r.ours.total_deg);
+    let heading = column(&|r| r.ours.heading_deg);
+    let inclination = column(&|r| r.ours.inclination_deg);
+    let vqf = column(&|r| r.vqf_total_deg);
+    let summary = |pick: fn(MeanMax) -> Option<f64>| BroadSummary {
+        ours: BroadFigures {
+            total_deg: pick(total),
+            heading_deg: pick(heading),
+            inclination_deg: pick(inclination),
+        },
+        vqf_total_deg: pick(vqf),
+    };
+    Rows::Broad {
+        mean: summary(|(mean, _)| mean),
+        max: summary(|(_, max)| max),
+        rows,
+    }
+}
+
+fn attitude_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Value>>) -> Rows {
+    let rows = runs
+        .iter()
+        .map(|(_, o)| {
+            let vqf = refs.and_then(|m| reference(m, &o.name, &[VQF, "attitude_rmse_deg"]));
+            let (rmse, anees, error) = match &o.result {
+                Ok(m) => (
+                    finite(m.attitude_rmse_after_2s_deg),
+                    m.nees_mean.get("attitude").copied().and_then(finite),
+                    None,
+                ),
+                Err(e) => (None, None, Some(e.clone())),
+            };
+            let ratio = match (rmse, vqf) {
+                (Some(a), Some(b)) if b > 0.0 => finite(a / b),
+                _ => None,
+            };
+            AttitudeRow {
+                dataset: o.name.clone(),
+                error,
+                attitude_rmse_after_2s_deg: rmse,
+                anees_attitude: anees,
+                vqf_attitude_rmse_deg: vqf,
+                ratio_to_vqf: ratio,
+            }
+        })
+        .collect();
+    Rows::Attitude { rows }
+}
+
+/// Output subfolder names: the dataset folder's name, prefixed with its parent's where two
+/// datasets share a name.
+fn output_names(datasets: &[PathBuf]) -> Vec<String> {
+    let base = |d: &Path| {
+        d.file_name().map_or_else(
+            || "dataset".to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        )
+    };
+    let names: Vec<String> = datasets.iter().map(|d| base(d)).collect();
+    names
+        .iter()
+        .zip(datasets)
+        .map(|(n, d)| {
+            if names.iter().filter(|m| *m == n).count() > 1 {
+                let parent = d.parent().map_or_else(String::new, base);
+                format!("{parent}-{n}")
+            } else {
+                n.clone()
+            }
+        })
+        .collect()
+}
+
+/// Replays one dataset into `out`; a panic in the filter is reported as the dataset's failure.
+fn run_one(
+    dataset: &Path,
+    out: &Path,
+    given: Option<&Path>,
+    name: &str,
+) -> Result<Metrics, String> {
+    let mut cfg = replay_config(given, dataset)?;
+    cfg.plots = false;
+    let scorer = crate::metrics::Scorer::default()
+        .for_dataset(dataset)
+        .map_err(|e| e.to_string())?;
+    let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        replay_scored(dataset, out, &cfg, name, scorer)
+    }));
+    let metrics = match run {
+        Ok(Ok(scorer)) => scorer.metrics(),
+        Ok(Err(e)) => return Err(e.to_string()),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| (*s).to_string()))
+                .unwrap_or_else(|| "unknown panic".into());
+            return Err(format!("panicked: {what}"));
+        }
+    };
+    let truth = dataset.join("state_groundtruth_estimate0/data.csv");
+    if metrics.samples_scored == 0 && truth.is_file() {
+        return Err(format!(
+            "{}: no estimate could be scored against it",
+            truth.display()
+        ));
+    }
+    Ok(metrics)
+}
+
+/// Runs the bench (see the module docs): replays every dataset under `opts.dir` into
+/// `opts.out`, writes `bench.json` there and moves the folder into place. A dataset that fails
+/// is reported in its row ([`Report::failures`]) and does not stop the others.
+///
+/// `progress` is called before each dataset with its index, the count and its folder.
+///
+/// # Errors
+/// No dataset found, an unusable `--config`, or an output folder that may not be written.
+pub fn run(
+    opts: &BenchOptions,
+    mut progress: impl FnMut(usize, usize, &Path),
+) -> Result<Report, BenchError> {
+    let datasets = find_datasets(&opts.dir)?;
+    if datasets.is_empty() {
+        return Err(BenchError::NoDatasets(opts.dir.clone()));
+    }
+    if let (Ok(d), Ok(o)) = (opts.dir.canonicalize(), opts.out.canonicalize()) {
+        if d.starts_with(&o) {
+            return Err(BenchError::OutHoldsDatasets {
+                out: opts.out.clone(),
+                dir: opts.dir.clone(),
+            });
+        }
+    }
+    if let Some(c) = &opts.config {
+        // Checked once before anything runs (and again per dataset).
+        replay_config(Some(c), &opts.dir).map_err(BenchError::Config)?;
+    }
+    let staging = Staging::new(&opts.out, opts.force, "bench")?;
+    let names = output_names(&datasets);
+    let mut outcomes = Vec::with_capacity(datasets.len());
+    for (i, (dataset, name)) in datasets.iter().zip(&names).enumerate() {
+        progress(i, datasets.len(), dataset);
+        let result = run_one(
+            dataset,
+            &staging.dir().join(name),
+            opts.config.as_deref(),
+            name,
+        );
+        let dataset_name = dataset
+            .file_name()
+            .map_or_else(|| name.clone(), |n| n.to_string_lossy().into_owned());
+        outcomes.push(Outcome {
+            name: dataset_name,
+            result,
+        });
+    }
+
+    // One table per parent folder, in the order found.
+    let mut groups: Vec<(PathBuf, Vec<(&Path, &Outcome)>)> = Vec::new();
+    for (dataset, outcome) in datasets.iter().zip(&outcomes) {
+        let parent = dataset
+            .parent()
+            .map_or_else(PathBuf::new, Path::to_path_buf);
+        match groups.iter_mut().find(|(p, _)| *p == parent) {
+            Some((_, runs)) => runs.push((dataset, outcome)),
+            None => groups.push((parent, vec![(dataset, outcome)])),
+        }
+    }
+    let mut tables = Vec::new();
+    for (folder, runs) in groups {
+        let path = folder.join("references.json");
+        let (refs, references_error) = match read_references(&path) {
+            Ok(r) => (r, None),
+            Err(e) => (None, Some(e)),
+        };
+        let rows = match &refs {
+            Some(References::Broad(m)) => broad_table(&runs, Some(m)),
+            Some(References::Attitude(m)) => attitude_table(&runs, Some(m)),
+            None if runs.iter().all(|(d, _)| d.join("movement.csv").is_file()) => {
+                broad_table(&runs, None)
+            }
+            None => attitude_table(&runs, None),
+        };
+        tables.push(Table {
+            references: (refs.is_some() || references_error.is_some()).then_some(path),
+            references_error,
+            folder,
+            rows,
+        });
+    }
+    let report = Report {
+        dir: opts.dir.clone(),
+        out: opts.out.clone(),
+        config: opts.config.clone(),
+        tables,
+    };
+    let json_path = staging.dir().join("bench.json");
+    let json = serde_json::to_string_pretty(&report).map_err(|e| BenchError::Write {
+        path: opts.out.join("bench.json"),
+        message: e.to_string(),
+    })?;
+    std::fs::write(&json_path, json + "\n").map_err(|e| BenchError::Write {
+        path: opts.out.join("bench.json"),
+        message: e.to_string(),
+    })?;
+    staging.commit()?;
+    Ok(report)
+}
+
+const DASH: &str = "–";
+
+fn cell(x: Option<f64>, decimals: usize) -> String {
+    x.map_or_else(|| DASH.to_string(), |v| format!("{v:.decimals$}"))
+}
+
+impl Report {
+    /// The datasets that failed to run, and the `references.json` files that could not be read.
+    #[must_use]
+    pub fn failures(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for t in &self.tables {
+            if let Some(e) = &t.references_error {
+                out.push(e.clone());
+            }
+            let errors: Vec<(&String, &Option<String>)> = match &t.rows {
+                Rows::Broad { rows, .. } => rows.iter().map(|r| (&r.dataset, &r.error)).collect(),
+                Rows::Attitude { rows } => rows.iter().map(|r| (&r.dataset, &r.error)).collect(),
+            };
+            for (name, e) in errors {
+                if let Some(e) = e {
+                    out.push(format!("{name}: {e}"));
+                }
+            }
+        }
+        out
+    }
+
+    /// The tables as printed.
+    #[must_use]
+    pub fn render(&self) -> String {
+        let mut s = String::new();
+        for t in &self.tables {
+            let refs = match (&t.references, &t.references_error) {
+                (_, Some(e)) => format!("references unusable: {e}"),
+                (Some(p), None) => format!("references {}", p.display()),
+                (None, None) => "no references.json".to_string(),
+            };
+            match &t.rows {
+                Rows::Broad { rows, mean, max } => {
+                    let w = rows
+                        .iter()
+                        .map(|r| r.dataset.chars().count())
+                        .max()
+                        .unwrap_or(5)
+                        .max(5);
+                    let _ = writeln!(
+                        s,
+                        "\nBROAD RMSE [deg] inside movement.csv: {} ({refs})",
+                        t.folder.display()
+                    );
+                    let _ = writeln!(
+                        s,
+                        "{:<w$}  {:>8} {:>8} {:>8}  {:>8}  {:>8}",
+                        "", "ours", "ours", "ours", "VQF", "Madgwick"
+                    );
+                    let _ = writeln!(
+                        s,
+                        "{:<w$}  {:>8} {:>8} {:>8}  {:>8}  {:>8}",
+                        "trial", "total", "heading", "inclin.", "total", "total"
+                    );
+                    for r in rows {
+                        if let Some(e) = &r.error {
+                            let _ = writeln!(s, "{:<w$}  failed: {e}", r.dataset);
+                            continue;
+                        }
+                        let _ = writeln!(
+                            s,
+                            "{:<w$}  {:>8} {:>8} {:>8}  {:>8}  {:>8}",
+                            r.dataset,
+                            cell(r.ours.total_deg, 3),
+                            cell(r.ours.heading_deg, 3),
+                            cell(r.ours.inclination_deg, 3),
+                            cell(r.vqf_total_deg, 3),
+                            cell(r.madgwick_total_deg, 3),
+                        );
+                    }
+                    for (label, a) in [("mean", mean), ("max", max)] {
+                        let _ = writeln!(
+                            s,
+                            "{:<w$}  {:>8} {:>8} {:>8}  {:>8}  {:>8}",
+                            label,
+                            cell(a.ours.total_deg, 3),
+                            cell(a.ours.heading_deg, 3),
+                            cell(a.ours.inclination_deg, 3),
+                            cell(a.vqf_total_deg, 3),
+                            DASH,
+                        );
+                    }
+                }
+                Rows::Attitude { rows } => {
+                    let w = rows
+                        .iter()
+                        .map(|r| r.dataset.chars().count())
+                        .max()
+                        .unwrap_or(7)
+                        .max(7);
+                    let _ = writeln!(
+                        s,
+                        "\nattitude RMSE [deg] from 2 s after the first truth sample: {} ({refs})",
+                        t.folder.display()
+                    );
+                    let _ = writeln!(
+                        s,
+                        "{:<w$}  {:>9} {:>11}  {:>9}  {:>8}",
+                        "dataset", "ours RMSE", "ours ANEES", "VQF RMSE", "ours/VQF"
+                    );
+                    for r in rows {
+                        if let Some(e) = &r.error {
+                            let _ = writeln!(s, "{:<w$}  failed: {e}", r.dataset);
+                            continue;
+                        }
+                        let _ = writeln!(
+                            s,
+                            "{:<w$}  {:>9} {:>11}  {:>9}  {:>8}",
+                            r.dataset,
+                            cell(r.attitude_rmse_after_2s_deg, 3),
+                            cell(r.anees_attitude, 2),
+                            cell(r.vqf_attitude_rmse_deg, 3),
+                            cell(r.ratio_to_vqf, 2),
+                        );
+                    }
+                    let _ = writeln!(s, "(ANEES: mean NEES of the attitude, 3 when consistent)");
+                }
+            }
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn aggregates_need_every_value() {
+        assert_eq!(aggregate(&[Some(1.0), Some(3.0)]), (Some(2.0), Some(3.0)));
+        assert_eq!(aggregate(&[Some(1.0), None]), (None, None));
+        assert_eq!(aggregate(&[]), (None, None));
+    }
+
+    #[test]
+    fn shared_names_get_their_parent() {
+        let d = [
+            PathBuf::from("a/x"),
+            PathBuf::from("b/x"),
+            PathBuf::from("b/y"),
+        ];
+        assert_eq!(output_names(&d), ["a-x", "b-x", "y"]);
+    }
+
+    #[test]
+    fn references_of_both_layouts_and_missing_entries() {
+        let dir = std::env::temp_dir().join(format!("host-sim-bench-refs-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("tmp");
+        let p = dir.join("references.json");
+        std::fs::write(
+            &p,
+            r#"{"trials": {"t1": {"vqf_9d": {"total": 2.5}, "madgwick_tagp_published": {"total": null}}}}"#,
+        )
+        .expect("write");
+        let Ok(Some(References::Broad(m))) = read_references(&p) else {
+            panic!("a BROAD layout");
+        };
+        assert_eq!(reference(&m, "t1", &[VQF, "total"]), Some(2.5));
+        assert_eq!(reference(&m, "t1", &[MADGWICK, "total"]), None);
+        assert_eq!(reference(&m, "t2", &[VQF, "total"]), None);
+        std::fs::write(
+            &p,
+            r#"{"datasets": {"d": {"vqf_9d": {"attitude_rmse_deg": 1.5}}}}"#,
+        )
+        .expect("write");
+        assert!(matches!(
+            read_references(&p),
+            Ok(Some(References::Attitude(_)))
+        ));
+        std::fs::write(&p, "{ not json").expect("write");
+        assert!(read_references(&p).is_err());
+        std::fs::remove_file(&p).expect("rm");
+        assert!(matches!(read_references(&p), Ok(None)));
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn nothing_computed_prints_a_dash() {
+        assert_eq!(cell(None, 3), "–");
+        assert_eq!(cell(Some(1.23456), 3), "1.235");
+        assert_eq!(finite(f64::NAN), None);
+    }
+}

@@ -37,6 +37,7 @@ pub(super) fn navigator_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> Att
     c.acceleration_correlation_s = T::lit(cfg.acceleration_correlation_s);
     c.accelerometer_bias_sigma = T::lit(cfg.accelerometer_bias_sigma);
     c.gyro_bias_sigma = T::lit(cfg.gyro_bias_sigma_dps.to_radians());
+    c.gyro_scale_sigma = T::lit(cfg.gyro_scale_sigma);
     c.magnetometer = ds.mag.as_ref().map(|m| {
         let mut mc = MagneticConfig::new(T::lit(m.sigma), Some(lit3(&m.reference_field)));
         mc.heading_noise = T::lit(cfg.heading_noise_deg.to_radians());
@@ -57,12 +58,18 @@ fn estimate<T: Real>(nav: &AttitudeNavigator<T>, t_ns: u64) -> Option<Estimate> 
         attitude: s.attitude.cast(),
         velocity: Vector3::zeros(),
         gyro_bias: up3(&s.gyro_bias),
-        accel_bias: Vector3::zeros(),
-        cov: [Some(block(0)), None, None, Some(block(1)), None],
+        accel_bias: up3(&s.accel_bias),
+        cov: [Some(block(0)), None, None, Some(block(1)), Some(block(2))],
     })
 }
 
-fn score_fusion<T: Real>(scorer: &mut Scorer, name: &str, t_ns: u64, f: Option<Fusion<T>>, dof: usize) {
+fn score_fusion<T: Real>(
+    scorer: &mut Scorer,
+    name: &str,
+    t_ns: u64,
+    f: Option<Fusion<T>>,
+    dof: usize,
+) {
     if let Some(f) = f {
         let nis = f.nis.to_f64();
         let outcome = if f.accepted {
@@ -74,7 +81,12 @@ fn score_fusion<T: Real>(scorer: &mut Scorer, name: &str, t_ns: u64, f: Option<F
     }
 }
 
-fn score_report<T: Real>(scorer: &mut Scorer, r: &Result<AttitudeReport<T>, NavError>, sensor: &str, t_ns: u64) {
+fn score_report<T: Real>(
+    scorer: &mut Scorer,
+    r: &Result<AttitudeReport<T>, NavError>,
+    sensor: &str,
+    t_ns: u64,
+) {
     match r {
         Ok(r) => {
             score_fusion(scorer, "gravity", t_ns, r.fused.gravity, 2);
@@ -129,7 +141,9 @@ pub(super) fn replay_attitude<T: Real>(
         let started = Instant::now();
         match ev? {
             Event::Imu { t_ns, gyro, accel } => {
-                let dt = last_imu.map_or(1.0 / ds.imu.rate_hz, |t| t_ns.saturating_sub(t) as f64 * 1e-9);
+                let dt = last_imu.map_or(1.0 / ds.imu.rate_hz, |t| {
+                    t_ns.saturating_sub(t) as f64 * 1e-9
+                });
                 last_imu = Some(t_ns);
                 let r = nav.imu(t_ns, &lit3(&gyro), &lit3(&accel));
                 score_report(&mut scorer, &r, "imu", t_ns);

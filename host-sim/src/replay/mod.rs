@@ -15,13 +15,12 @@
 //! With a GNSS stream it runs the 15-state INS, otherwise the attitude-only filter.
 
 use crate::baseline::{Madgwick, Mahony};
-use crate::dataset::read::{CameraParams, Dataset, Event, Truth, TruthStream};
+use crate::dataset::read::{CameraParams, Dataset, Event, TruthStream};
 use crate::dataset::DatasetError;
-use crate::metrics::{interpolate_truth, Estimate, Metrics, Outcome, Scorer};
+use crate::metrics::{Estimate, Metrics, Outcome, Scorer};
 use estimator_core::eskf::{
-    align_at_rest, Ahrs, BaroAltitude, EskfError, FilterConfig, GnssPosition, GnssVelocity,
-    GravityDirection, ImuNoise, ImuSample, InitialSigmas, Ins, Magnetometer, MagnetometerWindow,
-    UpdateOptions, UpdateOutcome,
+    align_at_rest, BaroAltitude, EskfError, FilterConfig, GnssPosition, GnssVelocity, ImuNoise,
+    ImuSample, InitialSigmas, Ins, Magnetometer, MagnetometerWindow, UpdateOptions, UpdateOutcome,
 };
 use estimator_core::eskf::{Alignment, CameraLandmark, PinholeIntrinsics};
 use estimator_core::gn::{solve_pnp, Loss, PinholeCamera, PnpOptions};
@@ -91,7 +90,10 @@ impl ReplayConfig {
             ("align_window_s", self.align_window_s),
             ("max_dt", self.max_dt),
             ("block_s", self.block_s),
-            ("acceleration_correlation_s", self.acceleration_correlation_s),
+            (
+                "acceleration_correlation_s",
+                self.acceleration_correlation_s,
+            ),
         ];
         for (name, x) in positive {
             if !(x.is_finite() && x > 0.0) {
@@ -109,7 +111,11 @@ impl ReplayConfig {
                 return Err(format!("{name} = {x}: must be 0 or more"));
             }
         }
-        for (name, x) in [("align_window_s", self.align_window_s), ("block_s", self.block_s), ("max_dt", self.max_dt)] {
+        for (name, x) in [
+            ("align_window_s", self.align_window_s),
+            ("block_s", self.block_s),
+            ("max_dt", self.max_dt),
+        ] {
             if x >= 4.0 {
                 return Err(format!("{name} = {x}: must be below 4 s"));
             }
@@ -128,12 +134,12 @@ impl Default for ReplayConfig {
             align_window_s: 1.0,
             gravity: [0.0, 0.0, -9.81],
             max_dt: 0.1,
-            block_s: 0.25,
+            block_s: 0.5,
             acceleration_correlation_s: 0.3,
             accelerometer_bias_sigma: 0.1,
             gyro_bias_sigma_dps: 0.5,
-            gyro_scale_sigma: 0.01,
-            heading_noise_deg: 6.0,
+            gyro_scale_sigma: 0.005,
+            heading_noise_deg: 8.0,
             heading_floor_deg: 1.0,
             instantaneous_imu: true,
             plots: true,
@@ -170,12 +176,9 @@ fn out_err(path: &Path) -> impl Fn(std::io::Error) -> ReplayError + '_ {
     }
 }
 
-/// Either filter.
+/// The 15-state filter of the GNSS and camera replays.
 #[derive(Clone, Debug)]
-enum Filter<T: Real> {
-    Ins(Box<Ins<T>>),
-    Ahrs(Box<Ahrs<T>>),
-}
+struct Filter<T: Real>(Box<Ins<T>>);
 
 fn lit3<T: Real>(v: &Vector3<f64>) -> Vector3<T> {
     v.map(T::lit)
@@ -191,39 +194,22 @@ fn block<T: Real, const N: usize>(p: &SMatrix<T, N, N>, b: usize) -> Matrix3<f64
 
 impl<T: Real> Filter<T> {
     fn estimate(&self, t_ns: u64) -> Estimate {
-        match self {
-            Filter::Ins(f) => {
-                let s = f.state();
-                let p = f.covariance();
-                Estimate {
-                    t_ns,
-                    position: up3(&s.position),
-                    attitude: s.attitude.cast(),
-                    velocity: up3(&s.velocity),
-                    gyro_bias: up3(&s.gyro_bias),
-                    accel_bias: up3(&s.accel_bias),
-                    cov: [
-                        Some(block(p, 0)),
-                        Some(block(p, 1)),
-                        Some(block(p, 2)),
-                        Some(block(p, 3)),
-                        Some(block(p, 4)),
-                    ],
-                }
-            }
-            Filter::Ahrs(f) => {
-                let s = f.state();
-                let p = f.covariance();
-                Estimate {
-                    t_ns,
-                    position: Vector3::zeros(),
-                    attitude: s.attitude.cast(),
-                    velocity: Vector3::zeros(),
-                    gyro_bias: up3(&s.gyro_bias),
-                    accel_bias: Vector3::zeros(),
-                    cov: [Some(block(p, 0)), None, None, Some(block(p, 1)), None],
-                }
-            }
+        let s = self.0.state();
+        let p = self.0.covariance();
+        Estimate {
+            t_ns,
+            position: up3(&s.position),
+            attitude: s.attitude.cast(),
+            velocity: up3(&s.velocity),
+            gyro_bias: up3(&s.gyro_bias),
+            accel_bias: up3(&s.accel_bias),
+            cov: [
+                Some(block(p, 0)),
+                Some(block(p, 1)),
+                Some(block(p, 2)),
+                Some(block(p, 3)),
+                Some(block(p, 4)),
+            ],
         }
     }
 
@@ -238,10 +224,7 @@ impl<T: Real> Filter<T> {
             accel: lit3(accel),
             dt: T::lit(dt),
         };
-        match self {
-            Filter::Ins(f) => f.predict(&imu),
-            Filter::Ahrs(f) => f.predict(&imu),
-        }
+        self.0.predict(&imu)
     }
 }
 
@@ -394,7 +377,7 @@ fn replay_in<T: Real>(
                 config,
             )
             .map_err(|e| ReplayError::Start(e.to_string()))?;
-            Filter::Ins(Box::new(ins))
+            Filter(Box::new(ins))
         }
         (_, _, Some(frame), Some(cam)) => {
             let world_from_body = pnp_pose(&frame, cam, &alignment.attitude.cast())?;
@@ -412,7 +395,7 @@ fn replay_in<T: Real>(
                 config,
             )
             .map_err(|e| ReplayError::Start(e.to_string()))?;
-            Filter::Ins(Box::new(ins))
+            Filter(Box::new(ins))
         }
         _ => {
             return Err(ReplayError::Start(
@@ -514,10 +497,7 @@ fn replay_in<T: Real>(
                 if let Some(m) = &ds.mag {
                     let model =
                         Magnetometer::new(lit3(&field), lit3(&m.reference_field), T::lit(m.sigma));
-                    let r = match &mut filter {
-                        Filter::Ins(f) => f.update(&model, &ekf),
-                        Filter::Ahrs(f) => f.update(&model, &ekf),
-                    };
+                    let r = filter.0.update(&model, &ekf);
                     scorer.measurement("mag", t_ns, outcome(r, 3));
                 }
             }
@@ -528,7 +508,7 @@ fn replay_in<T: Real>(
                 sigma_p,
                 sigma_v,
             } => {
-                if let (Filter::Ins(f), Some(g)) = (&mut filter, &ds.gnss) {
+                if let (Filter(f), Some(g)) = (&mut filter, &ds.gnss) {
                     let r = f.update(
                         &GnssPosition::new(lit3(&position), lit3(&g.lever_arm), T::lit(sigma_p)),
                         &ekf,
@@ -547,13 +527,13 @@ fn replay_in<T: Real>(
                 }
             }
             Event::Baro { t_ns, altitude } => {
-                if let (Filter::Ins(f), Some(b)) = (&mut filter, &ds.baro) {
+                if let (Filter(f), Some(b)) = (&mut filter, &ds.baro) {
                     let r = f.update(&BaroAltitude::new(T::lit(altitude), T::lit(b.sigma)), &ekf);
                     scorer.measurement("baro", t_ns, outcome(r, 1));
                 }
             }
             Event::Camera { t_ns, observations } => {
-                if let (Filter::Ins(f), Some(cam)) = (&mut filter, &ds.camera) {
+                if let (Filter(f), Some(cam)) = (&mut filter, &ds.camera) {
                     let [fx, fy, cx, cy] = cam.intrinsics;
                     let intrinsics = PinholeIntrinsics {
                         fx: T::lit(fx),
@@ -666,4 +646,3 @@ fn pnp_pose(
         .inverse()
         .compose(&cam.body_from_camera.inverse()))
 }
-

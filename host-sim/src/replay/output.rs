@@ -59,7 +59,12 @@ impl TruthCursor {
     }
 }
 
-pub(super) fn write_tum(f: &mut impl Write, t_ns: u64, p: &Vector3<f64>, r: &So3<f64>) -> std::io::Result<()> {
+pub(super) fn write_tum(
+    f: &mut impl Write,
+    t_ns: u64,
+    p: &Vector3<f64>,
+    r: &So3<f64>,
+) -> std::io::Result<()> {
     let q = r.quaternion();
     writeln!(
         f,

@@ -6,8 +6,8 @@
 //! gyro measured between sample `i` and the end, and `R̂ₑᵀ · mean(R̂ᵢ fᵢ)` is the block's mean
 //! specific force seen in the body at the end, without any attitude error in it.
 
-use crate::nav::mean::VectorMean;
 use crate::lie::LieGroup;
+use crate::nav::mean::VectorMean;
 use crate::Real;
 use nalgebra::Vector3;
 

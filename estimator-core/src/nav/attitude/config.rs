@@ -36,14 +36,14 @@ pub struct MagneticConfig<T: Real> {
 
 impl<T: Real> MagneticConfig<T> {
     /// A magnetometer with white noise `sigma` per axis and an optional reference; the other
-    /// values are the defaults listed on each field's use: 6°·√s heading noise, 1°
+    /// values are the defaults listed on each field's use: 8°·√s heading noise, 1°
     /// heading floor, 10 % norm and 10° dip tolerance, 20 s turning at 20 °/s or more for a new field.
     #[must_use]
     pub fn new(sigma: T, reference: Option<Vector3<T>>) -> Self {
         Self {
             reference,
             sigma,
-            heading_noise: T::lit(6.0_f64.to_radians()),
+            heading_noise: T::lit(8.0_f64.to_radians()),
             heading_floor: T::lit(1.0_f64.to_radians()),
             norm_tolerance: T::lit(0.1),
             dip_tolerance: T::lit(10.0_f64.to_radians()),
@@ -126,8 +126,8 @@ pub struct AttitudeConfig<T: Real> {
 
 impl<T: Real> AttitudeConfig<T> {
     /// The defaults around a filter configuration: trapezoidal IMU integration; 1 s start-up;
-    /// 0.25 s blocks; 0.3 s acceleration correlation; 0.1 m/s² accelerometer bias (0.6° of
-    /// tilt); 1 % gyro scale and cross-axis error; 0.5 °/s gyro bias at switch-on; rest below 2 °/s and 0.5 m/s² for 1.5 s with a
+    /// 0.5 s blocks; 0.3 s acceleration correlation; 0.1 m/s² accelerometer bias (0.6° of
+    /// tilt); 0.5 % gyro scale and cross-axis error; 0.5 °/s gyro bias at switch-on; rest below 2 °/s and 0.5 m/s² for 1.5 s with a
     /// 0.1 °/s floor; widen after 8 rejected blocks (2 s); valid below 5° tilt and 10° heading;
     /// no magnetometer.
     #[must_use]
@@ -136,10 +136,10 @@ impl<T: Real> AttitudeConfig<T> {
             filter,
             instantaneous_imu: true,
             startup_s: T::lit(1.0),
-            block_s: T::lit(0.25),
+            block_s: T::lit(0.5),
             acceleration_correlation_s: T::lit(0.3),
             accelerometer_bias_sigma: T::lit(0.1),
-            gyro_scale_sigma: T::lit(0.01),
+            gyro_scale_sigma: T::lit(0.005),
             gyro_bias_sigma: T::lit(0.5_f64.to_radians()),
             rest_gyro: T::lit(2.0_f64.to_radians()),
             rest_accel: T::lit(0.5),

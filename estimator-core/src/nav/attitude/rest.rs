@@ -31,7 +31,8 @@ pub(super) fn is_still<T: Real>(
     let rate_sq = stats.gyro_scatter_sq + w.dot(&w);
     let vertical = stats.accel_norm - g;
     let accel_sq = stats.accel_scatter_sq + vertical * vertical;
-    rate_sq <= config.rest_gyro * config.rest_gyro && accel_sq <= config.rest_accel * config.rest_accel
+    rate_sq <= config.rest_gyro * config.rest_gyro
+        && accel_sq <= config.rest_accel * config.rest_accel
 }
 
 /// The variance of the mean rate of a still block, `N_g²/(n Δt) + σ_rest²`.
@@ -52,6 +53,9 @@ pub(super) fn fuse<T: Real>(
     config: &AttitudeConfig<T>,
 ) -> Result<Fusion<T>, NavError> {
     let sigma = mean_rate_variance(stats, config).sqrt();
-    let outcome = filter.update(&ZeroRate::new(stats.gyro_mean, sigma), &UpdateOptions::default())?;
+    let outcome = filter.update(
+        &ZeroRate::new(stats.gyro_mean, sigma),
+        &UpdateOptions::default(),
+    )?;
     Ok(Fusion::from(outcome))
 }

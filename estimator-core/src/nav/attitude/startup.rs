@@ -42,7 +42,12 @@ pub(super) fn start<T: Real>(
         (*bias_prior, config.gyro_bias_sigma)
     };
     // The mean specific force's error per axis: the motion's and the bias's, as an angle.
-    let motion = specific_force_sigma(stats, config, acceleration_power(stats, white_sq(stats, config)), g);
+    let motion = specific_force_sigma(
+        stats,
+        config,
+        acceleration_power(stats, white_sq(stats, config)),
+        g,
+    );
     let bias = config.accelerometer_bias_sigma;
     let tilt = (motion * motion + bias * bias).sqrt() / g;
 
@@ -83,7 +88,8 @@ pub(super) fn start<T: Real>(
             let vertical = m.dot(&up_body);
             let horizontal = mat3::norm(&(m - up_body * vertical));
             let white = mag.sigma / horizontal;
-            let tan_dip = reference.z.abs() / (reference.x * reference.x + reference.y * reference.y).sqrt();
+            let tan_dip =
+                reference.z.abs() / (reference.x * reference.x + reference.y * reference.y).sqrt();
             let coupling = tan_dip * tilt;
             (white * white / T::from_count((*n).max(1))
                 + mag.heading_noise * mag.heading_noise / stats.duration

@@ -216,3 +216,96 @@ fn reset_jacobian_is_right_jacobian() {
         assert!((col - jr.column(i)).amax() < 1e-8);
     }
 }
+
+fn random_ahrs_accel_bias(rng: &mut Rng) -> AhrsAccelBiasState<f64> {
+    AhrsAccelBiasState {
+        attitude: So3::exp(&rng.vec3(1.0)),
+        gyro_bias: rng.vec3(0.01),
+        accel_bias: rng.vec3(0.1),
+    }
+}
+
+#[test]
+fn zero_rate_and_accelerometer_match_finite_differences_for_every_state() {
+    let mut rng = Rng::new(12);
+    for _ in 0..20 {
+        let z = ZeroRate::new(rng.vec3(0.01), 1e-3);
+        check("zero rate, ahrs", &z, &random_ahrs(&mut rng));
+        check("zero rate, ins", &z, &random_ins(&mut rng));
+        let x9 = random_ahrs_accel_bias(&mut rng);
+        check("zero rate, ahrs accel bias", &z, &x9);
+        let f = AccelerometerAtRest::new(rng.vec3(9.0), 0.05);
+        check("accelerometer, ahrs accel bias", &f, &x9);
+        check(
+            "gravity, ahrs accel bias",
+            &GravityDirection::new(rng.vec3(9.0), 0.05),
+            &x9,
+        );
+    }
+}
+
+/// The magnetic heading's row is the vertical part of the attitude error only: along
+/// `δθ = ε R̂ᵀu` (a rotation of the world about up) it matches the finite difference of the
+/// azimuth; across it (`δθ ⊥ R̂ᵀu`) the row is zero by construction.
+#[test]
+fn magnetic_heading_row_is_the_azimuth_derivative_about_up() {
+    let mut rng = Rng::new(13);
+    let up = Vector3::z();
+    for _ in 0..20 {
+        let x = random_ahrs(&mut rng);
+        let model = MagneticHeading::new(rng.vec3(30.0), Vector3::new(0.0, 20.0, -40.0), 0.05);
+        let row = Measurement::<f64, AhrsState<f64>, 6, 1>::linearize(&model, &x)
+            .expect("linearize")
+            .jacobian;
+        let axis = x.attitude.inverse().act(&up);
+        let r = |e: f64| {
+            let mut dx = SVector::<f64, 6>::zeros();
+            dx.fixed_rows_mut::<3>(0).copy_from(&(axis * e));
+            Measurement::<f64, AhrsState<f64>, 6, 1>::linearize(&model, &x.oplus(&dx))
+                .expect("linearize")
+                .residual[0]
+        };
+        let d = |h: f64| (r(h) - r(-h)) / (2.0 * h);
+        let numeric = -(4.0 * d(EPS / 2.0) - d(EPS)) / 3.0;
+        let analytic = row.fixed_columns::<3>(0).dot(&axis.transpose());
+        assert!((analytic - numeric).abs() < 1e-7, "{analytic} vs {numeric}");
+        // Across the vertical: zero.
+        let across = axis.cross(&rng.vec3(1.0)).normalize();
+        assert!(row.fixed_columns::<3>(0).dot(&across.transpose()).abs() < 1e-12);
+        assert!(row.fixed_columns::<3>(3).amax() == 0.0);
+    }
+}
+
+#[test]
+fn ahrs_accel_bias_predict_matches_dense_f_p_ft() {
+    let mut rng = Rng::new(14);
+    for _ in 0..10 {
+        let x = random_ahrs_accel_bias(&mut rng);
+        let p = random_spd::<9>(&mut rng);
+        let w = rng.vec3(1.0);
+        let dt = 0.01;
+        let prop = |s: AhrsAccelBiasState<f64>| {
+            let mut f = AhrsAccelBias::new(s, p, zero_noise()).expect("filter");
+            f.predict(&gyro_only(w, dt)).expect("predict");
+            *f.state()
+        };
+        let base = prop(x);
+        let g = |dx: &SVector<f64, 9>| {
+            let s = prop(x.oplus(dx));
+            let mut e = SVector::<f64, 9>::zeros();
+            e.fixed_rows_mut::<3>(0)
+                .copy_from(&s.attitude.rminus(&base.attitude));
+            e.fixed_rows_mut::<3>(3)
+                .copy_from(&(s.gyro_bias - base.gyro_bias));
+            e.fixed_rows_mut::<3>(6)
+                .copy_from(&(s.accel_bias - base.accel_bias));
+            e
+        };
+        let f = fd_jacobian(g, EPS);
+        let mut filter = AhrsAccelBias::new(x, p, zero_noise()).expect("filter");
+        filter.predict(&gyro_only(w, dt)).expect("predict");
+        let dense = f * p * f.transpose();
+        let err = (filter.covariance() - dense).amax();
+        assert!(err < 1e-8 * dense.amax(), "F P Fᵀ mismatch {err:e}");
+    }
+}

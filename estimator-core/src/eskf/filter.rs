@@ -141,6 +141,7 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
     /// [`EskfError::NonFinite`] for a negative or non-finite sigma, [`EskfError::ZeroNorm`] for
     /// a zero gravity, [`EskfError::NumericalFailure`] when `P` would overflow; `P` is then
     /// unchanged.
+    #[allow(clippy::question_mark)] // a matched, not propagated, matrix result (see `align`)
     pub fn widen_attitude(&mut self, tilt: T, yaw: T) -> Result<(), EskfError> {
         if !(non_negative_finite(tilt) && non_negative_finite(yaw)) {
             return Err(EskfError::NonFinite);

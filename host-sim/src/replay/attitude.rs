@@ -35,6 +35,7 @@ pub(super) fn navigator_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> Att
     c.startup_s = T::lit(cfg.align_window_s);
     c.block_s = T::lit(cfg.block_s);
     c.acceleration_correlation_s = T::lit(cfg.acceleration_correlation_s);
+    c.motion_memory_s = T::lit(cfg.motion_memory_s);
     c.accelerometer_bias_sigma = T::lit(cfg.accelerometer_bias_sigma);
     c.gyro_bias_sigma = T::lit(cfg.gyro_bias_sigma_dps.to_radians());
     c.gyro_scale_sigma = T::lit(cfg.gyro_scale_sigma);

@@ -56,6 +56,8 @@ pub struct ReplayConfig {
     pub block_s: f64,
     /// Attitude navigator: correlation time of the body's linear acceleration, s.
     pub acceleration_correlation_s: f64,
+    /// Attitude navigator: memory of the slow-acceleration estimate, s.
+    pub motion_memory_s: f64,
     /// Attitude navigator: 1σ of the accelerometer bias per axis, m/s² (the tilt floor is
     /// this over g; 0 where the accelerometer has no bias).
     pub accelerometer_bias_sigma: f64,
@@ -94,6 +96,7 @@ impl ReplayConfig {
                 "acceleration_correlation_s",
                 self.acceleration_correlation_s,
             ),
+            ("motion_memory_s", self.motion_memory_s),
         ];
         for (name, x) in positive {
             if !(x.is_finite() && x > 0.0) {
@@ -135,7 +138,8 @@ impl Default for ReplayConfig {
             gravity: [0.0, 0.0, -9.81],
             max_dt: 0.1,
             block_s: 0.5,
-            acceleration_correlation_s: 0.3,
+            acceleration_correlation_s: 0.15,
+            motion_memory_s: 5.0,
             accelerometer_bias_sigma: 0.1,
             gyro_bias_sigma_dps: 0.5,
             gyro_scale_sigma: 0.005,
@@ -261,6 +265,7 @@ pub fn replay_scored(
     title: &str,
     scorer: Scorer,
 ) -> Result<Scorer, ReplayError> {
+    let scorer = scorer.for_dataset(dataset_dir)?;
     match cfg.precision.as_str() {
         "f32" => replay_in::<f32>(dataset_dir, out, cfg, title, scorer),
         "f64" => replay_in::<f64>(dataset_dir, out, cfg, title, scorer),

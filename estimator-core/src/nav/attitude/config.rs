@@ -95,6 +95,9 @@ pub struct AttitudeConfig<T: Real> {
     /// Correlation time of the body's linear acceleration, s: the mean of a block of length
     /// `T` keeps `min(1, 2τ/T)` of its variance.
     pub acceleration_correlation_s: T,
+    /// Memory of the slow-acceleration estimate, s (the running mean of the blocks' vertical
+    /// mean acceleration, taken for the horizontal one).
+    pub motion_memory_s: T,
     /// 1σ of the accelerometer bias per axis at switch-on, m/s² (the bias is estimated; its
     /// random walk is the filter configuration's).
     pub accelerometer_bias_sigma: T,
@@ -126,7 +129,8 @@ pub struct AttitudeConfig<T: Real> {
 
 impl<T: Real> AttitudeConfig<T> {
     /// The defaults around a filter configuration: trapezoidal IMU integration; 1 s start-up;
-    /// 0.5 s blocks; 0.3 s acceleration correlation; 0.1 m/s² accelerometer bias (0.6° of
+    /// 0.5 s blocks; 0.15 s acceleration correlation; 5 s memory of slow
+    /// accelerations; 0.1 m/s² accelerometer bias (0.6° of
     /// tilt); 0.5 % gyro scale and cross-axis error; 0.5 °/s gyro bias at switch-on; rest below 2 °/s and 0.5 m/s² for 1.5 s with a
     /// 0.1 °/s floor; widen after 8 rejected blocks (2 s); valid below 5° tilt and 10° heading;
     /// no magnetometer.
@@ -137,7 +141,8 @@ impl<T: Real> AttitudeConfig<T> {
             instantaneous_imu: true,
             startup_s: T::lit(1.0),
             block_s: T::lit(0.5),
-            acceleration_correlation_s: T::lit(0.3),
+            acceleration_correlation_s: T::lit(0.15),
+            motion_memory_s: T::lit(5.0),
             accelerometer_bias_sigma: T::lit(0.1),
             gyro_scale_sigma: T::lit(0.005),
             gyro_bias_sigma: T::lit(0.5_f64.to_radians()),
@@ -166,6 +171,7 @@ impl<T: Real> AttitudeConfig<T> {
             && positive_finite(self.block_s)
             && self.block_s < four_seconds
             && positive_finite(self.acceleration_correlation_s)
+            && positive_finite(self.motion_memory_s)
             && non_negative_finite(self.accelerometer_bias_sigma)
             && non_negative_finite(self.gyro_scale_sigma)
             && non_negative_finite(self.gyro_bias_sigma)

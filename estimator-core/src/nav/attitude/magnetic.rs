@@ -35,7 +35,7 @@
 use super::block::MagStats;
 use super::config::{AttitudeConfig, MagneticConfig};
 use super::report::{Event, Fusion, MagneticStatus};
-use super::tilt::world_attitude_covariance;
+use super::tilt::{recovery_options, world_attitude_covariance};
 use crate::eskf::{AhrsAccelBias, MagneticHeading, UpdateOptions};
 use crate::kernels::mat3;
 use crate::lie::LieGroup;
@@ -48,6 +48,10 @@ fn norm_dip<T: Real>(c: &Vector3<T>) -> (T, T, T) {
     let h = (c.x * c.x + c.y * c.y).sqrt();
     (mat3::norm(c), h, c.z.arctan2(h))
 }
+
+/// What one block of the magnetometer did: its status, the heading update (if one was made)
+/// and the event (if any).
+pub(super) type Outcome<T> = (MagneticStatus, Option<Fusion<T>>, Option<Event>);
 
 /// The magnetometer's state.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -136,7 +140,7 @@ impl<T: Real> Magnetic<T> {
         rotation: T,
         config: &AttitudeConfig<T>,
         mag: &MagneticConfig<T>,
-    ) -> Result<(MagneticStatus, Option<Fusion<T>>, Option<Event>), NavError> {
+    ) -> Result<Outcome<T>, NavError> {
         let (m_body, n) = (&stats.body, stats.n);
         let c = filter.state().attitude.act(m_body);
         let Some(reference) = self.reference else {
@@ -178,7 +182,7 @@ impl<T: Real> Magnetic<T> {
                 && (run.turned >= T::frac_pi_2() || lasted >= mag.new_field_s);
             if wrong_estimate {
                 filter.widen_attitude(T::zero(), innovation.abs())?;
-                fusion = Fusion::from(filter.update(&model, &options)?);
+                fusion = Fusion::from(filter.update(&model, &recovery_options())?);
                 self.rejected = Rejections::none();
                 event = Some(Event::HeadingWidened);
             }

@@ -109,6 +109,9 @@ pub struct AttitudeNavigator<T: Real> {
     bias_prior: Vector3<T>,
     /// The linear-acceleration power of the previous block, (m/s²)² per axis.
     last_power: T,
+    /// The running mean of the squared vertical block-mean acceleration, (m/s²)²: the
+    /// variance per axis of slow accelerations that a block's scatter does not show.
+    slow_power: T,
     /// Still blocks in a row, s.
     still_s: T,
     tilt_rejected: u16,
@@ -141,6 +144,7 @@ impl<T: Real> AttitudeNavigator<T> {
             last_imu: None,
             bias_prior: Vector3::zeros(),
             last_power: T::zero(),
+            slow_power: T::zero(),
             still_s: T::zero(),
             tilt_rejected: 0,
             report: AttitudeReport {
@@ -406,7 +410,9 @@ impl<T: Real> AttitudeNavigator<T> {
             self.last_power
         };
         self.last_power = power;
-        let sigma = tilt::specific_force_sigma(&stats, &self.config, used_power, g);
+        let sigma =
+            tilt::specific_force_sigma(&stats, &self.config, used_power, self.slow_power, g);
+        self.slow_power = tilt::update_slow_power(self.slow_power, &stats, &self.config, g);
         let (fusion, event) =
             tilt::fuse(filter, &stats, sigma, &self.config, &mut self.tilt_rejected)?;
         self.report.fused.gravity = Some(fusion);

@@ -46,6 +46,7 @@ pub(super) fn start<T: Real>(
         stats,
         config,
         acceleration_power(stats, white_sq(stats, config)),
+        T::zero(),
         g,
     );
     let bias = config.accelerometer_bias_sigma;

@@ -6,7 +6,7 @@
 //! whose noise is the mean linear acceleration plus the white noise, per axis
 //!
 //! ```text
-//! σ² = σ_s²/n  +  q·min(1, 2τ/T)  +  (‖f̄‖ − ‖g‖)²            (m/s²)²
+//! σ² = σ_s²/n  +  max(q·min(1, 2τ/T), q_slow)  +  (‖f̄‖ − ‖g‖)²            (m/s²)²
 //! ```
 //!
 //! * `σ_s² = N_a²/Δt`: the white noise of one sample (density `N_a`, interval `Δt`), `n`
@@ -19,7 +19,11 @@
 //!   for an acceleration correlated over `τ` (a first-order Gauss–Markov process keeps
 //!   `2τ/T` of its variance in a mean over `T ≫ τ`);
 //! * `(‖f̄‖ − ‖g‖)²`: the vertical part of `ā`, which the norm shows directly, taken for the
-//!   size of the horizontal part the norm cannot show.
+//!   size of the horizontal part the norm cannot show;
+//! * `q_slow`: the running mean of that vertical part's square over the last
+//!   `motion_memory_s`: accelerations slower than a block (a body that speeds up for a second)
+//!   leave no scatter inside a block, but they show in the vertical means of the blocks
+//!   before, and a hand-held or worn body accelerates about as much across as along gravity.
 //!
 //! No threshold throws a block away: a block taken during strong motion simply weighs little.
 //! Because the bias is a state, blocks in different orientations separate it from the tilt
@@ -31,7 +35,7 @@
 use super::block::BlockStats;
 use super::config::AttitudeConfig;
 use super::report::{Event, Fusion};
-use crate::eskf::{AccelerometerAtRest, AhrsAccelBias, ErrorState, Filter, UpdateOptions};
+use crate::eskf::{AccelerometerAtRest, AhrsAccelBias, ErrorState, Filter, Gate, UpdateOptions};
 use crate::kernels::mat3;
 use crate::lie::LieGroup;
 use crate::nav::error::NavError;
@@ -61,11 +65,13 @@ pub(super) fn white_sq<T: Real>(stats: &BlockStats<T>, config: &AttitudeConfig<T
 }
 
 /// The 1σ per axis of the block's mean specific force, m/s² (module docs), with `power` the
-/// per-axis linear-acceleration variance to use.
+/// per-axis linear-acceleration variance inside the block and `slow` that of slow
+/// accelerations.
 pub(super) fn specific_force_sigma<T: Real>(
     stats: &BlockStats<T>,
     config: &AttitudeConfig<T>,
     power: T,
+    slow: T,
     g: T,
 ) -> T {
     let white = white_sq(stats, config) / T::from_count(stats.n.max(1));
@@ -76,7 +82,23 @@ pub(super) fn specific_force_sigma<T: Real>(
         T::one()
     };
     let vertical = stats.accel_norm - g;
-    (white + power * keep + vertical * vertical).sqrt()
+    let inside = power * keep;
+    let motion = if inside > slow { inside } else { slow };
+    (white + motion + vertical * vertical).sqrt()
+}
+
+/// The running mean of `(‖f̄‖ − ‖g‖)²` over the last `motion_memory_s` (first order, weight
+/// `min(1, T/τ_m)` per block).
+pub(super) fn update_slow_power<T: Real>(
+    slow: T,
+    stats: &BlockStats<T>,
+    config: &AttitudeConfig<T>,
+    g: T,
+) -> T {
+    let vertical = stats.accel_norm - g;
+    let w = stats.duration / config.motion_memory_s;
+    let w = if w < T::one() { w } else { T::one() };
+    slow + (vertical * vertical - slow) * w
 }
 
 /// The world-frame attitude covariance `R P_θθ Rᵀ` of a filter.
@@ -118,12 +140,19 @@ pub(super) fn fuse<T: Real>(
             let f = stats.accel_body - filter.state().accel_bias;
             let angle = mat3::norm(&(f / mat3::norm(&f) - predicted));
             filter.widen_attitude(angle, T::zero())?;
-            fusion = Fusion::from(filter.update(&model, &options)?);
+            fusion = Fusion::from(filter.update(&model, &recovery_options())?);
             *rejected = 0;
             event = Some(Event::TiltWidened);
         }
     }
     Ok((fusion, event))
+}
+
+/// The update after a widening: ungated (the data were just found right and the estimate
+/// wrong) and iterated (the error may be far beyond the linear range: a vector turned by `θ`
+/// also changes along itself by `1 − cos θ`, which one linearization leaves in the residual).
+pub(super) fn recovery_options<T: Real>() -> UpdateOptions<T> {
+    UpdateOptions::iterated(Gate::Off, 5, T::lit(1e-6))
 }
 
 /// `true` when `v` has a usable direction.

@@ -35,6 +35,11 @@ impl Clock {
         }
     }
 
+    /// The last accepted timestamp.
+    pub(crate) fn last(&self) -> Option<u64> {
+        self.last
+    }
+
     /// Accepts `t_ns`.
     pub(crate) fn set(&mut self, t_ns: u64) {
         self.last = Some(t_ns);

@@ -21,7 +21,7 @@ mod mean;
 
 pub use attitude::{
     AttitudeConfig, AttitudeEstimate, AttitudeNavigator, AttitudeReport, Counters, Event, Fusion,
-    Fusions, MagneticConfig, MagneticStatus, Reason, Validity,
+    Fusions, MagneticConfig, MagneticFusion, MagneticStatus, Reason, Validity,
 };
 pub use error::NavError;
 pub use mean::VectorMean;

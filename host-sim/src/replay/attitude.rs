@@ -9,7 +9,8 @@ use crate::dataset::read::{Dataset, Event, TruthStream};
 use crate::metrics::{Estimate, Outcome, Scorer};
 use estimator_core::eskf::{FilterConfig, ImuNoise};
 use estimator_core::nav::{
-    AttitudeConfig, AttitudeNavigator, AttitudeReport, Fusion, MagneticConfig, NavError,
+    AttitudeConfig, AttitudeNavigator, AttitudeReport, Fusion, MagneticConfig, MagneticFusion,
+    NavError,
 };
 use estimator_core::Real;
 use nalgebra::{Matrix3, Vector3};
@@ -36,6 +37,7 @@ pub(super) fn navigator_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> Att
     c.block_s = T::lit(cfg.block_s);
     c.acceleration_correlation_s = T::lit(cfg.acceleration_correlation_s);
     c.motion_memory_s = T::lit(cfg.motion_memory_s);
+    c.rotation_only = cfg.rotation_only;
     c.accelerometer_bias_sigma = T::lit(cfg.accelerometer_bias_sigma);
     c.gyro_bias_sigma = T::lit(cfg.gyro_bias_sigma_dps.to_radians());
     c.gyro_scale_sigma = T::lit(cfg.gyro_scale_sigma);
@@ -43,6 +45,9 @@ pub(super) fn navigator_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> Att
         let mut mc = MagneticConfig::new(T::lit(m.sigma), Some(lit3(&m.reference_field)));
         mc.heading_noise = T::lit(cfg.heading_noise_deg.to_radians());
         mc.heading_floor = T::lit(cfg.heading_floor_deg.to_radians());
+        if cfg.magnetometer_vector {
+            mc.fusion = MagneticFusion::Vector;
+        }
         mc
     });
     c
@@ -83,6 +88,7 @@ fn score_fusion<T: Real>(
 }
 
 fn score_report<T: Real>(
+    mag_dof: usize,
     scorer: &mut Scorer,
     r: &Result<AttitudeReport<T>, NavError>,
     sensor: &str,
@@ -90,8 +96,8 @@ fn score_report<T: Real>(
 ) {
     match r {
         Ok(r) => {
-            score_fusion(scorer, "gravity", t_ns, r.fused.gravity, 2);
-            score_fusion(scorer, "mag", t_ns, r.fused.heading, 1);
+            score_fusion(scorer, "gravity", t_ns, r.fused.gravity, 3);
+            score_fusion(scorer, "mag", t_ns, r.fused.heading, mag_dof);
             score_fusion(scorer, "zero_rate", t_ns, r.fused.zero_rate, 3);
         }
         Err(_) => scorer.measurement(sensor, t_ns, Outcome::Refused),
@@ -137,6 +143,8 @@ pub(super) fn replay_attitude<T: Real>(
         None
     };
     let mut baselines: Option<(Madgwick, Mahony)> = None;
+    // The heading is one number; the whole field three.
+    let mag_dof = if cfg.magnetometer_vector { 3 } else { 1 };
     let mut last_imu: Option<u64> = None;
     for ev in ds.events()? {
         let started = Instant::now();
@@ -147,7 +155,7 @@ pub(super) fn replay_attitude<T: Real>(
                 });
                 last_imu = Some(t_ns);
                 let r = nav.imu(t_ns, &lit3(&gyro), &lit3(&accel));
-                score_report(&mut scorer, &r, "imu", t_ns);
+                score_report(mag_dof, &mut scorer, &r, "imu", t_ns);
                 scorer.filter_ns += started.elapsed().as_nanos();
                 scorer.imu_samples += 1;
                 let Some(e) = estimate(&nav, t_ns) else {
@@ -185,7 +193,7 @@ pub(super) fn replay_attitude<T: Real>(
                     mh.mag(&field);
                 }
                 let r = nav.magnetometer(t_ns, &lit3(&field));
-                score_report(&mut scorer, &r, "mag", t_ns);
+                score_report(mag_dof, &mut scorer, &r, "mag", t_ns);
                 scorer.filter_ns += started.elapsed().as_nanos();
             }
             // Without GNSS and camera, the other sensors have nothing to aid.

@@ -56,6 +56,11 @@ pub struct ReplayConfig {
     pub block_s: f64,
     /// Attitude navigator: correlation time of the body's linear acceleration, s.
     pub acceleration_correlation_s: f64,
+    /// Attitude navigator: fuse the magnetometer's whole field (`true`: a calibrated
+    /// magnetometer in a clean field; it then also measures the tilt) rather than its heading.
+    pub magnetometer_vector: bool,
+    /// Attitude navigator: the body only rotates in place (no linear acceleration).
+    pub rotation_only: bool,
     /// Attitude navigator: memory of the slow-acceleration estimate, s.
     pub motion_memory_s: f64,
     /// Attitude navigator: 1σ of the accelerometer bias per axis, m/s² (the tilt floor is
@@ -103,8 +108,13 @@ impl ReplayConfig {
                 return Err(format!("{name} = {x}: must be a positive number"));
             }
         }
+        if !(self.accelerometer_bias_sigma.is_finite() && self.accelerometer_bias_sigma > 0.0) {
+            return Err(format!(
+                "accelerometer_bias_sigma = {}: must be a positive number (the bias is a state)",
+                self.accelerometer_bias_sigma
+            ));
+        }
         for (name, x) in [
-            ("accelerometer_bias_sigma", self.accelerometer_bias_sigma),
             ("gyro_bias_sigma_dps", self.gyro_bias_sigma_dps),
             ("gyro_scale_sigma", self.gyro_scale_sigma),
             ("heading_noise_deg", self.heading_noise_deg),
@@ -140,6 +150,8 @@ impl Default for ReplayConfig {
             block_s: 0.5,
             acceleration_correlation_s: 0.15,
             motion_memory_s: 5.0,
+            rotation_only: false,
+            magnetometer_vector: false,
             accelerometer_bias_sigma: 0.1,
             gyro_bias_sigma_dps: 0.5,
             gyro_scale_sigma: 0.005,

@@ -77,8 +77,9 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Measurement<T, S, N, 3> for G
 }
 
 /// The accelerometer of a body at rest (or its mean over a while, with the mean linear
-/// acceleration in the noise), for the filters with an accelerometer bias: `h(x) = Rᵀ(−g) + b_a`,
-/// `H = [[Rᵀ(−g)]×, 0, …, I]` (the identity on the `b_a` columns). Unlike [`GravityDirection`] it models the accelerometer bias,
+/// acceleration in the noise), for the filters with an accelerometer bias:
+/// `h(x) = Rᵀ(−g) + M b_a`, `H = [[Rᵀ(−g)]×, 0, …, M]` (`M` on the `b_a` columns; `M = I` for
+/// one sample). Unlike [`GravityDirection`] it models the accelerometer bias,
 /// so repeated updates at rest stay consistent (tilt and horizontal bias are separated only as
 /// far as the data allow).
 ///
@@ -103,16 +104,21 @@ pub struct AccelerometerAtRest<T: Real> {
     pub gravity: Vector3<T>,
     /// `R`, (m/s²)².
     pub noise: Matrix3<T>,
+    /// `M` in `h(x) = Rᵀ(−g) + M b_a`: the identity for one sample; for a mean over samples
+    /// taken while the body turned, the mean rotation from each sample's body to the last,
+    /// `M = mean(R_eᵀ R_i)` (the bias turns with the body).
+    pub bias_map: Matrix3<T>,
 }
 
 impl<T: Real> AccelerometerAtRest<T> {
-    /// ENU gravity `[0, 0, −9.81]`, isotropic noise `σ² I`.
+    /// ENU gravity `[0, 0, −9.81]`, isotropic noise `σ² I`, `M = I`.
     #[must_use]
     pub fn new(accel: Vector3<T>, sigma: T) -> Self {
         Self {
             accel,
             gravity: Vector3::new(T::zero(), T::zero(), T::lit(-9.81)),
             noise: isotropic(sigma),
+            bias_map: Matrix3::identity(),
         }
     }
 }
@@ -125,15 +131,22 @@ impl<T: Real> AccelerometerAtRest<T> {
         accel_bias: &Vector3<T>,
         column: usize,
     ) -> Result<Linearization<T, N, 3>, EskfError> {
-        if !(all_finite(self.accel.as_slice()) && all_finite(self.gravity.as_slice())) {
+        let finite = all_finite(self.accel.as_slice())
+            && all_finite(self.gravity.as_slice())
+            && all_finite(self.bias_map.as_slice());
+        if !finite {
             return Err(EskfError::NonFinite);
         }
         if self.accel.norm_squared() <= T::zero() {
             return Err(EskfError::ZeroNorm);
         }
         let (predicted, d_attitude) = in_body(attitude, &-self.gravity);
-        let residual = self.accel - (predicted + accel_bias);
-        Ok(three_rows(residual, &[(0, &d_attitude)], &[column]))
+        let residual = self.accel - (predicted + mat3::mul_vec(&self.bias_map, accel_bias));
+        Ok(three_rows(
+            residual,
+            &[(0, &d_attitude), (column, &self.bias_map)],
+            &[],
+        ))
     }
 }
 

@@ -9,13 +9,15 @@
 use crate::lie::LieGroup;
 use crate::nav::mean::VectorMean;
 use crate::Real;
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 /// The sums of one block.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Block<T: Real> {
     /// `R̂ᵢ fᵢ`: specific force in the estimate's world frame.
     pub(super) accel: VectorMean<T>,
+    /// `Σ R̂ᵢ`: the bias turns with the body, so the block mean sees `R̂ₑᵀ mean(R̂ᵢ) b_a`.
+    pub(super) frames: Matrix3<T>,
     /// Raw gyro `ωᵢ`, body frame.
     pub(super) gyro: VectorMean<T>,
     /// `R̂ᵢ mᵢ`: field in the estimate's world frame.
@@ -33,6 +35,9 @@ pub(super) struct BlockStats<T: Real> {
     pub(super) duration: T,
     /// Mean specific force, body frame at the end.
     pub(super) accel_body: Vector3<T>,
+    /// `M = R̂ₑᵀ mean(R̂ᵢ)`: the mean accelerometer bias over the block, seen at its end, is
+    /// `M b_a`.
+    pub(super) bias_map: Matrix3<T>,
     /// Its norm.
     pub(super) accel_norm: T,
     /// Total variance of the world-frame specific force about its mean, (m/s²)².
@@ -69,6 +74,7 @@ impl<T: Real> Default for Block<T> {
     fn default() -> Self {
         Self {
             accel: VectorMean::default(),
+            frames: Matrix3::zeros(),
             gyro: VectorMean::default(),
             mag: VectorMean::default(),
             elapsed_ns: 0,
@@ -85,6 +91,10 @@ impl<T: Real> Block<T> {
         };
         let to_body = end.inverse();
         let accel_body = to_body.act(&a);
+        let bias_map = crate::kernels::mat3::mul(
+            &to_body.rotation_matrix(),
+            &(self.frames / T::from_count(self.accel.count().max(1))),
+        );
         let mag = self.mag.mean().map(|m| MagStats {
             body: to_body.act(&m),
             n: self.mag.count(),
@@ -95,6 +105,7 @@ impl<T: Real> Block<T> {
             duration: T::from_count(self.elapsed_ns) * T::lit(1e-9),
             accel_norm: crate::kernels::mat3::norm(&accel_body),
             accel_body,
+            bias_map,
             accel_scatter_sq: self.accel.scatter_sq(),
             gyro_mean: w,
             gyro_scatter_sq: self.gyro.scatter_sq(),

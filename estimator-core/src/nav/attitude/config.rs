@@ -6,6 +6,17 @@ use crate::nav::error::NavError;
 use crate::Real;
 use nalgebra::Vector3;
 
+/// What the magnetometer corrects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MagneticFusion {
+    /// The heading only ([`MagneticHeading`](crate::eskf::MagneticHeading)): a wrong field can
+    /// move the heading but never the tilt. For real magnetometers near iron.
+    Heading,
+    /// The whole field ([`Magnetometer`](crate::eskf::Magnetometer)): it also measures the
+    /// tilt. Only for a calibrated magnetometer in a clean, known field.
+    Vector,
+}
+
 /// The magnetometer, when there is one.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MagneticConfig<T: Real> {
@@ -15,6 +26,8 @@ pub struct MagneticConfig<T: Real> {
     pub reference: Option<Vector3<T>>,
     /// White noise of one sample, per axis (the magnetometer's unit).
     pub sigma: T,
+    /// What it corrects ([`MagneticFusion::Heading`] by default).
+    pub fusion: MagneticFusion,
     /// Heading noise beyond the white noise, as a density, rad·√s (a block of length `T` gets
     /// `σ² = N²/T`): what a magnetometer reads wrong for a while without the norm or the dip
     /// showing it (iron nearby, residual calibration, the tilt error seen through the dip). It
@@ -36,13 +49,14 @@ pub struct MagneticConfig<T: Real> {
 
 impl<T: Real> MagneticConfig<T> {
     /// A magnetometer with white noise `sigma` per axis and an optional reference; the other
-    /// values are the defaults listed on each field's use: 8°·√s heading noise, 1°
+    /// values are the defaults listed on each field's use: heading-only fusion, 8°·√s heading noise, 1°
     /// heading floor, 10 % norm and 10° dip tolerance, 20 s turning at 20 °/s or more for a new field.
     #[must_use]
     pub fn new(sigma: T, reference: Option<Vector3<T>>) -> Self {
         Self {
             reference,
             sigma,
+            fusion: MagneticFusion::Heading,
             heading_noise: T::lit(8.0_f64.to_radians()),
             heading_floor: T::lit(1.0_f64.to_radians()),
             norm_tolerance: T::lit(0.1),
@@ -92,14 +106,17 @@ pub struct AttitudeConfig<T: Real> {
     /// Length of one aiding block, s: the accelerometer and magnetometer are averaged over a
     /// block (in a frame carried along by the gyro) and fused once at its end.
     pub block_s: T,
+    /// The body only rotates in place (a gimbal, a turntable): the accelerometer sees gravity,
+    /// its bias and white noise, and the motion terms of the accelerometer noise are left out.
+    pub rotation_only: bool,
     /// Correlation time of the body's linear acceleration, s: the mean of a block of length
     /// `T` keeps `min(1, 2τ/T)` of its variance.
     pub acceleration_correlation_s: T,
     /// Memory of the slow-acceleration estimate, s (the running mean of the blocks' vertical
     /// mean acceleration, taken for the horizontal one).
     pub motion_memory_s: T,
-    /// 1σ of the accelerometer bias per axis at switch-on, m/s² (the bias is estimated; its
-    /// random walk is the filter configuration's).
+    /// 1σ of the accelerometer bias per axis at switch-on, m/s², `> 0` (the bias is a state
+    /// with this prior; its random walk is the filter configuration's).
     pub accelerometer_bias_sigma: T,
     /// 1σ of the gyro's scale-factor and cross-axis errors (a fraction): a block that turns
     /// by `θ` adds `(σ_s θ)²` to the attitude variance on every axis. The noise densities of a
@@ -141,6 +158,7 @@ impl<T: Real> AttitudeConfig<T> {
             instantaneous_imu: true,
             startup_s: T::lit(1.0),
             block_s: T::lit(0.5),
+            rotation_only: false,
             acceleration_correlation_s: T::lit(0.15),
             motion_memory_s: T::lit(5.0),
             accelerometer_bias_sigma: T::lit(0.1),
@@ -158,7 +176,7 @@ impl<T: Real> AttitudeConfig<T> {
     }
 
     /// `Ok` when every value is in its domain: the filter configuration valid, every time and
-    /// sigma positive (the bias sigmas may be 0), `max_rejected_blocks ≥ 1`, and the block and
+    /// sigma positive (the gyro bias, scale and heading sigmas may be 0), `max_rejected_blocks ≥ 1`, and the block and
     /// start-up shorter than 4 s (their length in nanoseconds fits 32 bits).
     ///
     /// # Errors
@@ -172,7 +190,7 @@ impl<T: Real> AttitudeConfig<T> {
             && self.block_s < four_seconds
             && positive_finite(self.acceleration_correlation_s)
             && positive_finite(self.motion_memory_s)
-            && non_negative_finite(self.accelerometer_bias_sigma)
+            && positive_finite(self.accelerometer_bias_sigma)
             && non_negative_finite(self.gyro_scale_sigma)
             && non_negative_finite(self.gyro_bias_sigma)
             && positive_finite(self.rest_gyro)

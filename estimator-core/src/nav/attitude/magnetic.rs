@@ -15,7 +15,11 @@
 //! ```
 //!
 //! (`σ_m` the white noise of one sample, `n` samples, `N_hd` the heading noise density of the
-//! configuration, `T` the block's length), gated at 99.9 %, and with the heading floor `σ_ψ ≥ heading_floor`
+//! configuration, `T` the block's length). The azimuth is computed with the estimated tilt, so
+//! a tilt error `δ` shows in it as about `tan(dip)·δ`; `N_hd` covers it (the row leaves the
+//! tilt alone, so the coupling is not in `H`: this is the price of never letting the
+//! magnetometer move the tilt, and why a calibrated magnetometer in a clean field is better
+//! fused whole), gated at 99.9 %, and with the heading floor `σ_ψ ≥ heading_floor`
 //! applied afterwards. After `max_rejected_blocks` rejections in a row whose innovations agree
 //! within `4N_hd/√T` while the body turned by 90° or more (or for `new_field_s` without turning,
 //! with norm and dip agreeing all along), the estimate is taken for wrong (a disturbance would
@@ -26,6 +30,10 @@
 //! scatter beyond the white noise, `s_m² − 3σ_m² > (ε_n ‖m_w‖)²` (a magnet carried by the body
 //! turns with it).
 //!
+//! With [`MagneticFusion::Vector`] the undisturbed block is fused as the whole field instead
+//! ([`Magnetometer`], per axis `σ² = σ_m²/n + ‖c_h‖² N_hd²/T`), which also corrects the tilt:
+//! for a calibrated magnetometer in a clean field.
+//!
 //! **A new field.** A disturbed but steady field that stays the same (norm and dip within the
 //! tolerances of the first disturbed block) for `new_field_s`, while the body turned at a mean
 //! rate of at least `new_field_min_rate`, is taken as the new reference: its norm and dip, with
@@ -33,10 +41,10 @@
 //! defines it: `m_w = [0, ‖c_h‖, c_up]`, north is where the field points.
 
 use super::block::MagStats;
-use super::config::{AttitudeConfig, MagneticConfig};
+use super::config::{AttitudeConfig, MagneticConfig, MagneticFusion};
 use super::report::{Event, Fusion, MagneticStatus};
 use super::tilt::{recovery_options, world_attitude_covariance};
-use crate::eskf::{AhrsAccelBias, MagneticHeading, UpdateOptions};
+use crate::eskf::{AhrsAccelBias, MagneticHeading, Magnetometer, UpdateOptions};
 use crate::kernels::mat3;
 use crate::lie::LieGroup;
 use crate::nav::error::NavError;
@@ -166,7 +174,15 @@ impl<T: Real> Magnetic<T> {
         let model = MagneticHeading::new(*m_body, reference, var.sqrt());
         let options = UpdateOptions::default();
         let mut event = None;
-        let mut fusion = Fusion::from(filter.update(&model, &options)?);
+        let mut fusion = match mag.fusion {
+            MagneticFusion::Heading => Fusion::from(filter.update(&model, &options)?),
+            MagneticFusion::Vector => {
+                let sigma_sq = mag.sigma * mag.sigma / T::from_count(n.max(1))
+                    + horizontal * horizontal * mag.heading_noise * mag.heading_noise / duration;
+                let vector = Magnetometer::new(*m_body, reference, sigma_sq.sqrt());
+                Fusion::from(filter.update(&vector, &options)?)
+            }
+        };
         if fusion.accepted {
             self.rejected = Rejections::none();
         } else {

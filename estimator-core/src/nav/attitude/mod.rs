@@ -34,7 +34,7 @@ mod rest;
 mod startup;
 mod tilt;
 
-pub use config::{AttitudeConfig, MagneticConfig};
+pub use config::{AttitudeConfig, MagneticConfig, MagneticFusion};
 pub use report::{
     AttitudeEstimate, AttitudeReport, Counters, Event, Fusion, Fusions, MagneticStatus, Reason,
     Validity,
@@ -263,13 +263,31 @@ impl<T: Real> AttitudeNavigator<T> {
         self.report.event = None;
         self.report.fused = Fusions::default();
         if self.magnetic.is_some() {
-            let frame = match &self.phase {
-                Phase::Starting { frame } => *frame,
-                Phase::Running { filter } => filter.state().attitude,
-            };
+            let frame = self.frame_at(t_ns);
             self.block.mag.add(&frame.act(field));
         }
         Ok(self.report)
+    }
+
+    /// The frame of the estimate at `t_ns`, carried from the last IMU sample by its rate (a
+    /// magnetometer sample between two IMU samples would otherwise be rotated with the
+    /// attitude of up to one interval earlier: a lag of `ω Δt`).
+    fn frame_at(&self, t_ns: u64) -> So3<T> {
+        let (frame, bias) = match &self.phase {
+            Phase::Starting { frame } => (*frame, self.bias_prior),
+            Phase::Running { filter } => (filter.state().attitude, filter.state().gyro_bias),
+        };
+        let (Some(last), Some((gyro, _))) = (self.imu_clock.last(), self.last_imu) else {
+            return frame;
+        };
+        let ahead = t_ns.checked_sub(last).and_then(|d| u32::try_from(d).ok());
+        let behind = last.checked_sub(t_ns).and_then(|d| u32::try_from(d).ok());
+        let dt = match (ahead, behind) {
+            (Some(d), _) if d <= self.durations.max_step => T::from_count(d) * T::lit(1e-9),
+            (_, Some(d)) if d <= self.durations.max_step => -(T::from_count(d) * T::lit(1e-9)),
+            _ => return frame,
+        };
+        frame.compose(&So3::exp(&((gyro - bias) * dt)))
     }
 
     /// The IMU step on a copy (committed by the caller only on `Ok`).
@@ -319,6 +337,7 @@ impl<T: Real> AttitudeNavigator<T> {
             Phase::Running { filter } => filter.state().attitude,
         };
         self.block.accel.add(&frame.act(accel));
+        self.block.frames += frame.rotation_matrix();
         self.block.gyro.add(gyro);
         self.imu_clock.set(t_ns);
         self.last_imu = Some((*gyro, *accel));

@@ -1,8 +1,10 @@
 //! The accelerometer over a block, with a noise that follows the motion.
 //!
 //! The mean specific force of a block, seen in the body at its end (see `block`), is
-//! `f̄ = Rᵀ(ā − g) + b_a`: gravity, the block's mean linear acceleration `ā`, and the
-//! accelerometer bias. It is an [`AccelerometerAtRest`] measurement (`h(x) = Rᵀ(−g) + b_a`)
+//! `f̄ = Rᵀ(ā − g) + M b_a`: gravity, the block's mean linear acceleration `ā`, and the
+//! accelerometer bias, which turned with the body during the block (`M = R̂ₑᵀ mean(R̂ᵢ)`, the
+//! mean rotation from each sample to the end). It is an [`AccelerometerAtRest`] measurement
+//! (`h(x) = Rᵀ(−g) + M b_a`)
 //! whose noise is the mean linear acceleration plus the white noise, per axis
 //!
 //! ```text
@@ -24,6 +26,8 @@
 //!   `motion_memory_s`: accelerations slower than a block (a body that speeds up for a second)
 //!   leave no scatter inside a block, but they show in the vertical means of the blocks
 //!   before, and a hand-held or worn body accelerates about as much across as along gravity.
+//!
+//! With `rotation_only` (a body that turns in place) only the white noise remains.
 //!
 //! No threshold throws a block away: a block taken during strong motion simply weighs little.
 //! Because the bias is a state, blocks in different orientations separate it from the tilt
@@ -75,6 +79,9 @@ pub(super) fn specific_force_sigma<T: Real>(
     g: T,
 ) -> T {
     let white = white_sq(stats, config) / T::from_count(stats.n.max(1));
+    if config.rotation_only {
+        return white.sqrt();
+    }
     let two_tau = T::lit(2.0) * config.acceleration_correlation_s;
     let keep = if stats.duration > two_tau {
         two_tau / stats.duration
@@ -121,8 +128,10 @@ pub(super) fn fuse<T: Real>(
     config: &AttitudeConfig<T>,
     rejected: &mut u16,
 ) -> Result<(Fusion<T>, Option<Event>), NavError> {
+    // The bias turned with the body during the block: the block sees `M b_a`.
     let model = AccelerometerAtRest {
         gravity: config.filter.gravity,
+        bias_map: stats.bias_map,
         ..AccelerometerAtRest::new(stats.accel_body, sigma)
     };
     let options = UpdateOptions::default();

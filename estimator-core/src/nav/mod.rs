@@ -13,6 +13,32 @@
 //! sensor; the world frame is ENU (`z` up), gravity `[0, 0, −9.81]`; the body frame is the
 //! IMU's; the attitude `R` maps body to world. Every call that takes a sample returns a
 //! `Result`; on `Err` the navigator is unchanged bit for bit. Nothing allocates or panics.
+//!
+//! # Tuning the attitude navigator
+//!
+//! Start from the sensor's noise ([`FilterConfig`](crate::eskf::FilterConfig)): the white-noise
+//! densities and random walks of the gyro and accelerometer, from the data sheet or better from
+//! a static recording (`host-sim calibrate`, Allan deviation), and the magnetometer's per-sample
+//! `sigma`. Then, in [`AttitudeConfig`], in order of effect:
+//!
+//! | parameter | what it does | how to choose it |
+//! |---|---|---|
+//! | `magnetometer.heading_noise` (8°·√s) | how fast the heading follows the magnetometer | larger near iron and for poorly calibrated magnetometers (slower, more robust); smaller in a clean field |
+//! | `gyro_scale_sigma` (0.5 %) | attitude uncertainty added per radian turned | the gyro's sensitivity and cross-axis error after calibration (data sheets: 1–3 % raw); raise it if the attitude lags after fast turns |
+//! | `block_s` (0.5 s) | length over which accelerometer and magnetometer are averaged | 0.25–1 s: longer averages out more motion but reacts later |
+//! | `acceleration_correlation_s` (0.15 s), `motion_memory_s` (5 s) | how much of the measured motion stays in a block's mean | the time scale of the body's accelerations (hand: 0.1–0.3 s; vehicle: seconds) and of changes in how much it moves |
+//! | `rotation_only` (false) | leaves out the motion terms | `true` only for a body that turns in place (gimbal, turntable) |
+//! | `accelerometer_bias_sigma` (0.1 m/s²) | prior of the accelerometer bias | the data sheet's zero-g offset after calibration |
+//! | `gyro_bias_sigma` (0.5 °/s) | prior of the gyro bias when the start is not at rest | the data sheet's zero-rate offset |
+//! | `rest_gyro`, `rest_accel`, `rest_min_s` (2 °/s, 0.5 m/s², 1.5 s) | when the body counts as at rest (zero-rate updates) | lower for a quiet sensor on a table; never above the slowest real rotation |
+//! | `magnetometer.norm_tolerance`, `dip_tolerance` (10 %, 10°) | when a field counts as disturbed | tighter for a well-calibrated magnetometer |
+//! | `magnetometer.fusion` (`Heading`) | heading only, or the whole field | `Vector` only for a calibrated magnetometer in a clean field (it then also corrects the tilt) |
+//! | `max_rejected_blocks` (8) | how many rejected blocks in a row before the estimate is taken for wrong | lower recovers faster from a wrong estimate, higher resists long disturbances |
+//! | `tilt_valid_sigma`, `heading_valid_sigma` (5°, 10°) | when the report calls a quantity valid | what the application can use |
+//!
+//! Check a tuning on recordings with truth: `host-sim replay` prints the attitude RMSE and the
+//! ANEES (3 for a consistent filter: much above, the noise values are too small; much below,
+//! too large), and `host-sim bench` runs every dataset under a folder.
 
 mod attitude;
 mod clock;

@@ -220,11 +220,15 @@ fn refused_updates_leave_filter_unchanged() {
         r(f.update(&GnssPosition::new(z, Vector3::zeros(), 1.0), &bad)),
         Err(EskfError::InvalidOption)
     );
-    let bad = UpdateOptions::ekf(Gate::Threshold(NAN));
-    assert_eq!(
-        r(f.update(&GnssPosition::new(z, Vector3::zeros(), 1.0), &bad)),
-        Err(EskfError::InvalidOption)
-    );
+    // A threshold that is NaN, zero or negative would reject everything: refused.
+    for t in [NAN, 0.0, -1.0, f64::NEG_INFINITY] {
+        let bad = UpdateOptions::ekf(Gate::Threshold(t));
+        assert_eq!(
+            r(f.update(&GnssPosition::new(z, Vector3::zeros(), 1.0), &bad)),
+            Err(EskfError::InvalidOption),
+            "threshold {t}"
+        );
+    }
     assert_eq!(f, before);
 
     // Heading singular: body x axis vertical.

@@ -45,13 +45,15 @@ impl<T: Real> UpdateOptions<T> {
     }
 
     /// `Ok` when the iteration cap is at least 1, the tolerance finite and a threshold gate
-    /// not NaN.
+    /// positive.
     pub(super) fn validate(&self) -> Result<(), EskfError> {
         if self.max_iterations == 0 || !self.step_tolerance.is_finite() {
             return Err(EskfError::InvalidOption);
         }
         if let Gate::Threshold(t) = self.gate {
-            if !(t.is_finite() || t > T::zero()) {
+            // Positive (`+∞` accepts everything); false for NaN, zero and negatives, which
+            // would silently reject every measurement.
+            if !(t > T::zero()) {
                 return Err(EskfError::InvalidOption);
             }
         }

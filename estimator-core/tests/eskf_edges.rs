@@ -504,3 +504,23 @@ fn f32_filter_fits_the_memory_budget() {
     assert!(ins <= 1200, "{ins}");
     assert!(ahrs <= 256, "{ahrs}");
 }
+
+/// A finite noise density whose variance over `max_dt` overflows is refused at construction,
+/// for both precisions, instead of leaving an infinite covariance after the first prediction.
+#[test]
+fn noise_that_overflows_the_process_noise_is_refused() {
+    let mut c32 = FilterConfig::<f32>::default();
+    c32.imu_noise.gyroscope_noise_density = 1e20;
+    assert_eq!(c32.validate(), Err(EskfError::NoiseNotPositiveDefinite));
+    let p6 = nalgebra::SMatrix::<f32, 6, 6>::identity() * 1e-2;
+    assert_eq!(
+        Ahrs::new(AhrsState::identity(), p6, c32).err(),
+        Some(EskfError::NoiseNotPositiveDefinite)
+    );
+    let mut c64 = FilterConfig::<f64>::default();
+    c64.imu_noise.accelerometer_random_walk = 1e160;
+    assert_eq!(c64.validate(), Err(EskfError::NoiseNotPositiveDefinite));
+    // The defaults, and a large but representable density, pass.
+    c64.imu_noise.accelerometer_random_walk = 1e100;
+    assert_eq!(c64.validate(), Ok(()));
+}

@@ -81,7 +81,9 @@ impl<T: Real> Default for FilterConfig<T> {
 }
 
 impl<T: Real> FilterConfig<T> {
-    /// `Ok` when every number is finite, the noise densities are `≥ 0` and `max_dt > 0`.
+    /// `Ok` when every number is finite, the noise densities are `≥ 0`, `max_dt > 0`, and the
+    /// largest process noise a prediction can add, `σ² max_dt` for each density, is finite (a
+    /// finite density can still overflow it).
     pub fn validate(&self) -> Result<(), EskfError> {
         if !(all_finite(self.gravity.as_slice()) && self.max_dt.is_finite()) {
             return Err(EskfError::NonFinite);
@@ -91,6 +93,16 @@ impl<T: Real> FilterConfig<T> {
         }
         if self.max_dt <= T::zero() {
             return Err(EskfError::InvalidOption);
+        }
+        let n = &self.imu_noise;
+        let densities = [
+            n.gyroscope_noise_density,
+            n.gyroscope_random_walk,
+            n.accelerometer_noise_density,
+            n.accelerometer_random_walk,
+        ];
+        if !densities.iter().all(|d| (*d * *d * self.max_dt).is_finite()) {
+            return Err(EskfError::NoiseNotPositiveDefinite);
         }
         Ok(())
     }

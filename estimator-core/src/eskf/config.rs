@@ -101,7 +101,10 @@ impl<T: Real> FilterConfig<T> {
             n.accelerometer_noise_density,
             n.accelerometer_random_walk,
         ];
-        if !densities.iter().all(|d| (*d * *d * self.max_dt).is_finite()) {
+        if !densities
+            .iter()
+            .all(|d| (*d * *d * self.max_dt).is_finite())
+        {
             return Err(EskfError::NoiseNotPositiveDefinite);
         }
         Ok(())

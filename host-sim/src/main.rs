@@ -254,14 +254,27 @@ fn print_summary(name: &str, seed: u64, cfg: &ReplayConfig, m: &Metrics, out: &P
             fmt(*v)
         );
     }
-    for (sensor, nis) in &m.nis_mean {
+    // Every sensor that took part, with what became of its updates (refused: bad input or a
+    // numerical failure; rejected: the gate).
+    let sensors: std::collections::BTreeSet<&String> = m
+        .updates_accepted
+        .keys()
+        .chain(m.updates_rejected.keys())
+        .chain(m.updates_refused.keys())
+        .collect();
+    for sensor in sensors {
         let a = m.updates_accepted.get(sensor).copied().unwrap_or(0);
         let r = m.updates_rejected.get(sensor).copied().unwrap_or(0);
+        let f = m.updates_refused.get(sensor).copied().unwrap_or(0);
+        let nis = m.nis_mean.get(sensor).copied().unwrap_or(f64::NAN);
         out!(
-            "  {:<28} {:>12}   accepted {a}, rejected {r}",
+            "  {:<28} {:>12}   accepted {a}, gated out {r}, refused {f}",
             format!("mean NIS {sensor}"),
-            fmt(*nis)
+            fmt(nis)
         );
+    }
+    for w in &m.warnings {
+        out!("  warning: {w}");
     }
     for (name, v) in &m.baseline_attitude_rmse_deg {
         out!(

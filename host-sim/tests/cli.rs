@@ -909,3 +909,34 @@ fn calibrate_refuses_bad_intervals() {
     }
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// A missing optional file that changes the result is named in the summary and in
+/// `metrics.json`, and the per-sensor counts say what became of every update.
+#[test]
+fn a_missing_lever_arm_is_a_warning_in_the_summary() {
+    let base = tmp("missing-lever-arm");
+    let ds = base.join("ds");
+    simulate("car", &ds);
+    std::fs::remove_file(ds.join("gnss0/sensor.yaml")).expect("remove");
+    let out = base.join("out");
+    let o = host_sim(&[
+        "replay",
+        ds.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("warning:") && stdout.contains("gnss0/sensor.yaml is missing"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("gated out") && stdout.contains("refused"),
+        "{stdout}"
+    );
+    let m: serde_json::Value =
+        serde_json::from_slice(&read(&out.join("metrics.json"))).expect("json");
+    assert_eq!(m["warnings"].as_array().map(Vec::len), Some(1));
+    let _ = std::fs::remove_dir_all(&base);
+}

@@ -81,6 +81,8 @@ pub struct Dataset {
     pub has_groundtruth: bool,
     /// The scored intervals of `movement.csv` (`[start, end]` ns, inclusive), if present.
     pub movement: Option<Vec<(u64, u64)>>,
+    /// What a missing optional file made the reader assume (printed in the summary).
+    pub warnings: Vec<String>,
 }
 
 /// One sensor event.
@@ -283,15 +285,26 @@ impl Dataset {
         } else {
             None
         };
+        let mut warnings = Vec::new();
         let gnss = if dir.join("gnss0/data.csv").is_file() {
             let path = dir.join("gnss0/sensor.yaml");
             let lever_arm = if path.is_file() {
                 let y = SensorYaml::read(&path)?;
                 match y.list("lever_arm", 3) {
                     Ok(l) => Vector3::new(l[0], l[1], l[2]),
-                    Err(_) => Vector3::zeros(),
+                    Err(_) => {
+                        warnings.push(format!(
+                            "{} has no lever_arm: the antenna is taken to be at the IMU",
+                            path.display()
+                        ));
+                        Vector3::zeros()
+                    }
                 }
             } else {
+                warnings.push(format!(
+                    "{} is missing: the antenna is taken to be at the IMU (no lever arm)",
+                    path.display()
+                ));
                 Vector3::zeros()
             };
             Some(GnssParams { lever_arm })
@@ -342,6 +355,7 @@ impl Dataset {
             camera,
             baro,
             has_groundtruth: dir.join("state_groundtruth_estimate0/data.csv").is_file(),
+            warnings,
             movement: movement(dir)?,
         })
     }

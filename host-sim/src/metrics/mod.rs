@@ -210,6 +210,8 @@ pub struct Scorer {
     pub nees_steps: Vec<[f64; 5]>,
     /// Sum of squared attitude errors and count, per reference filter (`baseline`).
     pub baselines: BTreeMap<String, (f64, u64)>,
+    /// What the run assumed for want of an optional file (copied to `metrics.json`).
+    pub warnings: Vec<String>,
     /// BROAD's movement intervals (ns, inclusive); `None`: BROAD's metric is not computed.
     movement: Option<Vec<(u64, u64)>>,
     /// BROAD's errors inside the movement intervals.
@@ -253,6 +255,8 @@ pub struct Metrics {
     pub samples_scored: u64,
     /// Attitude RMSE of the reference filters run on the same data (Madgwick, Mahony), degrees.
     pub baseline_attitude_rmse_deg: BTreeMap<String, f64>,
+    /// What the run assumed for want of an optional file.
+    pub warnings: Vec<String>,
 }
 
 impl Scorer {
@@ -432,6 +436,7 @@ impl Scorer {
                 .iter()
                 .map(|(k, (sq, n))| (k.clone(), (sq / (*n).max(1) as f64).sqrt().to_degrees()))
                 .collect(),
+            warnings: self.warnings.clone(),
         }
     }
 }

@@ -295,6 +295,7 @@ fn replay_in<T: Real>(
     mut scorer: Scorer,
 ) -> Result<Scorer, ReplayError> {
     let ds = Dataset::open(dir)?;
+    scorer.warnings.extend(ds.warnings.iter().cloned());
     std::fs::create_dir_all(out).map_err(out_err(out))?;
     if ds.gnss.is_none() && ds.camera.is_none() {
         return attitude::replay_attitude::<T>(&ds, dir, out, cfg, title, scorer);

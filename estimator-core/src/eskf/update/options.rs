@@ -2,6 +2,7 @@
 
 use super::gate::{Gate, GateProbability};
 use crate::eskf::error::EskfError;
+use crate::kernels::positive_finite;
 use crate::Real;
 
 /// How an update is done: the gate, and the number of Gauss-Newton iterations.
@@ -45,15 +46,15 @@ impl<T: Real> UpdateOptions<T> {
     }
 
     /// `Ok` when the iteration cap is at least 1, the tolerance finite and a threshold gate
-    /// positive.
+    /// positive and finite.
     pub(super) fn validate(&self) -> Result<(), EskfError> {
         if self.max_iterations == 0 || !self.step_tolerance.is_finite() {
             return Err(EskfError::InvalidOption);
         }
         if let Gate::Threshold(t) = self.gate {
-            // Positive (`+∞` accepts everything); false for NaN, zero and negatives, which
+            // Positive and finite (`Gate::Off` accepts everything); NaN, zero and negatives
             // would silently reject every measurement.
-            if !(t > T::zero()) {
+            if !positive_finite(t) {
                 return Err(EskfError::InvalidOption);
             }
         }

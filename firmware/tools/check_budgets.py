@@ -4,7 +4,10 @@
   check_budgets.py BUDGETS DEMO_OUT ICOUNT_OUT [EXTRA...]   check, print the table
   check_budgets.py BUDGETS --allowed CHECK                   exit 0 if CHECK has an allowance
 
-DEMO_OUT: the demo's semihosting output (`bench <i> <name> stack=<bytes>`, `size_of <T> <n>`).
+DEMO_OUT: the demo's semihosting output (`bench <i> <name> stack=<bytes>`, `size_of <T> <n>`,
+`bench_group <first> <windows> <name> imu_samples=<n> stack=<bytes>`: one window per call of a
+run over a stream, giving `icount.<name>_per_imu_sample` (the windows' sum over the IMU samples,
+rounded), `icount.<name>_max_call` and `stack.<name>`).
 ICOUNT_OUT: the plugin's output (`icount <i> <instructions>`); window 0 is the empty one, whose
 count (the marker overhead) is subtracted from the others.
 EXTRA: files of `name value` lines (flash sizes measured by the script).
@@ -34,12 +37,17 @@ budgets, allow = read_budgets(sys.argv[1])
 if sys.argv[2] == "--allowed":
     sys.exit(0 if (sys.argv[3] in allow and not strict) else 1)
 
-names, stack, icount, sizes, extra = {}, {}, {}, {}, {}
+names, stack, icount, sizes, extra, groups = {}, {}, {}, {}, {}, []
 for line in open(sys.argv[2]):
     m = re.match(r"bench (\d+) (\S+) stack=(\d+)", line)
     if m:
         names[int(m.group(1))] = m.group(2)
         stack[m.group(2)] = int(m.group(3))
+    m = re.match(r"bench_group (\d+) (\d+) (\S+) imu_samples=(\d+) stack=(\d+)", line)
+    if m:
+        first, windows, name, samples = int(m.group(1)), int(m.group(2)), m.group(3), int(m.group(4))
+        groups.append((first, windows, name, samples))
+        stack[name] = int(m.group(5))
     m = re.match(r"size_of (.+) (\d+)$", line.strip())
     if m:
         sizes[m.group(1)] = int(m.group(2))
@@ -55,6 +63,13 @@ overhead = raw[0]
 for i, name in names.items():
     if i in raw and i != 0:
         icount[name] = raw[i] - overhead
+for first, windows, name, samples in groups:
+    calls = [raw[i] - overhead for i in range(first, first + windows) if i in raw]
+    if len(calls) != windows or samples == 0:
+        print(f"check_budgets: {name}: {len(calls)} of {windows} windows counted")
+        sys.exit(1)
+    icount[name + "_per_imu_sample"] = (sum(calls) + samples // 2) // samples
+    icount[name + "_max_call"] = max(calls)
 for path in sys.argv[4:]:
     for line in open(path):
         parts = line.split()

@@ -10,7 +10,11 @@ script. What it takes:
 * INS (15 states): IMU, magnetometer and GNSS samples of WINDOW_S seconds from START_S, with the
   ground truth at both ends and the sensors' parameters (IMU noise densities, the magnetometer's
   reference field and sigma, the GNSS lever arm).
-* AHRS (attitude only): IMU and magnetometer of the same window of its own dataset.
+* Attitude only (the attitude navigator): IMU and magnetometer of AHRS_WINDOW_S seconds from
+  AHRS_START_S of its own dataset, with the IMU timestamps (ns) and the ground truth at the end.
+  The window starts 2 s before the end of host-sim's 5 s at rest (1–6 s) and ends in the
+  hand-held motion: the navigator's 1 s start-up, two 0.5 s blocks at rest with the zero-rate
+  update (which needs 1.5 s still), then 6 s of motion.
 * PnP: the first camera frame at or after START_S, PNP_POINTS of its observations spread over
   the frame (every k-th in file order), their landmarks, the camera's intrinsics, pixel sigma and
   `T_BS`, and the body's true pose at that frame.
@@ -29,6 +33,8 @@ import textwrap
 
 START_S = 10.0
 WINDOW_S = 2.0
+AHRS_START_S = 4.0
+AHRS_WINDOW_S = 8.0
 PNP_POINTS = 20
 
 
@@ -79,11 +85,11 @@ def ns(seconds):
     return int(round(seconds * 1e9))
 
 
-def window(ds):
-    """IMU rows with timestamps in [START_S, START_S + WINDOW_S] (inclusive), and both ends (ns)."""
+def window(ds, start_s=START_S, window_s=WINDOW_S):
+    """IMU rows with timestamps in [start_s, start_s + window_s] (inclusive), and both ends (ns)."""
     imu = rows(os.path.join(ds, "imu0", "data.csv"))
-    t0 = ns(START_S)  # timestamps as written: host-sim's datasets start at 1 s
-    t1 = t0 + ns(WINDOW_S)
+    t0 = ns(start_s)  # timestamps as written: host-sim's datasets start at 1 s
+    t1 = t0 + ns(window_s)
     sel = [r for r in imu if t0 <= int(r[0]) <= t1]
     if not sel or int(sel[0][0]) != t0 or int(sel[-1][0]) != t1:
         sys.exit("make_stream: %s has no IMU samples at both ends of the window" % ds)
@@ -144,7 +150,7 @@ def imu_block(ds, imu, t0, t1):
     )
     out.append(
         "/// IMU samples at `t0 + k·DT` (k = 0..=%d): gyroscope (rad/s) then accelerometer (m/s²),\n"
-        "/// body frame, instantaneous values.\npub const IMU: [[f32; 6]; %d] = [\n" % (len(imu) - 1, len(imu))
+        "/// body frame, instantaneous values.\npub static IMU: [[f32; 6]; %d] = [\n" % (len(imu) - 1, len(imu))
     )
     for r in imu:
         out.append("    %s,\n" % arr(float(x) for x in r[1:7]))
@@ -159,7 +165,7 @@ def imu_block(ds, imu, t0, t1):
     )
     out.append(
         "/// Magnetometer samples (body, µT), each with the index of the IMU sample of the same time.\n"
-        "pub const MAG: [(usize, [f32; 3]); %d] = [\n" % len(mags)
+        "pub static MAG: [(usize, [f32; 3]); %d] = [\n" % len(mags)
     )
     for i, v in mags:
         out.append("    (%d, %s),\n" % (i, arr(v)))
@@ -184,6 +190,11 @@ def ends(ds, t0, t1):
         truth_rs("TRUTH_START", truth_at(ds, t0)),
         truth_rs("TRUTH_END", truth_at(ds, t1)),
     ]
+
+
+def end(ds, t1):
+    """The ground truth at the end of the window (the navigator starts on its own)."""
+    return ["/// Ground truth at the last IMU sample.\n", truth_rs("TRUTH_END", truth_at(ds, t1))]
 
 
 def origin(ds, what):
@@ -213,10 +224,24 @@ def ins_rs(ds):
     return module(doc, "ins", "{GnssFix, Truth}", body)
 
 
+def timestamps(imu):
+    """The first IMU timestamp and the interval (ns), after checking that every sample is at
+    `T0_NS + k·DT_NS` exactly."""
+    t = [int(r[0]) for r in imu]
+    dt = t[1] - t[0]
+    if any(b - a != dt for a, b in zip(t, t[1:])):
+        sys.exit("make_stream: the IMU timestamps of the attitude window are not evenly spaced")
+    return [
+        "/// IMU sample k is at `T0_NS + k·DT_NS` (ns, the dataset's clock); a magnetometer sample\n"
+        "/// has the time of its IMU sample.\n",
+        "pub const T0_NS: u64 = %d;\npub const DT_NS: u64 = %d;\n" % (t[0], dt),
+    ]
+
+
 def ahrs_rs(ds):
-    imu, t0, t1 = window(ds)
-    body = imu_block(ds, imu, t0, t1) + ends(ds, t0, t1)
-    doc = origin(ds, "The attitude-only filter's stream") % ("%g–%g s" % (t0 * 1e-9, t1 * 1e-9))
+    imu, t0, t1 = window(ds, AHRS_START_S, AHRS_WINDOW_S)
+    body = imu_block(ds, imu, t0, t1) + timestamps(imu) + end(ds, t1)
+    doc = origin(ds, "The attitude navigator's stream") % ("%g–%g s" % (t0 * 1e-9, t1 * 1e-9))
     return module(doc, "ahrs", "Truth", body)
 
 

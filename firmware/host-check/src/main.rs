@@ -27,9 +27,9 @@ fn emit(name: &str, doc: &str, o: &Outcome<f32>) -> String {
     writeln!(s, "    ins_v: {},", arr(o.ins_v)).unwrap();
     writeln!(s, "    ins_p: {},", arr(o.ins_p)).unwrap();
     writeln!(s, "    ins_accepted: {},", o.ins_accepted).unwrap();
-    writeln!(s, "    ahrs_q: {},", arr(o.ahrs_q)).unwrap();
-    writeln!(s, "    ahrs_bg: {},", arr(o.ahrs_bg)).unwrap();
-    writeln!(s, "    ahrs_accepted: {},", o.ahrs_accepted).unwrap();
+    writeln!(s, "    nav_q: {},", arr(o.nav_q)).unwrap();
+    writeln!(s, "    nav_bg: {},", arr(o.nav_bg)).unwrap();
+    writeln!(s, "    nav_fused: {},", o.nav_fused).unwrap();
     writeln!(s, "    pnp_q: {},", arr(o.pnp_q)).unwrap();
     writeln!(s, "    pnp_t: {},", arr(o.pnp_t)).unwrap();
     writeln!(s, "    truth_errors: {},", arr(o.truth_errors)).unwrap();
@@ -54,9 +54,9 @@ fn main() {
         ins_v: narrow(o64.ins_v),
         ins_p: narrow(o64.ins_p),
         ins_accepted: o64.ins_accepted,
-        ahrs_q: narrow(o64.ahrs_q),
-        ahrs_bg: narrow(o64.ahrs_bg),
-        ahrs_accepted: o64.ahrs_accepted,
+        nav_q: narrow(o64.nav_q),
+        nav_bg: narrow(o64.nav_bg),
+        nav_fused: o64.nav_fused,
         pnp_q: narrow(o64.pnp_q),
         pnp_t: narrow(o64.pnp_t),
         truth_errors: narrow(o64.truth_errors),

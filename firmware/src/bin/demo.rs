@@ -1,13 +1,15 @@
 //! The firmware proof, run under QEMU (`mps2-an386`, Cortex-M4F):
 //!
-//! 1. runs the Lie-group operations, the 15-state filter (`Ins<f32>`), the attitude-only filter
-//!    (`Ahrs<f32>`) and a 20-point PnP solve on the embedded stream (`scenario.rs`), and checks
-//!    the results against the host's (`expected.rs`): f64 reference within stated tolerances,
-//!    the host's f32 run within a few ulps, and a sanity bound on the error against the truth;
+//! 1. runs the Lie-group operations, the 15-state filter (`Ins<f32>`), the attitude navigator
+//!    (`AttitudeNavigator<f32>`) and a 20-point PnP solve on the embedded stream
+//!    (`scenario.rs`), and checks the results against the host's (`expected.rs`): f64 reference
+//!    within stated tolerances, the host's f32 run within a few ulps, and the errors against the
+//!    truth within the scenario's bounds and the estimators' own 3σ;
 //! 2. measures each operation once more between the `bench_start`/`bench_stop` markers (the
 //!    instruction-count plugin `qemu-plugin/icount.c` counts between them) with the stack
-//!    painted below the caller, and prints the peak stack of each;
-//! 3. prints `size_of` of the filter and solver types;
+//!    painted below the caller, and prints the peak stack of each; the navigator's costliest
+//!    call, and every navigator call over the whole stream (one window each);
+//! 3. prints `size_of` of the filter, navigator and solver types;
 //! 4. exits through semihosting: status 0 when every check passed, 1 otherwise.
 #![no_std]
 #![no_main]
@@ -28,11 +30,12 @@ use core::mem::size_of;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use estimator_core::eskf::{
-    Ahrs, AhrsState, EskfError, FilterConfig, Ins, InsState, Measurement, UpdateOptions,
-    UpdateOutcome,
+    Ahrs, AhrsAccelBias, AhrsAccelBiasState, AhrsState, EskfError, FilterConfig, Ins, InsState,
+    Measurement, UpdateOptions, UpdateOutcome,
 };
 use estimator_core::gn::{self, solve_pnp, PnpSolution, SolveError};
 use estimator_core::lie::{LieGroup, Se3, So3};
+use estimator_core::nav::{AttitudeEstimate, AttitudeNavigator, AttitudeReport};
 use nalgebra::{Vector3, Vector6};
 
 // ---------------------------------------------------------------- benchmark markers
@@ -224,14 +227,14 @@ fn check_outcome(c: &mut Checker, o: &scenario::Outcome<f32>) {
     c.close("ins velocity vs f64", &o.ins_v, &r.ins_v, 1e-4);
     c.close("ins position vs f64", &o.ins_p, &r.ins_p, 1e-4);
     c.equal("ins updates accepted", o.ins_accepted, r.ins_accepted);
-    c.close("ahrs attitude q vs f64", &o.ahrs_q, &r.ahrs_q, 2e-5);
-    c.close("ahrs gyro bias vs f64", &o.ahrs_bg, &r.ahrs_bg, 1e-5);
-    c.equal("ahrs updates accepted", o.ahrs_accepted, r.ahrs_accepted);
+    c.close("nav attitude q vs f64", &o.nav_q, &r.nav_q, 2e-5);
+    c.close("nav gyro bias vs f64", &o.nav_bg, &r.nav_bg, 1e-5);
+    c.equal("nav blocks fused", o.nav_fused, r.nav_fused);
     c.close("pnp rotation q vs f64", &o.pnp_q, &r.pnp_q, 1e-5);
     c.close("pnp translation vs f64", &o.pnp_t, &r.pnp_t, 1e-4);
     // Against the host's own f32 run: the same IEEE f32 arithmetic, so (nearly) identical.
     let all = |o: &scenario::Outcome<f32>| {
-        let mut v = [0.0f32; 56];
+        let mut v = [0.0f32; 37 + 2 * scenario::TRUTH_CHECKS];
         let parts: [&[f32]; 12] = [
             &o.so3_exp,
             &o.so3_log,
@@ -239,8 +242,8 @@ fn check_outcome(c: &mut Checker, o: &scenario::Outcome<f32>) {
             &o.ins_q,
             &o.ins_v,
             &o.ins_p,
-            &o.ahrs_q,
-            &o.ahrs_bg,
+            &o.nav_q,
+            &o.nav_bg,
             &o.pnp_q,
             &o.pnp_t,
             &o.truth_errors,
@@ -259,16 +262,20 @@ fn check_outcome(c: &mut Checker, o: &scenario::Outcome<f32>) {
     };
     c.close("all values vs host f32", &all(o), &all(h), 1e-5);
     // Against host-sim's ground truth: each error within the 3-σ radius of the estimator's own
-    // covariance.
+    // covariance; the navigator's tilt and heading also within the bounds the scenario's
+    // sensors allow (`scenario::nav_tolerances`).
     let names = [
         "ins position error (m)",
         "ins attitude error (rad)",
-        "ahrs attitude error (rad)",
+        "nav tilt error (rad)",
         "pnp rotation error (rad)",
         "pnp translation error (m)",
         "ins gyro bias error (rad/s)",
         "ins accel bias error (m/s2)",
-        "ahrs gyro bias error (rad/s)",
+        "nav gyro bias error (rad/s)",
+        "nav heading error (rad)",
+        "nav tilt error, own 3s (rad)",
+        "nav heading err, own 3s (rad)",
     ];
     for ((name, e), b) in names.iter().zip(o.truth_errors).zip(o.truth_bounds) {
         c.below(name, e, b);
@@ -303,6 +310,18 @@ impl<Mo: Measurement<f32, InsState<f32>, 15, M>, const M: usize> Filter<Mo, M> f
 }
 
 impl<Mo: Measurement<f32, AhrsState<f32>, 6, M>, const M: usize> Filter<Mo, M> for Ahrs<f32> {
+    fn update_with(
+        &mut self,
+        m: &Mo,
+        o: &UpdateOptions<f32>,
+    ) -> Result<UpdateOutcome<f32>, EskfError> {
+        self.update(m, o)
+    }
+}
+
+impl<Mo: Measurement<f32, AhrsAccelBiasState<f32>, 9, M>, const M: usize> Filter<Mo, M>
+    for AhrsAccelBias<f32>
+{
     fn update_with(
         &mut self,
         m: &Mo,
@@ -351,7 +370,85 @@ impl Updates {
     }
 }
 
-fn run_benchmarks(w: &scenario::Workload<f32>) -> Updates {
+/// Benchmarks the navigator's IMU call that ends a block at rest with the magnetometer on: the
+/// prediction, the attitude widening for the block's rotation, and the zero-rate, gravity and
+/// heading updates. Returns whether the same call on another copy fused all three.
+fn bench_nav_step(index: &mut u32, s: &scenario::NavStep<f32>) -> bool {
+    let mut nav = s.nav;
+    bench(index, "nav_imu_block_end", || {
+        let _ = black_box(black_box(&mut nav).imu(
+            black_box(s.t_ns),
+            black_box(&s.gyro),
+            black_box(&s.accel),
+        ));
+    });
+    let mut other = s.nav;
+    let Ok(r) = other.imu(s.t_ns, &s.gyro, &s.accel) else {
+        hprintln!("info nav_imu_block_end error");
+        return false;
+    };
+    let nis = |f: Option<estimator_core::nav::Fusion<f32>>| f.map_or(f32::NAN, |f| f.nis);
+    hprintln!(
+        "info nav_imu_block_end at_rest={} nis zero_rate={} gravity={} heading={}",
+        r.at_rest,
+        nis(r.fused.zero_rate),
+        nis(r.fused.gravity),
+        nis(r.fused.heading)
+    );
+    let fused = |f: Option<estimator_core::nav::Fusion<f32>>| f.is_some_and(|f| f.accepted);
+    r.at_rest && fused(r.fused.zero_rate) && fused(r.fused.gravity) && fused(r.fused.heading)
+}
+
+/// Runs a new navigator over the whole attitude stream, each call in its own measured window
+/// (painted like every other), and prints
+/// `bench_group <first window> <windows> nav_stream imu_samples=<n> stack=<peak>`:
+/// `tools/check_budgets.py` sums the plugin's counts of those windows. Returns the final
+/// estimate and the samples refused.
+fn bench_nav_stream(index: &mut u32) -> Option<(AttitudeEstimate<f32>, u32)> {
+    let mut nav = AttitudeNavigator::new(scenario::attitude_config::<f32>()).ok()?;
+    let first = *index;
+    let (mut windows, mut imu, mut peak) = (0u32, 0u32, 0usize);
+    scenario::attitude_samples::<f32>(|sample| {
+        let stack = match sample {
+            scenario::Sample::Imu { t_ns, gyro, accel } => {
+                imu += 1;
+                measure(&mut || {
+                    let _ = black_box(black_box(&mut nav).imu(
+                        black_box(t_ns),
+                        black_box(&gyro),
+                        black_box(&accel),
+                    ));
+                })
+            }
+            scenario::Sample::Mag { t_ns, field } => measure(&mut || {
+                let _ =
+                    black_box(black_box(&mut nav).magnetometer(black_box(t_ns), black_box(&field)));
+            }),
+        };
+        peak = peak.max(stack);
+        windows += 1;
+    });
+    *index += windows;
+    hprintln!(
+        "bench_group {} {} nav_stream imu_samples={} stack={}",
+        first,
+        windows,
+        imu,
+        peak
+    );
+    Some((nav.estimate()?, nav.counters().refused))
+}
+
+/// What the benchmarks found besides the figures.
+struct Benchmarks {
+    updates: Updates,
+    /// The navigator's costliest call fused every aid (it ran its whole path).
+    nav_step: bool,
+    /// The navigator's measured run over the stream: final estimate, samples refused.
+    nav_stream: Option<(AttitudeEstimate<f32>, u32)>,
+}
+
+fn run_benchmarks(w: &scenario::Workload<f32>) -> Benchmarks {
     let mut i = 0u32;
     bench(&mut i, "empty", || {});
 
@@ -460,7 +557,32 @@ fn run_benchmarks(w: &scenario::Workload<f32>) -> Updates {
         &w.iterated,
     );
     updates.bench(&mut i, "ahrs_update_heading", ahrs, &w.ahrs_heading, opts);
-    updates
+    let nav_step = w
+        .nav_step
+        .as_ref()
+        .is_some_and(|s| bench_nav_step(&mut i, s));
+    // The parts of that call, each alone on the navigator's filter (attitude, gyro and
+    // accelerometer biases): what the call's cost is made of.
+    if let Some(p) = &w.nav_parts {
+        let mut f = p.filter;
+        bench(&mut i, "nav_filter_predict", || {
+            let _ = black_box(black_box(&mut f).predict(black_box(&p.imu)));
+        });
+        let mut f = p.filter;
+        bench(&mut i, "nav_filter_widen_attitude", || {
+            let _ = black_box(black_box(&mut f).widen_attitude(black_box(1e-3), black_box(1e-3)));
+        });
+        let f = &p.filter;
+        updates.bench(&mut i, "nav_filter_update_zero_rate", f, &p.zero_rate, opts);
+        updates.bench(&mut i, "nav_filter_update_accel", f, &p.at_rest, opts);
+        updates.bench(&mut i, "nav_filter_update_heading", f, &p.heading, opts);
+    }
+    let nav_stream = bench_nav_stream(&mut i);
+    Benchmarks {
+        updates,
+        nav_step,
+        nav_stream,
+    }
 }
 
 #[entry]
@@ -473,14 +595,40 @@ fn main() -> ! {
 
     match work {
         Some(w) => {
-            let u = run_benchmarks(&w);
-            c.equal("benchmarked updates accepted", u.accepted, u.run);
+            let b = run_benchmarks(&w);
+            c.equal(
+                "benchmarked updates accepted",
+                b.updates.accepted,
+                b.updates.run,
+            );
+            c.equal("nav costliest call fused all", u32::from(b.nav_step), 1);
+            match b.nav_stream {
+                Some((e, refused)) => {
+                    c.equal("nav stream samples refused", refused, 0);
+                    // The measured run is the checked one.
+                    let q = scenario::quat(&e.attitude);
+                    c.close("nav stream = checked run", &q, &outcome.nav_q, 0.0);
+                }
+                None => c.equal("nav stream run", 0, 1),
+            }
         }
         None => c.equal("benchmark workload built", 0, 1),
     }
 
     hprintln!("size_of Ins<f32> {}", size_of::<Ins<f32>>());
     hprintln!("size_of Ahrs<f32> {}", size_of::<Ahrs<f32>>());
+    hprintln!(
+        "size_of AttitudeNavigator<f32> {}",
+        size_of::<AttitudeNavigator<f32>>()
+    );
+    hprintln!(
+        "size_of AttitudeReport<f32> {}",
+        size_of::<AttitudeReport<f32>>()
+    );
+    hprintln!(
+        "size_of AttitudeEstimate<f32> {}",
+        size_of::<AttitudeEstimate<f32>>()
+    );
     hprintln!("size_of InsState<f32> {}", size_of::<InsState<f32>>());
     hprintln!("size_of PnpSolution<f32> {}", size_of::<PnpSolution<f32>>());
     hprintln!(

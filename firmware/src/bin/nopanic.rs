@@ -26,10 +26,11 @@
 use core::hint::black_box as bb;
 use cortex_m_rt::entry;
 use estimator_core::eskf::{
-    align_at_rest, AccelerometerAtRest, Ahrs, AhrsState, BaroAltitude, CameraLandmark, ErrorState,
-    FilterConfig, Gate, GateProbability, GnssPosition, GnssVelocity, GravityDirection, Heading,
-    ImuNoise, ImuSample, InitialSigmas, Ins, InsState, Magnetometer, MagnetometerWindow,
-    Measurement, PinholeIntrinsics, UpdateOptions, ZeroVelocity,
+    align_at_rest, AccelerometerAtRest, Ahrs, AhrsAccelBias, AhrsAccelBiasState, AhrsState,
+    BaroAltitude, CameraLandmark, ErrorState, FilterConfig, Gate, GateProbability, GnssPosition,
+    GnssVelocity, GravityDirection, Heading, ImuNoise, ImuSample, InitialSigmas, Ins, InsState,
+    MagneticHeading, Magnetometer, MagnetometerWindow, Measurement, PinholeIntrinsics,
+    UpdateOptions, ZeroRate, ZeroVelocity,
 };
 use estimator_core::gn::{
     check_point_spread, point_reprojection_error, reprojection_error, solve, solve_pnp,
@@ -38,6 +39,9 @@ use estimator_core::gn::{
     TriangulationOptions, VectorPair,
 };
 use estimator_core::lie::{skew, LieGroup, Se2, Se3, So2, So3};
+use estimator_core::nav::{
+    AttitudeConfig, AttitudeNavigator, MagneticConfig, Validity, VectorMean,
+};
 use estimator_core::Real;
 use nalgebra::{
     Matrix2, Matrix3, Matrix4, Quaternion, SMatrix, SVector, UnitQuaternion, Vector1, Vector2,
@@ -175,6 +179,8 @@ fn eskf<T: Real>(x: &Seed<T>) {
     let iter = UpdateOptions::iterated(bb(Gate::Threshold(h)), bb(3), g);
     let opts = bb(if bb(false) { iter } else { ekf_opts });
     ahrs(x, &config, &opts);
+    ahrs_accel_bias(x, &config, &opts);
+    nav(x, &config);
     keep(&UpdateOptions::<T>::default());
     keep(&bb(Gate::<T>::Probability(GateProbability::P95)).threshold(bb(3)));
     keep(&GateProbability::P999.quantile::<T>(bb(9)));
@@ -249,6 +255,8 @@ fn eskf<T: Real>(x: &Seed<T>) {
     ins_update!(GravityDirection::new(w, g));
     ins_update!(Heading::new(c, g));
     ins_update!(AccelerometerAtRest::new(v, a));
+    ins_update!(ZeroRate::new(v, a));
+    ins_update!(MagneticHeading::new(v, w, d));
     // The outcome's accessors, once (on the last outcome).
     if let Ok(outcome) = ins_update!(cam) {
         keep(&(outcome.nis(), outcome.is_accepted()));
@@ -290,7 +298,77 @@ fn ahrs<T: Real>(x: &Seed<T>, config: &FilterConfig<T>, opts: &UpdateOptions<T>)
     ahrs_update!(Magnetometer::new(v, w, d));
     ahrs_update!(GravityDirection::new(w, g));
     ahrs_update!(Heading::new(c, g));
+    ahrs_update!(ZeroRate::new(v, a));
+    ahrs_update!(MagneticHeading::new(v, w, d));
+    keep(&ahrs.widen_attitude(a, b));
     keep(&ahrs);
+}
+
+/// The attitude filter with both IMU biases (the attitude navigator's), with its own models.
+#[inline(never)]
+fn ahrs_accel_bias<T: Real>(x: &Seed<T>, config: &FilterConfig<T>, opts: &UpdateOptions<T>) {
+    let [a, b, c, d, e, f, g, _] = *x;
+    let (v, w) = (Vector3::new(a, b, c), Vector3::new(d, e, f));
+    let st = bb(AhrsAccelBiasState::<T>::identity());
+    keep(&st.oplus(&SVector::<T, 9>::repeat(g)));
+    let p = SMatrix::<T, 9, 9>::from_diagonal_element(b);
+    let mut filter = match AhrsAccelBias::new(st, p, *config) {
+        Ok(f) => f,
+        Err(e) => {
+            keep(&e);
+            return;
+        }
+    };
+    keep(&(filter.state(), filter.covariance(), filter.sigmas()));
+    keep(&filter.predict(&ImuSample {
+        gyro: v,
+        accel: w,
+        dt: g,
+    }));
+    keep(&filter.widen_attitude(a, b));
+    keep(&filter.update(&ZeroRate::new(v, a), opts));
+    keep(&filter.update(&AccelerometerAtRest::new(w, a), opts));
+    keep(&filter.update(&MagneticHeading::new(v, w, d), opts));
+    keep(&filter.update(&GravityDirection::new(w, g), opts));
+    keep(&filter.update(&Magnetometer::new(v, w, d), opts));
+    keep(&filter);
+}
+
+/// The attitude navigator on an opaque state (`black_box` after construction: every phase and
+/// branch of its calls is reachable) and opaque samples; the running mean it is built on.
+#[inline(never)]
+fn nav<T: Real>(x: &Seed<T>, config: &FilterConfig<T>) {
+    let [a, b, c, d, e, f, g, h] = *x;
+    let (v, w) = (Vector3::new(a, b, c), Vector3::new(d, e, f));
+    let mut cfg = AttitudeConfig::new(*config);
+    cfg.magnetometer = bb(Some(MagneticConfig::new(g, bb(Some(w)))));
+    let cfg = bb(cfg);
+    keep(&cfg.validate());
+    let nav = match AttitudeNavigator::new(cfg) {
+        Ok(n) => n,
+        Err(e) => {
+            keep(&e);
+            return;
+        }
+    };
+    let mut nav = bb(nav);
+    let t = bb(1_000_000_000u64);
+    keep(&nav.imu(t, &v, &w));
+    keep(&nav.magnetometer(t, &w));
+    keep(&nav.estimate());
+    keep(&(
+        nav.config(),
+        nav.filter(),
+        nav.report(),
+        nav.counters(),
+        nav.magnetic_reference(),
+    ));
+    keep(&bb(Validity::Valid).is_valid());
+    let mut mean = VectorMean::<T>::default();
+    mean.add(&v);
+    mean.add(&bb(w));
+    keep(&(mean.count(), mean.mean(), mean.scatter_sq()));
+    keep(&(T::from_count(bb(7)), h.to_count()));
 }
 
 #[inline(never)]

@@ -66,7 +66,7 @@ impl<T: Real> BlockStats<T> {
     /// The rotation of the block, rad: RMS rate about `bias` times the duration.
     pub(super) fn rotation(&self, bias: &Vector3<T>) -> T {
         let w = self.gyro_mean - bias;
-        (self.gyro_scatter_sq + w.dot(&w)).sqrt() * self.duration
+        (self.gyro_scatter_sq + w.dot(&w)).sqrt_rn() * self.duration
     }
 }
 

@@ -53,7 +53,7 @@ use nalgebra::Vector3;
 
 /// Norm, horizontal norm and dip angle of a world (ENU) vector.
 fn norm_dip<T: Real>(c: &Vector3<T>) -> (T, T, T) {
-    let h = (c.x * c.x + c.y * c.y).sqrt();
+    let h = (c.x * c.x + c.y * c.y).sqrt_rn();
     (mat3::norm(c), h, c.z.arctan2(h))
 }
 
@@ -140,6 +140,7 @@ impl<T: Real> Magnetic<T> {
 
     /// Fuses one block's magnetometer samples (a block of `duration` s during which the body
     /// turned by `rotation` rad).
+    #[inline(never)] // its own stack frame, not the caller's
     pub(super) fn fuse(
         &mut self,
         filter: &mut AhrsAccelBias<T>,
@@ -171,7 +172,7 @@ impl<T: Real> Magnetic<T> {
         let white = mag.sigma / horizontal;
         let var = white * white / T::from_count(n.max(1))
             + mag.heading_noise * mag.heading_noise / duration;
-        let model = MagneticHeading::new(*m_body, reference, var.sqrt());
+        let model = MagneticHeading::new(*m_body, reference, var.sqrt_rn());
         let options = UpdateOptions::default();
         let mut event = None;
         let mut fusion = match mag.fusion {
@@ -179,7 +180,7 @@ impl<T: Real> Magnetic<T> {
             MagneticFusion::Vector => {
                 let sigma_sq = mag.sigma * mag.sigma / T::from_count(n.max(1))
                     + horizontal * horizontal * mag.heading_noise * mag.heading_noise / duration;
-                let vector = Magnetometer::new(*m_body, reference, sigma_sq.sqrt());
+                let vector = Magnetometer::new(*m_body, reference, sigma_sq.sqrt_rn());
                 Fusion::from(filter.update(&vector, &options)?)
             }
         };
@@ -194,7 +195,7 @@ impl<T: Real> Magnetic<T> {
             // error while the body turns: a disturbance would change with the orientation.
             let lasted = T::from_count(u32::from(run.count)) * duration;
             let wrong_estimate = run.count >= config.max_rejected_blocks
-                && run.high - run.low <= T::lit(4.0) * mag.heading_noise / duration.sqrt()
+                && run.high - run.low <= T::lit(4.0) * mag.heading_noise / duration.sqrt_rn()
                 && (run.turned >= T::frac_pi_2() || lasted >= mag.new_field_s);
             if wrong_estimate {
                 filter.widen_attitude(T::zero(), innovation.abs())?;
@@ -206,7 +207,7 @@ impl<T: Real> Magnetic<T> {
         let w = world_attitude_covariance(filter);
         let deficit = mag.heading_floor * mag.heading_floor - w.m33;
         if deficit > T::zero() {
-            filter.widen_attitude(T::zero(), deficit.sqrt())?;
+            filter.widen_attitude(T::zero(), deficit.sqrt_rn())?;
         }
         let status = if fusion.accepted {
             MagneticStatus::Fused

@@ -60,6 +60,25 @@ enum Phase<T: Real> {
     Running { filter: AhrsAccelBias<T> },
 }
 
+/// The update a pending block makes next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Stage {
+    /// The accelerometer.
+    Gravity,
+    /// The magnetometer.
+    Heading,
+}
+
+/// A finished block whose accelerometer and magnetometer updates are still to be made, one per
+/// IMU call.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Pending<T: Real> {
+    stats: block::BlockStats<T>,
+    /// The accelerometer's 1σ per axis, m/s².
+    sigma: T,
+    stage: Stage,
+}
+
 /// Durations of the configuration in nanoseconds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Durations {
@@ -101,6 +120,10 @@ pub struct AttitudeNavigator<T: Real> {
     durations: Durations,
     phase: Phase<T>,
     block: Block<T>,
+    /// The last finished block's remaining updates.
+    pending: Option<Pending<T>>,
+    /// The rotation since that block's end (gyro increments of the predictions).
+    carry: So3<T>,
     imu_clock: Clock,
     mag_clock: Clock,
     /// The previous IMU sample (gyro, accel), for trapezoidal integration.
@@ -139,6 +162,8 @@ impl<T: Real> AttitudeNavigator<T> {
                 frame: So3::identity(),
             },
             block: Block::default(),
+            pending: None,
+            carry: So3::identity(),
             imu_clock: Clock::default(),
             mag_clock: Clock::default(),
             last_imu: None,
@@ -210,8 +235,8 @@ impl<T: Real> AttitudeNavigator<T> {
             attitude: filter.state().attitude,
             gyro_bias: filter.state().gyro_bias,
             accel_bias: filter.state().accel_bias,
-            sigma_tilt: tilt.sqrt(),
-            sigma_heading: w.m33.sqrt(),
+            sigma_tilt: tilt.sqrt_rn(),
+            sigma_heading: w.m33.sqrt_rn(),
         })
     }
 
@@ -228,12 +253,8 @@ impl<T: Real> AttitudeNavigator<T> {
         gyro: &Vector3<T>,
         accel: &Vector3<T>,
     ) -> Result<AttitudeReport<T>, NavError> {
-        let mut next = *self;
-        match next.take_imu(t_ns, gyro, accel) {
-            Ok(()) => {
-                *self = next;
-                Ok(self.report)
-            }
+        match self.take_imu(t_ns, gyro, accel) {
+            Ok(()) => Ok(self.report),
             Err(e) => {
                 self.counters.refused = self.counters.refused.saturating_add(1);
                 Err(e)
@@ -290,7 +311,9 @@ impl<T: Real> AttitudeNavigator<T> {
         frame.compose(&So3::exp(&((gyro - bias) * dt)))
     }
 
-    /// The IMU step on a copy (committed by the caller only on `Ok`).
+    /// The IMU step. Every check that can refuse the sample (its values, its time, the
+    /// prediction) comes before the first change, so a refused sample changes nothing; what
+    /// follows cannot fail (an update the filter refuses is counted and skipped).
     fn take_imu(
         &mut self,
         t_ns: u64,
@@ -301,14 +324,14 @@ impl<T: Real> AttitudeNavigator<T> {
             return Err(NavError::NonFinite);
         }
         check_vector(accel)?;
-        self.report.event = None;
-        self.report.fused = Fusions::default();
-        let dt_ns = match self.imu_clock.tick(t_ns, self.durations.max_step)? {
+        let tick = self.imu_clock.tick(t_ns, self.durations.max_step)?;
+        let mut event = None;
+        let dt_ns = match tick {
             Tick::First => None,
             Tick::Step(ns) => Some(ns),
             Tick::Gap => {
                 self.restart();
-                self.report.event = Some(Event::Realigned);
+                event = Some(Event::Realigned);
                 self.counters.realigned = self.counters.realigned.saturating_add(1);
                 None
             }
@@ -324,14 +347,24 @@ impl<T: Real> AttitudeNavigator<T> {
                     let w = (g_mid - self.bias_prior) * dt;
                     *frame = frame.compose(&So3::exp(&w)).normalize();
                 }
-                Phase::Running { filter } => filter.predict(&ImuSample {
-                    gyro: g_mid,
-                    accel: a_mid,
-                    dt,
-                })?,
+                Phase::Running { filter } => {
+                    let bias = filter.state().gyro_bias;
+                    filter.predict(&ImuSample {
+                        gyro: g_mid,
+                        accel: a_mid,
+                        dt,
+                    })?;
+                    // The rotation since the pending block's end, by the same increments.
+                    self.carry = self.carry.compose(&So3::exp(&((g_mid - bias) * dt)));
+                }
             }
             self.block.elapsed_ns = self.block.elapsed_ns.saturating_add(ns);
         }
+        self.report.event = event;
+        self.report.fused = Fusions::default();
+        // At most one update of the pending block per call (the cost of a call stays that of
+        // one update).
+        self.fuse_pending_stage();
         let frame = match &self.phase {
             Phase::Starting { frame } => *frame,
             Phase::Running { filter } => filter.state().attitude,
@@ -348,10 +381,19 @@ impl<T: Real> AttitudeNavigator<T> {
             Phase::Running { .. } => self.durations.block,
         };
         if self.block.elapsed_ns >= length {
-            self.end_block()?;
+            // A block shorter than its updates: finish the previous one first.
+            while self.pending.is_some() {
+                self.fuse_pending_stage();
+            }
+            self.end_block();
         }
         self.refresh_validity();
         Ok(())
+    }
+
+    /// Counts an update the filter refused (a numerical failure: the filter is unchanged).
+    fn failed(&mut self) {
+        self.counters.numerical_failures = self.counters.numerical_failures.saturating_add(1);
     }
 
     /// Back to start-up (after a gap), keeping the bias estimate and the magnetic reference.
@@ -363,50 +405,56 @@ impl<T: Real> AttitudeNavigator<T> {
             frame: So3::identity(),
         };
         self.block = Block::default();
+        self.pending = None;
         self.last_imu = None;
         self.still_s = T::zero();
         self.tilt_rejected = 0;
     }
 
-    /// Fuses the finished block (or starts the filter from the start-up window).
-    fn end_block(&mut self) -> Result<(), NavError> {
+    /// Closes the finished block: starts the filter from the start-up window, or widens for
+    /// the gyro's scale error, makes the zero-rate update at rest, and leaves the accelerometer
+    /// and magnetometer updates pending for the next calls.
+    #[inline(never)]
+    fn end_block(&mut self) {
         let frame = match &self.phase {
             Phase::Starting { frame } => *frame,
             Phase::Running { filter } => filter.state().attitude,
         };
         let block = core::mem::take(&mut self.block);
         let Some(stats) = block.stats(&frame) else {
-            return Ok(());
+            return;
         };
         let g = mat3::norm(&self.config.filter.gravity);
         if !tilt::has_direction(&stats.accel_body) {
             // Free fall for a whole block: nothing to fuse.
-            return Ok(());
+            return;
         }
         let power = tilt::acceleration_power(&stats, tilt::white_sq(&stats, &self.config));
         let filter = match &mut self.phase {
             Phase::Starting { .. } => {
-                let (filter, still) =
-                    startup::start(&stats, &self.config, &self.bias_prior, &mut self.magnetic)?;
-                self.phase = Phase::Running { filter };
-                self.still_s = if still { stats.duration } else { T::zero() };
-                self.last_power = power;
-                self.report.at_rest = still;
-                if self.report.event.is_none() {
-                    self.report.event = Some(Event::Started);
+                match startup::start(&stats, &self.config, &self.bias_prior, &mut self.magnetic) {
+                    Ok((filter, still)) => {
+                        self.phase = Phase::Running { filter };
+                        self.still_s = if still { stats.duration } else { T::zero() };
+                        self.last_power = power;
+                        self.report.at_rest = still;
+                        if self.report.event.is_none() {
+                            self.report.event = Some(Event::Started);
+                        }
+                        if stats.mag.is_some() && self.magnetic.is_some() {
+                            self.report.magnetic = MagneticStatus::Fused;
+                        }
+                    }
+                    // The window gave no attitude (a numerical failure): collect another.
+                    Err(_) => self.failed(),
                 }
-                if stats.mag.is_some() && self.magnetic.is_some() {
-                    self.report.magnetic = MagneticStatus::Fused;
-                }
-                return Ok(());
+                return;
             }
             Phase::Running { filter } => filter,
         };
         // The gyro's scale and cross-axis errors over the block's rotation.
         let turned = self.config.gyro_scale_sigma * stats.rotation(&filter.state().gyro_bias);
-        if turned > T::zero() {
-            filter.widen_attitude(turned, turned)?;
-        }
+        let widened = turned > T::zero() && filter.widen_attitude(turned, turned).is_err();
         // Rest: zero-rate update of the gyro bias.
         let still = rest::is_still(&stats, &filter.state().gyro_bias, &self.config, g);
         self.still_s = if still {
@@ -415,14 +463,24 @@ impl<T: Real> AttitudeNavigator<T> {
             T::zero()
         };
         self.report.at_rest = still && self.still_s >= self.config.rest_min_s;
-        if self.report.at_rest {
-            let fusion = rest::fuse(filter, &stats, &self.config)?;
-            if fusion.accepted {
-                self.counters.zero_rate = self.counters.zero_rate.saturating_add(1);
-            }
-            self.report.fused.zero_rate = Some(fusion);
+        let zero_rate = if self.report.at_rest {
+            Some(rest::fuse(filter, &stats, &self.config))
+        } else {
+            None
+        };
+        if widened {
+            self.failed();
         }
-        // Tilt.
+        match zero_rate {
+            Some(Ok(fusion)) => {
+                if fusion.accepted {
+                    self.counters.zero_rate = self.counters.zero_rate.saturating_add(1);
+                }
+                self.report.fused.zero_rate = Some(fusion);
+            }
+            Some(Err(_)) => self.failed(),
+            None => {}
+        }
         let used_power = if power > self.last_power {
             power
         } else {
@@ -432,50 +490,101 @@ impl<T: Real> AttitudeNavigator<T> {
         let sigma =
             tilt::specific_force_sigma(&stats, &self.config, used_power, self.slow_power, g);
         self.slow_power = tilt::update_slow_power(self.slow_power, &stats, &self.config, g);
-        let (fusion, event) =
-            tilt::fuse(filter, &stats, sigma, &self.config, &mut self.tilt_rejected)?;
-        self.report.fused.gravity = Some(fusion);
-        if fusion.accepted {
-            self.counters.gravity_fused = self.counters.gravity_fused.saturating_add(1);
-        } else {
-            self.counters.gravity_rejected = self.counters.gravity_rejected.saturating_add(1);
+        self.pending = Some(Pending {
+            stats,
+            sigma,
+            stage: Stage::Gravity,
+        });
+        self.carry = So3::identity();
+    }
+
+    /// The next update of the pending block, with its measurements carried from the block's
+    /// end to now by the gyro (`v_now = C⁻¹ v_end`, `C` the rotation since the end).
+    #[inline(never)]
+    fn fuse_pending_stage(&mut self) {
+        let (Some(pending), Phase::Running { filter }) = (self.pending, &mut self.phase) else {
+            self.pending = None;
+            return;
+        };
+        let back = self.carry.inverse();
+        let mut stats = pending.stats;
+        stats.accel_body = back.act(&stats.accel_body);
+        stats.bias_map = mat3::mul(&back.rotation_matrix(), &stats.bias_map);
+        if let Some(m) = stats.mag.as_mut() {
+            m.body = back.act(&m.body);
         }
-        if event.is_some() {
-            self.counters.widened = self.counters.widened.saturating_add(1);
-            self.report.event = event;
-        }
-        // Heading.
-        if let (Some(state), Some(mag), Some(ms)) = (
-            self.magnetic.as_mut(),
-            self.config.magnetometer.as_ref(),
-            stats.mag,
-        ) {
-            let rotation = stats.rotation(&filter.state().gyro_bias);
-            let (status, fusion, event) =
-                state.fuse(filter, &ms, stats.duration, rotation, &self.config, mag)?;
-            self.report.magnetic = status;
-            self.report.fused.heading = fusion;
-            let c = &mut self.counters;
-            match status {
-                MagneticStatus::Fused => c.heading_fused = c.heading_fused.saturating_add(1),
-                MagneticStatus::Rejected => {
-                    c.heading_rejected = c.heading_rejected.saturating_add(1);
+        match pending.stage {
+            Stage::Gravity => {
+                let fused = tilt::fuse(
+                    filter,
+                    &stats,
+                    pending.sigma,
+                    &self.config,
+                    &mut self.tilt_rejected,
+                );
+                self.pending = match (stats.mag, self.magnetic.is_some()) {
+                    (Some(_), true) => Some(Pending {
+                        stage: Stage::Heading,
+                        ..pending
+                    }),
+                    _ => None,
+                };
+                let Ok((fusion, event)) = fused else {
+                    self.failed();
+                    return;
+                };
+                self.report.fused.gravity = Some(fusion);
+                let c = &mut self.counters;
+                if fusion.accepted {
+                    c.gravity_fused = c.gravity_fused.saturating_add(1);
+                } else {
+                    c.gravity_rejected = c.gravity_rejected.saturating_add(1);
                 }
-                MagneticStatus::Disturbed => {
-                    c.magnetic_disturbed = c.magnetic_disturbed.saturating_add(1);
+                if event.is_some() {
+                    c.widened = c.widened.saturating_add(1);
+                    self.report.event = event;
                 }
-                MagneticStatus::NotConfigured | MagneticStatus::Waiting => {}
             }
-            match event {
-                Some(Event::HeadingWidened) => c.widened = c.widened.saturating_add(1),
-                Some(Event::NewMagneticField) => c.new_fields = c.new_fields.saturating_add(1),
-                _ => {}
-            }
-            if event.is_some() {
-                self.report.event = event;
+            Stage::Heading => {
+                self.pending = None;
+                let (Some(state), Some(mag), Some(ms)) = (
+                    self.magnetic.as_mut(),
+                    self.config.magnetometer.as_ref(),
+                    stats.mag,
+                ) else {
+                    return;
+                };
+                let rotation = stats.rotation(&filter.state().gyro_bias);
+                let fused = state.fuse(filter, &ms, stats.duration, rotation, &self.config, mag);
+                let Ok((status, fusion, event)) = fused else {
+                    self.failed();
+                    return;
+                };
+                self.report.magnetic = status;
+                self.report.fused.heading = fusion;
+                let c = &mut self.counters;
+                match status {
+                    MagneticStatus::Fused => c.heading_fused = c.heading_fused.saturating_add(1),
+                    MagneticStatus::Rejected => {
+                        c.heading_rejected = c.heading_rejected.saturating_add(1);
+                    }
+                    MagneticStatus::Disturbed => {
+                        c.magnetic_disturbed = c.magnetic_disturbed.saturating_add(1);
+                    }
+                    MagneticStatus::NotConfigured | MagneticStatus::Waiting => {}
+                }
+                match event {
+                    Some(Event::HeadingWidened) => c.widened = c.widened.saturating_add(1),
+                    Some(Event::NewMagneticField) => {
+                        c.new_fields = c.new_fields.saturating_add(1);
+                    }
+                    _ => {}
+                }
+                if event.is_some() {
+                    self.report.event = event;
+                }
             }
         }
-        Ok(())
     }
 
     /// The validity of tilt and heading from the current covariance.

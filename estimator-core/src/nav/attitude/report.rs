@@ -174,4 +174,7 @@ pub struct Counters {
     pub realigned: u32,
     /// New reference fields taken.
     pub new_fields: u32,
+    /// Updates the filter refused (a numerical failure; the filter was left as it was and
+    /// the update skipped).
+    pub numerical_failures: u32,
 }

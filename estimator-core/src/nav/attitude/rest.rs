@@ -47,12 +47,13 @@ pub(super) fn mean_rate_variance<T: Real>(stats: &BlockStats<T>, config: &Attitu
 }
 
 /// The zero-rate update of a block at rest.
+#[inline(never)] // its own stack frame, not the caller's
 pub(super) fn fuse<T: Real>(
     filter: &mut AhrsAccelBias<T>,
     stats: &BlockStats<T>,
     config: &AttitudeConfig<T>,
 ) -> Result<Fusion<T>, NavError> {
-    let sigma = mean_rate_variance(stats, config).sqrt();
+    let sigma = mean_rate_variance(stats, config).sqrt_rn();
     let outcome = filter.update(
         &ZeroRate::new(stats.gyro_mean, sigma),
         &UpdateOptions::default(),

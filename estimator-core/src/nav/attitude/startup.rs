@@ -28,6 +28,7 @@ use crate::Real;
 use nalgebra::Vector3;
 
 /// The filter started from a start-up window, and whether the window was still.
+#[inline(never)] // its own stack frame, not the caller's
 pub(super) fn start<T: Real>(
     stats: &BlockStats<T>,
     config: &AttitudeConfig<T>,
@@ -37,7 +38,7 @@ pub(super) fn start<T: Real>(
     let g = mat3::norm(&config.filter.gravity);
     let still = is_still(stats, bias_prior, config, g);
     let (gyro_bias, bias_sigma) = if still {
-        (stats.gyro_mean, mean_rate_variance(stats, config).sqrt())
+        (stats.gyro_mean, mean_rate_variance(stats, config).sqrt_rn())
     } else {
         (*bias_prior, config.gyro_bias_sigma)
     };
@@ -50,7 +51,7 @@ pub(super) fn start<T: Real>(
         g,
     );
     let bias = config.accelerometer_bias_sigma;
-    let tilt = (motion * motion + bias * bias).sqrt() / g;
+    let tilt = (motion * motion + bias * bias).sqrt_rn() / g;
 
     let up_body = stats.accel_body / stats.accel_norm;
     // The field and its reference, when both exist (a missing reference is learned here).
@@ -89,14 +90,14 @@ pub(super) fn start<T: Real>(
             let vertical = m.dot(&up_body);
             let horizontal = mat3::norm(&(m - up_body * vertical));
             let white = mag.sigma / horizontal;
-            let tan_dip =
-                reference.z.abs() / (reference.x * reference.x + reference.y * reference.y).sqrt();
+            let tan_dip = reference.z.abs()
+                / (reference.x * reference.x + reference.y * reference.y).sqrt_rn();
             let coupling = tan_dip * tilt;
             (white * white / T::from_count((*n).max(1))
                 + mag.heading_noise * mag.heading_noise / stats.duration
                 + mag.heading_floor * mag.heading_floor
                 + coupling * coupling)
-                .sqrt()
+                .sqrt_rn()
         }
         None => T::pi(),
     };

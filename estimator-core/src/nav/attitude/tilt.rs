@@ -80,7 +80,7 @@ pub(super) fn specific_force_sigma<T: Real>(
 ) -> T {
     let white = white_sq(stats, config) / T::from_count(stats.n.max(1));
     if config.rotation_only {
-        return white.sqrt();
+        return white.sqrt_rn();
     }
     let two_tau = T::lit(2.0) * config.acceleration_correlation_s;
     let keep = if stats.duration > two_tau {
@@ -91,7 +91,7 @@ pub(super) fn specific_force_sigma<T: Real>(
     let vertical = stats.accel_norm - g;
     let inside = power * keep;
     let motion = if inside > slow { inside } else { slow };
-    (white + motion + vertical * vertical).sqrt()
+    (white + motion + vertical * vertical).sqrt_rn()
 }
 
 /// The running mean of `(‖f̄‖ − ‖g‖)²` over the last `motion_memory_s` (first order, weight
@@ -121,6 +121,7 @@ pub(super) fn world_attitude_covariance<T: Real, S: ErrorState<T, N>, const N: u
 /// `max_rejected_blocks` rejections in a row (`rejected` counts them).
 /// Returns the update's outcome (after the widening, if there was one), and the event if the
 /// covariance was widened.
+#[inline(never)] // its own stack frame, not the caller's
 pub(super) fn fuse<T: Real>(
     filter: &mut AhrsAccelBias<T>,
     stats: &BlockStats<T>,

@@ -85,6 +85,7 @@ fn triad<T: Real>(u: &Vector3<T>, h: &Vector3<T>) -> Matrix3<T> {
 /// Errors: [`EskfError::EmptyWindow`], [`EskfError::NonFinite`], [`EskfError::ZeroNorm`] (zero
 /// mean accelerometer, magnetometer or reference, or a field with no horizontal part).
 #[allow(clippy::question_mark)] // the matches on vector results: see the module docs
+#[inline(never)] // once at start-up: its vectors stay out of the caller's frame
 pub fn align_at_rest<T: Real>(
     accel: &[Vector3<T>],
     gyro: &[Vector3<T>],

@@ -2,14 +2,14 @@
 
 use super::align::{prior_attitude_covariance, Alignment, InitialSigmas};
 use super::config::{FilterConfig, ImuSample};
-use super::covariance::{check_start, sigmas};
+use super::covariance::{check_start, is_spd, sigmas};
 use super::error::{EskfError, UpdateOutcome};
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use super::update::{update, Measurement, UpdateOptions};
 use crate::kernels::block::{add_scaled_identity, block, set_block};
-use crate::kernels::{all_finite, non_negative_finite};
+use crate::kernels::{all_finite, non_negative_finite, positive_finite};
 use crate::Real;
-use nalgebra::{SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 /// The on-manifold error-state Kalman filter over the nominal state `S` with an
 /// `N`-dimensional error state: the state, its full `N × N` covariance `P` and the
@@ -199,6 +199,53 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
     }
 }
 
+impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
+    /// A filter from a block-diagonal prior: `attitude` (3 × 3) on block 0 and `variances[k]`
+    /// times the identity on block `k + 1`. Such a `P` is symmetric positive definite exactly
+    /// when the attitude block is and every variance is positive, so that is what is checked
+    /// (a 3 × 3 factorization, not one of `P`).
+    fn from_block_diagonal(
+        state: S,
+        attitude: &Matrix3<T>,
+        variances: &[T],
+        config: FilterConfig<T>,
+    ) -> Result<Self, EskfError> {
+        config.validate()?;
+        let mut filter = Self {
+            state,
+            covariance: SMatrix::zeros(),
+            config,
+        };
+        filter.reset_block_diagonal(state, attitude, variances)?;
+        Ok(filter)
+    }
+
+    /// Replaces state and covariance by `state` and the block-diagonal prior of
+    /// [`Filter::from_block_diagonal`], in place (no second `P` on the stack); on `Err` the
+    /// filter is unchanged.
+    fn reset_block_diagonal(
+        &mut self,
+        state: S,
+        attitude: &Matrix3<T>,
+        variances: &[T],
+    ) -> Result<(), EskfError> {
+        if !state.is_finite() {
+            return Err(EskfError::NonFinite);
+        }
+        let spd = is_spd(attitude) && variances.iter().all(|v| positive_finite(*v));
+        if !spd {
+            return Err(EskfError::CovarianceNotPositiveDefinite);
+        }
+        self.state = state;
+        self.covariance = SMatrix::zeros();
+        set_block(&mut self.covariance, 0, 0, attitude);
+        for (k, v) in variances.iter().enumerate() {
+            add_scaled_identity(&mut self.covariance, k + 1, k + 1, *v);
+        }
+        Ok(())
+    }
+}
+
 impl<T: Real> Filter<T, InsState<T>, 15> {
     /// From a static [`Alignment`] at `position` (velocity zero, accelerometer bias zero), with
     /// the initial uncertainties `sigmas` (attitude covariance from
@@ -206,13 +253,13 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
     ///
     /// # Errors
     /// As [`Filter::new`], and [`EskfError::ZeroNorm`] for a zero gravity.
+    #[inline(never)] // once at start-up: its matrices stay out of the caller's frame
     pub fn from_alignment(
         alignment: &Alignment<T>,
         position: Vector3<T>,
         sigmas: &InitialSigmas<T>,
         config: FilterConfig<T>,
     ) -> Result<Self, EskfError> {
-        config.validate()?;
         let state = InsState {
             attitude: alignment.attitude,
             velocity: Vector3::zeros(),
@@ -220,17 +267,18 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
             gyro_bias: alignment.gyro_bias,
             accel_bias: Vector3::zeros(),
         };
-        let mut p = SMatrix::<T, 15, 15>::zeros();
-        match prior_attitude_covariance(alignment, sigmas, &config) {
-            Ok(attitude) => set_block(&mut p, 0, 0, &attitude),
+        let attitude = match prior_attitude_covariance(alignment, sigmas, &config) {
+            Ok(a) => a,
             Err(e) => return Err(e),
-        }
+        };
         let sq = |s: T| s * s;
-        add_scaled_identity(&mut p, 1, 1, sq(sigmas.velocity));
-        add_scaled_identity(&mut p, 2, 2, sq(sigmas.position));
-        add_scaled_identity(&mut p, 3, 3, sq(sigmas.gyro_bias));
-        add_scaled_identity(&mut p, 4, 4, sq(sigmas.accel_bias));
-        Self::new(state, p, config)
+        let variances = [
+            sq(sigmas.velocity),
+            sq(sigmas.position),
+            sq(sigmas.gyro_bias),
+            sq(sigmas.accel_bias),
+        ];
+        Self::from_block_diagonal(state, &attitude, &variances, config)
     }
 }
 
@@ -239,23 +287,22 @@ impl<T: Real> Filter<T, AhrsState<T>, 6> {
     ///
     /// # Errors
     /// As [`Filter::new`], and [`EskfError::ZeroNorm`] for a zero gravity.
+    #[inline(never)] // once at start-up: its matrices stay out of the caller's frame
     pub fn from_alignment(
         alignment: &Alignment<T>,
         sigmas: &InitialSigmas<T>,
         config: FilterConfig<T>,
     ) -> Result<Self, EskfError> {
-        config.validate()?;
-        let mut p = SMatrix::<T, 6, 6>::zeros();
-        match prior_attitude_covariance(alignment, sigmas, &config) {
-            Ok(attitude) => set_block(&mut p, 0, 0, &attitude),
+        let attitude = match prior_attitude_covariance(alignment, sigmas, &config) {
+            Ok(a) => a,
             Err(e) => return Err(e),
-        }
-        add_scaled_identity(&mut p, 1, 1, sigmas.gyro_bias * sigmas.gyro_bias);
+        };
         let state = AhrsState {
             attitude: alignment.attitude,
             gyro_bias: alignment.gyro_bias,
         };
-        Self::new(state, p, config)
+        let variances = [sigmas.gyro_bias * sigmas.gyro_bias];
+        Self::from_block_diagonal(state, &attitude, &variances, config)
     }
 }
 
@@ -265,24 +312,45 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 9> {
     ///
     /// # Errors
     /// As [`Filter::new`], and [`EskfError::ZeroNorm`] for a zero gravity.
+    #[inline(never)] // once at start-up: its matrices stay out of the caller's frame
     pub fn from_alignment(
         alignment: &Alignment<T>,
         sigmas: &InitialSigmas<T>,
         config: FilterConfig<T>,
     ) -> Result<Self, EskfError> {
         config.validate()?;
-        let mut p = SMatrix::<T, 9, 9>::zeros();
-        match prior_attitude_covariance(alignment, sigmas, &config) {
-            Ok(attitude) => set_block(&mut p, 0, 0, &attitude),
+        let mut filter = Self {
+            state: AhrsAccelBiasState::identity(),
+            covariance: SMatrix::zeros(),
+            config,
+        };
+        filter.restart_from_alignment(alignment, sigmas)?;
+        Ok(filter)
+    }
+
+    /// Starts this filter again from an [`Alignment`], as [`Filter::from_alignment`] with its
+    /// own configuration, in place (a navigator restarting its filter holds one `P`, not two).
+    ///
+    /// # Errors
+    /// A non-finite alignment, a sigma that is not positive and finite, or a zero gravity; the
+    /// filter is then unchanged.
+    #[inline(never)] // once at start-up: its matrices stay out of the caller's frame
+    pub fn restart_from_alignment(
+        &mut self,
+        alignment: &Alignment<T>,
+        sigmas: &InitialSigmas<T>,
+    ) -> Result<(), EskfError> {
+        let attitude = match prior_attitude_covariance(alignment, sigmas, &self.config) {
+            Ok(a) => a,
             Err(e) => return Err(e),
-        }
-        add_scaled_identity(&mut p, 1, 1, sigmas.gyro_bias * sigmas.gyro_bias);
-        add_scaled_identity(&mut p, 2, 2, sigmas.accel_bias * sigmas.accel_bias);
+        };
         let state = AhrsAccelBiasState {
             attitude: alignment.attitude,
             gyro_bias: alignment.gyro_bias,
             accel_bias: Vector3::zeros(),
         };
-        Self::new(state, p, config)
+        let sq = |s: T| s * s;
+        let variances = [sq(sigmas.gyro_bias), sq(sigmas.accel_bias)];
+        self.reset_block_diagonal(state, &attitude, &variances)
     }
 }

@@ -27,9 +27,9 @@ use core::hint::black_box as bb;
 use cortex_m_rt::entry;
 use estimator_core::eskf::{
     align_at_rest, AccelerometerAtRest, Ahrs, AhrsAccelBias, AhrsAccelBiasState, AhrsState,
-    BaroAltitude, CameraLandmark, ErrorState, FilterConfig, Gate, GateProbability, GnssPosition,
-    GnssVelocity, GravityDirection, Heading, ImuNoise, ImuSample, InitialSigmas, Ins, InsState,
-    MagneticHeading, Magnetometer, MagnetometerWindow, Measurement, PinholeIntrinsics,
+    Alignment, BaroAltitude, CameraLandmark, ErrorState, FilterConfig, Gate, GateProbability,
+    GnssPosition, GnssVelocity, GravityDirection, Heading, ImuNoise, ImuSample, InitialSigmas, Ins,
+    InsState, MagneticHeading, Magnetometer, MagnetometerWindow, Measurement, PinholeIntrinsics,
     UpdateOptions, ZeroRate, ZeroVelocity,
 };
 use estimator_core::gn::{
@@ -326,6 +326,14 @@ fn ahrs_accel_bias<T: Real>(x: &Seed<T>, config: &FilterConfig<T>, opts: &Update
         dt: g,
     }));
     keep(&filter.widen_attitude(a, b));
+    let al = Alignment {
+        attitude: So3::exp(&v),
+        gyro_bias: w,
+        heading_from_magnetometer: bb(false),
+    };
+    let sigmas = bb(InitialSigmas::default());
+    keep(&AhrsAccelBias::from_alignment(&al, &sigmas, *config));
+    keep(&filter.restart_from_alignment(&al, &sigmas));
     keep(&filter.update(&ZeroRate::new(v, a), opts));
     keep(&filter.update(&AccelerometerAtRest::new(w, a), opts));
     keep(&filter.update(&MagneticHeading::new(v, w, d), opts));

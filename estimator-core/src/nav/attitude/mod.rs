@@ -40,7 +40,7 @@ pub use report::{
     Validity,
 };
 
-use crate::eskf::{AhrsAccelBias, ImuSample};
+use crate::eskf::{AhrsAccelBias, AhrsAccelBiasState, ImuSample};
 use crate::kernels::{all_finite, mat3};
 use crate::lie::{LieGroup, So3};
 use crate::nav::clock::{Clock, Tick};
@@ -48,21 +48,13 @@ use crate::nav::error::NavError;
 use crate::Real;
 use block::Block;
 use magnetic::Magnetic;
-use nalgebra::Vector3;
-
-/// Where the navigator is.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Phase<T: Real> {
-    /// Collecting the start-up window; `frame` is the gyro-integrated rotation since its first
-    /// sample.
-    Starting { frame: So3<T> },
-    /// Filtering.
-    Running { filter: AhrsAccelBias<T> },
-}
+use nalgebra::{SMatrix, Vector3};
 
 /// The update a pending block makes next.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Stage {
+    /// The gyro at rest.
+    ZeroRate,
     /// The accelerometer.
     Gravity,
     /// The magnetometer.
@@ -96,7 +88,7 @@ fn nanoseconds<T: Real>(s: T) -> u32 {
 /// ```
 /// use estimator_core::eskf::{FilterConfig, ImuNoise};
 /// use estimator_core::nav::{AttitudeConfig, AttitudeNavigator, MagneticConfig};
-/// use nalgebra::Vector3;
+/// use nalgebra::{SMatrix, Vector3};
 ///
 /// let mut config = AttitudeConfig::<f32>::new(FilterConfig::default());
 /// config.magnetometer = Some(MagneticConfig::new(0.5, None)); // µT; reference learned
@@ -118,7 +110,12 @@ fn nanoseconds<T: Real>(s: T) -> u32 {
 pub struct AttitudeNavigator<T: Real> {
     config: AttitudeConfig<T>,
     durations: Durations,
-    phase: Phase<T>,
+    /// The filter: a placeholder until `running`, then the estimate.
+    filter: AhrsAccelBias<T>,
+    /// Started (`false`: collecting the start-up window).
+    running: bool,
+    /// During start-up: the gyro-integrated rotation since the window's first sample.
+    frame: So3<T>,
     block: Block<T>,
     /// The last finished block's remaining updates.
     pending: Option<Pending<T>>,
@@ -158,9 +155,13 @@ impl<T: Real> AttitudeNavigator<T> {
                 block: nanoseconds(config.block_s),
                 max_step: nanoseconds(config.filter.max_dt),
             },
-            phase: Phase::Starting {
-                frame: So3::identity(),
-            },
+            filter: AhrsAccelBias::new(
+                AhrsAccelBiasState::identity(),
+                SMatrix::identity(),
+                config.filter,
+            )?,
+            running: false,
+            frame: So3::identity(),
             block: Block::default(),
             pending: None,
             carry: So3::identity(),
@@ -200,10 +201,7 @@ impl<T: Real> AttitudeNavigator<T> {
     /// The filter, once started.
     #[must_use]
     pub fn filter(&self) -> Option<&AhrsAccelBias<T>> {
-        match &self.phase {
-            Phase::Running { filter } => Some(filter),
-            Phase::Starting { .. } => None,
-        }
+        self.running.then_some(&self.filter)
     }
 
     /// The report of the last call.
@@ -294,9 +292,10 @@ impl<T: Real> AttitudeNavigator<T> {
     /// magnetometer sample between two IMU samples would otherwise be rotated with the
     /// attitude of up to one interval earlier: a lag of `ω Δt`).
     fn frame_at(&self, t_ns: u64) -> So3<T> {
-        let (frame, bias) = match &self.phase {
-            Phase::Starting { frame } => (*frame, self.bias_prior),
-            Phase::Running { filter } => (filter.state().attitude, filter.state().gyro_bias),
+        let (frame, bias) = if self.running {
+            (self.filter.state().attitude, self.filter.state().gyro_bias)
+        } else {
+            (self.frame, self.bias_prior)
         };
         let (Some(last), Some((gyro, _))) = (self.imu_clock.last(), self.last_imu) else {
             return frame;
@@ -342,21 +341,18 @@ impl<T: Real> AttitudeNavigator<T> {
                 (true, Some((g0, a0))) => ((g0 + gyro) * T::lit(0.5), (a0 + accel) * T::lit(0.5)),
                 _ => (*gyro, *accel),
             };
-            match &mut self.phase {
-                Phase::Starting { frame } => {
-                    let w = (g_mid - self.bias_prior) * dt;
-                    *frame = frame.compose(&So3::exp(&w)).normalize();
-                }
-                Phase::Running { filter } => {
-                    let bias = filter.state().gyro_bias;
-                    filter.predict(&ImuSample {
-                        gyro: g_mid,
-                        accel: a_mid,
-                        dt,
-                    })?;
-                    // The rotation since the pending block's end, by the same increments.
-                    self.carry = self.carry.compose(&So3::exp(&((g_mid - bias) * dt)));
-                }
+            if self.running {
+                let bias = self.filter.state().gyro_bias;
+                self.filter.predict(&ImuSample {
+                    gyro: g_mid,
+                    accel: a_mid,
+                    dt,
+                })?;
+                // The rotation since the pending block's end, by the same increments.
+                self.carry = self.carry.compose(&So3::exp(&((g_mid - bias) * dt)));
+            } else {
+                let w = (g_mid - self.bias_prior) * dt;
+                self.frame = self.frame.compose(&So3::exp(&w)).normalize();
             }
             self.block.elapsed_ns = self.block.elapsed_ns.saturating_add(ns);
         }
@@ -365,10 +361,7 @@ impl<T: Real> AttitudeNavigator<T> {
         // At most one update of the pending block per call (the cost of a call stays that of
         // one update).
         self.fuse_pending_stage();
-        let frame = match &self.phase {
-            Phase::Starting { frame } => *frame,
-            Phase::Running { filter } => filter.state().attitude,
-        };
+        let frame = self.current_frame();
         self.block.accel.add(&frame.act(accel));
         self.block.frames += frame.rotation_matrix();
         self.block.gyro.add(gyro);
@@ -376,9 +369,10 @@ impl<T: Real> AttitudeNavigator<T> {
         self.last_imu = Some((*gyro, *accel));
         self.counters.imu = self.counters.imu.saturating_add(1);
         self.report.t_ns = t_ns;
-        let length = match self.phase {
-            Phase::Starting { .. } => self.durations.startup,
-            Phase::Running { .. } => self.durations.block,
+        let length = if self.running {
+            self.durations.block
+        } else {
+            self.durations.startup
         };
         if self.block.elapsed_ns >= length {
             // A block shorter than its updates: finish the previous one first.
@@ -391,6 +385,16 @@ impl<T: Real> AttitudeNavigator<T> {
         Ok(())
     }
 
+    /// The frame the samples are rotated into: the estimate once running, the start-up frame
+    /// before.
+    fn current_frame(&self) -> So3<T> {
+        if self.running {
+            self.filter.state().attitude
+        } else {
+            self.frame
+        }
+    }
+
     /// Counts an update the filter refused (a numerical failure: the filter is unchanged).
     fn failed(&mut self) {
         self.counters.numerical_failures = self.counters.numerical_failures.saturating_add(1);
@@ -398,12 +402,11 @@ impl<T: Real> AttitudeNavigator<T> {
 
     /// Back to start-up (after a gap), keeping the bias estimate and the magnetic reference.
     fn restart(&mut self) {
-        if let Phase::Running { filter } = &self.phase {
-            self.bias_prior = filter.state().gyro_bias;
+        if self.running {
+            self.bias_prior = self.filter.state().gyro_bias;
         }
-        self.phase = Phase::Starting {
-            frame: So3::identity(),
-        };
+        self.running = false;
+        self.frame = So3::identity();
         self.block = Block::default();
         self.pending = None;
         self.last_imu = None;
@@ -412,16 +415,14 @@ impl<T: Real> AttitudeNavigator<T> {
     }
 
     /// Closes the finished block: starts the filter from the start-up window, or widens for
-    /// the gyro's scale error, makes the zero-rate update at rest, and leaves the accelerometer
-    /// and magnetometer updates pending for the next calls.
+    /// the gyro's scale error and leaves the block's updates (zero rate at rest, accelerometer,
+    /// magnetometer) pending, one for each of the next calls.
     #[inline(never)]
     fn end_block(&mut self) {
-        let frame = match &self.phase {
-            Phase::Starting { frame } => *frame,
-            Phase::Running { filter } => filter.state().attitude,
-        };
-        let block = core::mem::take(&mut self.block);
-        let Some(stats) = block.stats(&frame) else {
+        let frame = self.current_frame();
+        let stats = self.block.stats(&frame);
+        self.block = Block::default();
+        let Some(stats) = stats else {
             return;
         };
         let g = mat3::norm(&self.config.filter.gravity);
@@ -430,28 +431,11 @@ impl<T: Real> AttitudeNavigator<T> {
             return;
         }
         let power = tilt::acceleration_power(&stats, tilt::white_sq(&stats, &self.config));
-        let filter = match &mut self.phase {
-            Phase::Starting { .. } => {
-                match startup::start(&stats, &self.config, &self.bias_prior, &mut self.magnetic) {
-                    Ok((filter, still)) => {
-                        self.phase = Phase::Running { filter };
-                        self.still_s = if still { stats.duration } else { T::zero() };
-                        self.last_power = power;
-                        self.report.at_rest = still;
-                        if self.report.event.is_none() {
-                            self.report.event = Some(Event::Started);
-                        }
-                        if stats.mag.is_some() && self.magnetic.is_some() {
-                            self.report.magnetic = MagneticStatus::Fused;
-                        }
-                    }
-                    // The window gave no attitude (a numerical failure): collect another.
-                    Err(_) => self.failed(),
-                }
-                return;
-            }
-            Phase::Running { filter } => filter,
-        };
+        if !self.running {
+            self.begin(&stats, power);
+            return;
+        }
+        let filter = &mut self.filter;
         // The gyro's scale and cross-axis errors over the block's rotation.
         let turned = self.config.gyro_scale_sigma * stats.rotation(&filter.state().gyro_bias);
         let widened = turned > T::zero() && filter.widen_attitude(turned, turned).is_err();
@@ -463,23 +447,8 @@ impl<T: Real> AttitudeNavigator<T> {
             T::zero()
         };
         self.report.at_rest = still && self.still_s >= self.config.rest_min_s;
-        let zero_rate = if self.report.at_rest {
-            Some(rest::fuse(filter, &stats, &self.config))
-        } else {
-            None
-        };
         if widened {
             self.failed();
-        }
-        match zero_rate {
-            Some(Ok(fusion)) => {
-                if fusion.accepted {
-                    self.counters.zero_rate = self.counters.zero_rate.saturating_add(1);
-                }
-                self.report.fused.zero_rate = Some(fusion);
-            }
-            Some(Err(_)) => self.failed(),
-            None => {}
         }
         let used_power = if power > self.last_power {
             power
@@ -493,97 +462,144 @@ impl<T: Real> AttitudeNavigator<T> {
         self.pending = Some(Pending {
             stats,
             sigma,
-            stage: Stage::Gravity,
+            stage: if self.report.at_rest {
+                Stage::ZeroRate
+            } else {
+                Stage::Gravity
+            },
         });
         self.carry = So3::identity();
+    }
+
+    /// Starts the filter from the start-up window's statistics, in the navigator's own storage
+    /// ([`AhrsAccelBias::restart_from_alignment`]).
+    fn begin(&mut self, stats: &block::BlockStats<T>, power: T) {
+        let start = startup::start(stats, &self.config, &self.bias_prior, &mut self.magnetic);
+        let started = match start {
+            Ok(s) => match self.filter.restart_from_alignment(&s.alignment, &s.sigmas) {
+                Ok(()) => Some(s.still),
+                Err(_) => None,
+            },
+            Err(_) => None,
+        };
+        let Some(still) = started else {
+            // The window gave no attitude (a numerical failure): collect another.
+            self.failed();
+            return;
+        };
+        self.running = true;
+        self.still_s = if still { stats.duration } else { T::zero() };
+        self.last_power = power;
+        self.report.at_rest = still;
+        if self.report.event.is_none() {
+            self.report.event = Some(Event::Started);
+        }
+        if stats.mag.is_some() && self.magnetic.is_some() {
+            self.report.magnetic = MagneticStatus::Fused;
+        }
     }
 
     /// The next update of the pending block, with its measurements carried from the block's
     /// end to now by the gyro (`v_now = C⁻¹ v_end`, `C` the rotation since the end).
     #[inline(never)]
     fn fuse_pending_stage(&mut self) {
-        let (Some(pending), Phase::Running { filter }) = (self.pending, &mut self.phase) else {
+        let (Some(pending), true) = (self.pending.as_mut(), self.running) else {
             self.pending = None;
             return;
         };
+        // Carried in place, and the carry restarted: the next stage carries from here.
         let back = self.carry.inverse();
-        let mut stats = pending.stats;
+        self.carry = So3::identity();
+        let stats = &mut pending.stats;
         stats.accel_body = back.act(&stats.accel_body);
         stats.bias_map = mat3::mul(&back.rotation_matrix(), &stats.bias_map);
         if let Some(m) = stats.mag.as_mut() {
             m.body = back.act(&m.body);
         }
-        match pending.stage {
+        let (filter, c, report) = (&mut self.filter, &mut self.counters, &mut self.report);
+        let next = match pending.stage {
+            Stage::ZeroRate => {
+                match rest::fuse(filter, stats, &self.config) {
+                    Ok(fusion) => {
+                        if fusion.accepted {
+                            c.zero_rate = c.zero_rate.saturating_add(1);
+                        }
+                        report.fused.zero_rate = Some(fusion);
+                    }
+                    Err(_) => c.numerical_failures = c.numerical_failures.saturating_add(1),
+                }
+                Some(Stage::Gravity)
+            }
             Stage::Gravity => {
                 let fused = tilt::fuse(
                     filter,
-                    &stats,
+                    stats,
                     pending.sigma,
                     &self.config,
                     &mut self.tilt_rejected,
                 );
-                self.pending = match (stats.mag, self.magnetic.is_some()) {
-                    (Some(_), true) => Some(Pending {
-                        stage: Stage::Heading,
-                        ..pending
-                    }),
-                    _ => None,
-                };
-                let Ok((fusion, event)) = fused else {
-                    self.failed();
-                    return;
-                };
-                self.report.fused.gravity = Some(fusion);
-                let c = &mut self.counters;
-                if fusion.accepted {
-                    c.gravity_fused = c.gravity_fused.saturating_add(1);
-                } else {
-                    c.gravity_rejected = c.gravity_rejected.saturating_add(1);
+                match fused {
+                    Ok((fusion, event)) => {
+                        report.fused.gravity = Some(fusion);
+                        if fusion.accepted {
+                            c.gravity_fused = c.gravity_fused.saturating_add(1);
+                        } else {
+                            c.gravity_rejected = c.gravity_rejected.saturating_add(1);
+                        }
+                        if event.is_some() {
+                            c.widened = c.widened.saturating_add(1);
+                            report.event = event;
+                        }
+                    }
+                    Err(_) => c.numerical_failures = c.numerical_failures.saturating_add(1),
                 }
-                if event.is_some() {
-                    c.widened = c.widened.saturating_add(1);
-                    self.report.event = event;
-                }
+                (stats.mag.is_some() && self.magnetic.is_some()).then_some(Stage::Heading)
             }
             Stage::Heading => {
-                self.pending = None;
-                let (Some(state), Some(mag), Some(ms)) = (
+                if let (Some(state), Some(mag), Some(ms)) = (
                     self.magnetic.as_mut(),
                     self.config.magnetometer.as_ref(),
-                    stats.mag,
-                ) else {
-                    return;
-                };
-                let rotation = stats.rotation(&filter.state().gyro_bias);
-                let fused = state.fuse(filter, &ms, stats.duration, rotation, &self.config, mag);
-                let Ok((status, fusion, event)) = fused else {
-                    self.failed();
-                    return;
-                };
-                self.report.magnetic = status;
-                self.report.fused.heading = fusion;
-                let c = &mut self.counters;
-                match status {
-                    MagneticStatus::Fused => c.heading_fused = c.heading_fused.saturating_add(1),
-                    MagneticStatus::Rejected => {
-                        c.heading_rejected = c.heading_rejected.saturating_add(1);
+                    stats.mag.as_ref(),
+                ) {
+                    let rotation = stats.rotation(&filter.state().gyro_bias);
+                    match state.fuse(filter, ms, stats.duration, rotation, &self.config, mag) {
+                        Ok((status, fusion, event)) => {
+                            report.magnetic = status;
+                            report.fused.heading = fusion;
+                            match status {
+                                MagneticStatus::Fused => {
+                                    c.heading_fused = c.heading_fused.saturating_add(1);
+                                }
+                                MagneticStatus::Rejected => {
+                                    c.heading_rejected = c.heading_rejected.saturating_add(1);
+                                }
+                                MagneticStatus::Disturbed => {
+                                    c.magnetic_disturbed = c.magnetic_disturbed.saturating_add(1);
+                                }
+                                MagneticStatus::NotConfigured | MagneticStatus::Waiting => {}
+                            }
+                            match event {
+                                Some(Event::HeadingWidened) => {
+                                    c.widened = c.widened.saturating_add(1);
+                                }
+                                Some(Event::NewMagneticField) => {
+                                    c.new_fields = c.new_fields.saturating_add(1);
+                                }
+                                _ => {}
+                            }
+                            if event.is_some() {
+                                report.event = event;
+                            }
+                        }
+                        Err(_) => c.numerical_failures = c.numerical_failures.saturating_add(1),
                     }
-                    MagneticStatus::Disturbed => {
-                        c.magnetic_disturbed = c.magnetic_disturbed.saturating_add(1);
-                    }
-                    MagneticStatus::NotConfigured | MagneticStatus::Waiting => {}
                 }
-                match event {
-                    Some(Event::HeadingWidened) => c.widened = c.widened.saturating_add(1),
-                    Some(Event::NewMagneticField) => {
-                        c.new_fields = c.new_fields.saturating_add(1);
-                    }
-                    _ => {}
-                }
-                if event.is_some() {
-                    self.report.event = event;
-                }
+                None
             }
+        };
+        match next {
+            Some(stage) => pending.stage = stage,
+            None => self.pending = None,
         }
     }
 

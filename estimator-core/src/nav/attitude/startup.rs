@@ -21,20 +21,20 @@ use super::config::AttitudeConfig;
 use super::magnetic::Magnetic;
 use super::rest::{is_still, mean_rate_variance};
 use super::tilt::{acceleration_power, specific_force_sigma, white_sq};
-use crate::eskf::{align_at_rest, AhrsAccelBias, InitialSigmas, MagnetometerWindow};
+use crate::eskf::{align_at_rest, Alignment, InitialSigmas, MagnetometerWindow};
 use crate::kernels::mat3;
 use crate::nav::error::NavError;
 use crate::Real;
 use nalgebra::Vector3;
 
-/// The filter started from a start-up window, and whether the window was still.
+/// The first attitude from a start-up window (module docs).
 #[inline(never)] // its own stack frame, not the caller's
 pub(super) fn start<T: Real>(
     stats: &BlockStats<T>,
     config: &AttitudeConfig<T>,
     bias_prior: &Vector3<T>,
     magnetic: &mut Option<Magnetic<T>>,
-) -> Result<(AhrsAccelBias<T>, bool), NavError> {
+) -> Result<Start<T>, NavError> {
     let g = mat3::norm(&config.filter.gravity);
     let still = is_still(stats, bias_prior, config, g);
     let (gyro_bias, bias_sigma) = if still {
@@ -108,6 +108,19 @@ pub(super) fn start<T: Real>(
         accel_bias: config.accelerometer_bias_sigma,
         ..InitialSigmas::default()
     };
-    let filter = AhrsAccelBias::from_alignment(&alignment, &sigmas, config.filter)?;
-    Ok((filter, still))
+    Ok(Start {
+        alignment,
+        sigmas,
+        still,
+    })
+}
+
+/// What the start-up window gives: the first attitude and bias, their uncertainties, and
+/// whether the window was still (the filter is built from them by
+/// [`AhrsAccelBias::from_alignment`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Start<T: Real> {
+    pub(super) alignment: Alignment<T>,
+    pub(super) sigmas: InitialSigmas<T>,
+    pub(super) still: bool,
 }

@@ -44,7 +44,7 @@ use crate::kernels::mat3;
 use crate::lie::LieGroup;
 use crate::nav::error::NavError;
 use crate::Real;
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 /// The per-axis variance of the linear acceleration beyond the white noise in a block,
 /// `q = max(0, s² − 3σ_s²)/3`, (m/s²)².
@@ -131,9 +131,10 @@ pub(super) fn fuse<T: Real>(
 ) -> Result<(Fusion<T>, Option<Event>), NavError> {
     // The bias turned with the body during the block: the block sees `M b_a`.
     let model = AccelerometerAtRest {
+        accel: stats.accel_body,
         gravity: config.filter.gravity,
+        noise: Matrix3::from_diagonal_element(sigma * sigma),
         bias_map: stats.bias_map,
-        ..AccelerometerAtRest::new(stats.accel_body, sigma)
     };
     let options = UpdateOptions::default();
     let mut event = None;

@@ -254,6 +254,7 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
     /// # Errors
     /// As [`Filter::new`], and [`EskfError::ZeroNorm`] for a zero gravity.
     #[inline(never)] // once at start-up: its matrices stay out of the caller's frame
+    #[allow(clippy::question_mark)] // a matched, not propagated, matrix result (see `align`)
     pub fn from_alignment(
         alignment: &Alignment<T>,
         position: Vector3<T>,
@@ -288,6 +289,7 @@ impl<T: Real> Filter<T, AhrsState<T>, 6> {
     /// # Errors
     /// As [`Filter::new`], and [`EskfError::ZeroNorm`] for a zero gravity.
     #[inline(never)] // once at start-up: its matrices stay out of the caller's frame
+    #[allow(clippy::question_mark)] // a matched, not propagated, matrix result (see `align`)
     pub fn from_alignment(
         alignment: &Alignment<T>,
         sigmas: &InitialSigmas<T>,
@@ -313,6 +315,7 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 9> {
     /// # Errors
     /// As [`Filter::new`], and [`EskfError::ZeroNorm`] for a zero gravity.
     #[inline(never)] // once at start-up: its matrices stay out of the caller's frame
+    #[allow(clippy::question_mark)] // a matched, not propagated, matrix result (see `align`)
     pub fn from_alignment(
         alignment: &Alignment<T>,
         sigmas: &InitialSigmas<T>,
@@ -335,6 +338,7 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 9> {
     /// A non-finite alignment, a sigma that is not positive and finite, or a zero gravity; the
     /// filter is then unchanged.
     #[inline(never)] // once at start-up: its matrices stay out of the caller's frame
+    #[allow(clippy::question_mark)] // a matched, not propagated, matrix result (see `align`)
     pub fn restart_from_alignment(
         &mut self,
         alignment: &Alignment<T>,

@@ -153,6 +153,19 @@ else
     || { cat "$OUT/nopanic-selftest.log"; fail "no-panic self-test failed for another reason"; }
 fi
 
+# The starter (src/bin/starter.rs): the navigator and the 15-state filter in a main loop, the file
+# a user copies. It must build and pass its own check under QEMU.
+step "starter firmware: builds, runs under QEMU, passes its check"
+if cargo build-m4 --release --bin starter 2> "$OUT/starter.log" \
+  && timeout 120 qemu-system-arm -machine mps2-an386 -cpu cortex-m4 -nographic -monitor none \
+    -serial none -semihosting-config enable=on,target=native \
+    -kernel "target/$TARGET/release/starter" > "$OUT/starter-run.txt"; then
+  tail -n 2 "$OUT/starter-run.txt"
+else
+  tail -n 20 "$OUT/starter.log" "$OUT/starter-run.txt" 2> /dev/null || true
+  fail "starter firmware"
+fi
+
 # Single-purpose firmware (attitude filter, inertial filter, PnP): each must link (no panic path)
 # at opt-level "s" and 3; their flash is budgeted below.
 for b in fp_ahrs fp_ins fp_pnp; do

@@ -425,9 +425,10 @@ pub fn attitude_samples<T: Scalar>(mut f: impl FnMut(Sample<T>)) {
     }
 }
 
-/// The navigator just before one IMU call that ends a block at rest (prediction, widening,
-/// block statistics, zero-rate update), which the demo measures again; the costliest call of
-/// the whole stream is measured over the stream (`nav_stream_max_call`).
+/// The navigator just before the IMU call at rest that makes a block's zero-rate update (the
+/// prediction and the update; the block ended in an earlier call), which the demo measures
+/// again; the costliest call of the whole stream is measured over the stream
+/// (`nav_stream_max_call`).
 #[derive(Clone, Copy, Debug)]
 pub struct NavStep<T: Real> {
     /// The navigator before the call.
@@ -537,9 +538,8 @@ fn nav<T: Scalar>(out: &mut Outcome<T>) -> Option<(AttitudeNavigator<T>, Option<
             let before = nav;
             match nav.imu(t_ns, &gyro, &accel) {
                 Ok(r) => {
-                    // The call that ends a block at rest: prediction, widening, block
-                    // statistics and the zero-rate update (the accelerometer and magnetometer
-                    // updates of that block follow in the next two calls).
+                    // The call at rest that makes a block's zero-rate update (the block's
+                    // accelerometer and magnetometer updates follow in the next two calls).
                     if r.at_rest && fused(r.fused.zero_rate) {
                         step = Some(NavStep {
                             nav: before,

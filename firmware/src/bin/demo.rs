@@ -370,10 +370,10 @@ impl Updates {
     }
 }
 
-/// Benchmarks the navigator's IMU call that ends a block at rest: the prediction, the attitude
-/// widening for the block's rotation, the block statistics and the zero-rate update (the
-/// block's accelerometer and magnetometer updates come in the next two calls). Returns whether
-/// the same call on another copy fused the zero rate.
+/// Benchmarks the navigator's IMU call at rest that makes a block's zero-rate update (the
+/// prediction and the update; the block ended in an earlier call, its accelerometer and
+/// magnetometer updates come in the next two). Returns whether the same call on another copy
+/// fused the zero rate.
 fn bench_nav_step(index: &mut u32, s: &scenario::NavStep<f32>) -> bool {
     let mut nav = s.nav;
     bench(index, "nav_imu_block_end", || {

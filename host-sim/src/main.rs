@@ -167,42 +167,37 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
         Command::Montecarlo {
             scenario,
             runs,
+            seed,
+            out,
+            json,
+            force,
             check,
         } => {
             let sc = Scenario::load(&scenario)?;
-            let report = host_sim::montecarlo::run(&sc, runs, 20.0, true)?;
-            out!(
-                "scenario {}: {} runs; 95 % chi-square bands",
-                sc.name,
-                report.runs
-            );
-            out!(
-                "  {:<22} {:>8} {:>8} {:>17} {:>8} {:>7}",
-                "statistic",
-                "value",
-                "expect",
-                "band",
-                "inside",
-                "holds"
-            );
-            for r in report.nees.iter().chain(&report.nis) {
-                let label = if r.fraction_inside.is_some() {
-                    format!("ANEES {}", r.name)
-                } else {
-                    format!("NIS {}", r.name)
-                };
-                let inside = r
-                    .fraction_inside
-                    .map_or("-".into(), |f| format!("{:.0} %", 100.0 * f));
+            // The output folder is checked before the runs, not after.
+            let staging = match &out {
+                Some(o) => Some(Staging::new(o, force, "montecarlo")?),
+                None => None,
+            };
+            let settle = host_sim::montecarlo::DEFAULT_SETTLE_S;
+            let report = host_sim::montecarlo::run_from(&sc, seed, runs, settle, true)?;
+            let command_line: Vec<String> = std::env::args_os()
+                .map(|a| a.to_string_lossy().into_owned())
+                .collect();
+            if let Some(staging) = staging {
+                report.write(staging.dir(), &command_line)?;
+                staging.commit()?;
+            }
+            if json {
                 out!(
-                    "  {:<22} {:>8.3} {:>8.3} {:>17} {:>8} {:>7}",
-                    label,
-                    r.value,
-                    r.expected,
-                    format!("[{:.3}, {:.3}]", r.lower, r.upper),
-                    inside,
-                    if r.holds() { "yes" } else { "NO" }
+                    "{}",
+                    serde_json::to_string_pretty(&report.json(&command_line))?
                 );
+            } else {
+                out!("{}", report.table().trim_end());
+                if let Some(o) = &out {
+                    out!("  outputs in {}", o.display());
+                }
             }
             if check && !report.holds() {
                 return Err("a consistency band is missed".into());

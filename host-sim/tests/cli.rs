@@ -940,3 +940,157 @@ fn a_missing_lever_arm_is_a_warning_in_the_summary() {
     assert_eq!(m["warnings"].as_array().map(Vec::len), Some(1));
     let _ = std::fs::remove_dir_all(&base);
 }
+
+/// A 26 s scenario file in `dir` (the Monte-Carlo bands leave out the first 20 s).
+fn short_montecarlo_scenario(dir: &Path) -> PathBuf {
+    std::fs::create_dir_all(dir).expect("folder");
+    let file = dir.join("short.toml");
+    std::fs::write(
+        &file,
+        "name = \"short\"\nduration_s = 26.0\nstatic_s = 3.0\nshape = \"car\"\n[mag]\nrate_hz = 25.0\n[gnss]\nrate_hz = 2.0\n",
+    )
+    .expect("write");
+    file
+}
+
+fn csv_rows(p: &Path) -> Vec<Vec<String>> {
+    String::from_utf8_lossy(&read(p))
+        .lines()
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect()
+}
+
+/// `montecarlo --out` writes runs.csv, bands.csv and montecarlo.json for the seeds asked for,
+/// `--json` prints the same JSON, and the output folder follows the rules of every command.
+#[test]
+fn montecarlo_writes_runs_bands_and_json() {
+    let base = tmp("montecarlo");
+    let scenario = short_montecarlo_scenario(&base);
+    let sc = scenario.to_str().expect("utf-8");
+    let out = base.join("out");
+    let out_s = out.to_str().expect("utf-8");
+    let args = [
+        "montecarlo",
+        "--scenario",
+        sc,
+        "--runs",
+        "2",
+        "--seed",
+        "5",
+        "--out",
+        out_s,
+    ];
+    let o = host_sim(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("ANEES attitude"), "{stdout}");
+
+    let runs = csv_rows(&out.join("runs.csv"));
+    assert_eq!(runs.len(), 3, "header and one row per run");
+    let header = &runs[0];
+    for col in [
+        "seed",
+        "ate_position_rmse_m",
+        "attitude_rmse_deg",
+        "velocity_rmse_mps",
+        "anees_attitude",
+        "nis_mean_gnss_position",
+        "accepted_mag",
+        "gated_out_mag",
+        "refused_mag",
+    ] {
+        assert!(header.iter().any(|h| h == col), "{col} not in {header:?}");
+    }
+    assert_eq!((runs[1][0].as_str(), runs[2][0].as_str()), ("5", "6"));
+    for row in &runs[1..] {
+        assert_eq!(row.len(), header.len());
+        assert!(
+            row.iter()
+                .all(|c| c.parse::<f64>().is_ok_and(f64::is_finite)),
+            "every figure is estimated here: {row:?}"
+        );
+    }
+
+    let bands = csv_rows(&out.join("bands.csv"));
+    assert_eq!(
+        bands[0],
+        [
+            "statistic",
+            "value",
+            "expected",
+            "lower",
+            "upper",
+            "fraction_inside",
+            "holds"
+        ]
+    );
+    assert!(bands.len() > 1, "no band: {bands:?}");
+    for row in &bands[1..] {
+        assert!(
+            stdout.contains(&row[0]),
+            "{} is in bands.csv, not in the table",
+            row[0]
+        );
+    }
+
+    let json: serde_json::Value =
+        serde_json::from_slice(&read(&out.join("montecarlo.json"))).expect("json");
+    assert_eq!(json["seeds"], serde_json::json!([5, 6]));
+    assert_eq!(json["runs"], 2);
+    assert_eq!(json["scenario"], "short");
+    assert_eq!(json["host_sim_version"], env!("CARGO_PKG_VERSION"));
+    assert!(json["precision"].is_string() && json["settle_s"].is_number());
+    assert!(json["command_line"]
+        .as_array()
+        .is_some_and(|a| a.iter().any(|v| v == "montecarlo")));
+    assert_eq!(json["per_run"].as_array().map(Vec::len), Some(2));
+    assert_eq!(json["per_run"][1]["seed"], 6);
+    assert_eq!(
+        json["bands"].as_array().map(Vec::len),
+        Some(bands.len() - 1)
+    );
+
+    // An earlier output needs --force; --json prints the same report, and --check fails
+    // exactly when a band is missed.
+    assert!(!host_sim(&args).status.success());
+    let mut forced = args.to_vec();
+    forced.extend(["--force", "--json", "--check"]);
+    let o = host_sim(&forced);
+    let printed: serde_json::Value = serde_json::from_slice(&o.stdout).expect("--json parses");
+    assert_eq!(printed["seeds"], json["seeds"]);
+    assert_eq!(printed["bands"], json["bands"]);
+    assert_eq!(printed["per_run"], json["per_run"]);
+    assert_eq!(Some(o.status.success()), printed["holds"].as_bool());
+
+    // Without --seed the runs start at 1, and without --out nothing is written.
+    let o = host_sim(&["montecarlo", "--scenario", sc, "--runs", "2", "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let printed: serde_json::Value = serde_json::from_slice(&o.stdout).expect("--json parses");
+    assert_eq!(printed["seeds"], serde_json::json!([1, 2]));
+
+    // A folder with files host-sim did not write is refused, even with --force, and left as
+    // it was.
+    let foreign = base.join("foreign");
+    std::fs::create_dir_all(&foreign).expect("folder");
+    std::fs::write(foreign.join("notes.txt"), "mine").expect("write");
+    let before = snapshot(&foreign);
+    let o = host_sim(&[
+        "montecarlo",
+        "--scenario",
+        sc,
+        "--runs",
+        "2",
+        "--out",
+        foreign.to_str().expect("utf-8"),
+        "--force",
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("did not write"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(snapshot(&foreign), before);
+    assert!(partial_folders_in(&base).is_empty());
+    let _ = std::fs::remove_dir_all(&base);
+}

@@ -6,7 +6,7 @@
 //! | `host-sim simulate --scenario NAME [--seed N] --out DIR [--force]` | write a dataset folder with ground truth ([`crate::dataset`]) |
 //! | `host-sim replay DATASET [--out DIR] [--config FILE] [--force]` | run the filter over a dataset folder, with or without ground truth |
 //! | `host-sim bench DIR [--out OUT] [--config FILE] [--force]` | replay every dataset folder under `DIR` (one and two levels deep) and print its scores beside the `references.json` of its folder ([`host_sim::bench`]; default `OUT`: `out/bench`) |
-//! | `host-sim montecarlo --scenario NAME --runs N` | consistency over seeds: NEES / NIS against chi-square bands |
+//! | `host-sim montecarlo --scenario NAME --runs N [--seed S] [--out DIR] [--json] [--force] [--check]` | consistency over the seeds `S`..`S+N-1`: NEES / NIS against chi-square bands; with `--out`, the runs and bands as CSV and JSON ([`host_sim::montecarlo`]) |
 //! | `host-sim calibrate DIR [--out DIR] [--from S] [--to S] [--force]` | IMU and magnetometer noise from a static recording (Allan deviation, `host_sim::calibrate`) |
 //! | `host-sim scenarios` | list the built-in scenarios |
 //!
@@ -135,16 +135,40 @@ Example: host-sim bench ../shared/datasets --out out/bench"
     },
     /// Consistency over seeds: NEES/NIS against chi-square bounds.
     #[command(
-        after_help = "Prints the mean NEES and NIS over the runs against their 95 % chi-square bands; \
-writes nothing.\n\nExample: host-sim montecarlo --scenario matched_ins --runs 60 --check"
+        after_help = "Simulates the scenario (a built-in name or a TOML file) once per seed, --seed to --seed + --runs - 1, \
+and replays each with the scenario's replay configuration (no plots).\n\
+Prints, after the first 20 s (the start-up), the ANEES per block and the mean NIS per sensor over the runs \
+against their 95 % chi-square bands, with the fraction of samples inside (NEES) and whether each holds; \
+--json prints montecarlo.json instead.\n\
+Writes with --out (nothing without it): runs.csv (one row per run: seed, ATE, attitude and velocity RMSE, \
+ANEES per block, mean NIS and accepted / gated-out / refused updates per sensor, each over the whole run as `run` reports it; \
+an empty cell where not estimated), \
+bands.csv (the printed table: statistic, value, expected, lower, upper, fraction_inside, holds) and montecarlo.json \
+(both, with the command line, scenario, precision, seeds, runs, settle time and host-sim version).\n\
+Exit status non-zero with --check when a band is missed (the outputs are still written).\n\n\
+Examples:\n  host-sim montecarlo --scenario matched_ins --runs 60 --check\n  \
+host-sim montecarlo --scenario matched_ahrs --runs 20 --seed 101 --out out/mc_ahrs"
     )]
     Montecarlo {
         /// A built-in scenario name or a TOML file.
         #[arg(long)]
         scenario: String,
         /// Number of runs.
-        #[arg(long, default_value_t = 25)]
+        #[arg(long, default_value_t = 25, value_parser = clap::value_parser!(u64).range(1..))]
         runs: u64,
+        /// Random seed of the first run; the runs use --seed to --seed + --runs - 1.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Output folder for runs.csv, bands.csv and montecarlo.json (default: write nothing).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Print montecarlo.json to stdout instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
+        /// files is never replaced).
+        #[arg(long, requires = "out")]
+        force: bool,
         /// Exit non-zero when a band is missed.
         #[arg(long)]
         check: bool,

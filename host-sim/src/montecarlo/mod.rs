@@ -13,15 +13,29 @@
 //!   all updates of all runs (after `settle_s`, as for the NEES: the prior is deliberately wide)
 //!   is `χ²(Σ dof)`; the band of the mean NIS is `[χ²_{0.025}(D), χ²_{0.975}(D)] / count` with
 //!   `D = Σ dof`.
+//!
+//! The [`Report`] also keeps each run's figures ([`RunResult`]); [`Report::write`] writes
+//! `runs.csv` (one row per run), `bands.csv` (the band table) and `montecarlo.json` (both, with
+//! how they were made). A figure a run did not estimate is an empty cell (`null` in the JSON),
+//! never 0.
 
 use crate::dataset::write::simulate;
-use crate::metrics::{Scorer, BLOCKS};
+use crate::metrics::{Metrics, Scorer, BLOCKS};
 use crate::replay::{replay_scored, ReplayConfig};
 use crate::scenario::Scenario;
 use crate::stats::chi2_quantile;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use std::path::PathBuf;
+use serde_json::{json, Map, Value};
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The start-up the NEES and NIS tests leave out by default, s (`host-sim montecarlo`).
+pub const DEFAULT_SETTLE_S: f64 = 20.0;
+
+/// The files [`Report::write`] writes.
+pub const FILES: [&str; 3] = ["runs.csv", "bands.csv", "montecarlo.json"];
 
 /// One line of the report.
 #[derive(Clone, Debug, PartialEq)]
@@ -48,15 +62,45 @@ impl BandResult {
     }
 }
 
+/// The figures of one run.
+#[derive(Clone, Debug)]
+pub struct RunResult {
+    /// The run's random seed.
+    pub seed: u64,
+    /// Its figures over the whole run, as `host-sim run` reports them.
+    pub metrics: Metrics,
+}
+
 /// The whole Monte-Carlo report.
 #[derive(Clone, Debug)]
 pub struct Report {
+    /// The scenario's name.
+    pub scenario: String,
+    /// The filter's precision (`"f32"` or `"f64"`).
+    pub precision: String,
+    /// The start-up left out of the bands, s.
+    pub settle_s: f64,
     /// Runs that completed.
     pub runs: usize,
     /// NEES per block.
     pub nees: Vec<BandResult>,
     /// NIS per sensor.
     pub nis: Vec<BandResult>,
+    /// Each run's figures, in seed order.
+    pub per_run: Vec<RunResult>,
+}
+
+/// The empty cell for what was not estimated; a number otherwise.
+fn cell(x: Option<f64>) -> String {
+    match x {
+        Some(v) if !v.is_nan() => v.to_string(),
+        _ => String::new(),
+    }
+}
+
+/// `null` for what was not estimated (or is not finite); a number otherwise.
+fn number(x: Option<f64>) -> Value {
+    x.filter(|v| v.is_finite()).map_or(Value::Null, Value::from)
 }
 
 impl Report {
@@ -65,15 +109,307 @@ impl Report {
     pub fn holds(&self) -> bool {
         self.nees.iter().chain(&self.nis).all(BandResult::holds)
     }
+
+    /// The seeds of the runs, in order.
+    #[must_use]
+    pub fn seeds(&self) -> Vec<u64> {
+        self.per_run.iter().map(|r| r.seed).collect()
+    }
+
+    /// Every band with its label (`ANEES <block>`, `mean NIS <sensor>`), NEES first.
+    pub fn bands(&self) -> impl Iterator<Item = (String, &BandResult)> {
+        self.nees
+            .iter()
+            .map(|r| (format!("ANEES {}", r.name), r))
+            .chain(self.nis.iter().map(|r| (format!("mean NIS {}", r.name), r)))
+    }
+
+    /// The band table `host-sim montecarlo` prints.
+    #[must_use]
+    pub fn table(&self) -> String {
+        let mut t = String::new();
+        let seeds = self.seeds();
+        let _ = writeln!(
+            t,
+            "scenario {}: {} runs (seeds {}..={}), precision {}; 95 % chi-square bands after the first {} s",
+            self.scenario,
+            self.runs,
+            seeds.first().copied().unwrap_or_default(),
+            seeds.last().copied().unwrap_or_default(),
+            self.precision,
+            self.settle_s
+        );
+        let _ = writeln!(
+            t,
+            "  {:<26} {:>8} {:>8} {:>17} {:>8} {:>7}",
+            "statistic", "value", "expect", "band", "inside", "holds"
+        );
+        for (label, r) in self.bands() {
+            let inside = r
+                .fraction_inside
+                .map_or("-".into(), |f| format!("{:.0} %", 100.0 * f));
+            let _ = writeln!(
+                t,
+                "  {:<26} {:>8.3} {:>8.3} {:>17} {:>8} {:>7}",
+                label,
+                r.value,
+                r.expected,
+                format!("[{:.3}, {:.3}]", r.lower, r.upper),
+                inside,
+                if r.holds() { "yes" } else { "NO" }
+            );
+        }
+        if self.nees.is_empty() && self.nis.is_empty() {
+            let _ = writeln!(
+                t,
+                "  no band: nothing was scored after the first {} s",
+                self.settle_s
+            );
+        }
+        t
+    }
+
+    /// The blocks with a NEES and the sensors with updates in any run, in order.
+    fn columns(&self) -> (Vec<&'static str>, Vec<String>) {
+        let blocks = BLOCKS
+            .iter()
+            .copied()
+            .filter(|b| {
+                self.per_run
+                    .iter()
+                    .any(|r| r.metrics.nees_mean.contains_key(*b))
+            })
+            .collect();
+        let sensors: BTreeSet<String> = self
+            .per_run
+            .iter()
+            .flat_map(|r| {
+                let m = &r.metrics;
+                m.nis_mean
+                    .keys()
+                    .chain(m.updates_accepted.keys())
+                    .chain(m.updates_rejected.keys())
+                    .chain(m.updates_refused.keys())
+                    .cloned()
+            })
+            .collect();
+        (blocks, sensors.into_iter().collect())
+    }
+
+    /// One row per run after its seed: the column names, then each run's cells (`None`: not
+    /// estimated).
+    fn run_rows(&self) -> (Vec<String>, Vec<Vec<Option<f64>>>) {
+        let (blocks, sensors) = self.columns();
+        let mut header: Vec<String> = [
+            "ate_position_rmse_m",
+            "attitude_rmse_deg",
+            "velocity_rmse_mps",
+        ]
+        .iter()
+        .map(|s| (*s).to_string())
+        .collect();
+        header.extend(blocks.iter().map(|b| format!("anees_{b}")));
+        for s in &sensors {
+            header.extend(
+                ["nis_mean", "accepted", "gated_out", "refused"]
+                    .iter()
+                    .map(|c| format!("{c}_{s}")),
+            );
+        }
+        let rows = self
+            .per_run
+            .iter()
+            .map(|r| {
+                let m = &r.metrics;
+                let count = |map: &std::collections::BTreeMap<String, u64>, s: &String| {
+                    map.get(s).map(|&n| n as f64)
+                };
+                let mut row = vec![
+                    Some(m.ate_position_rmse_m),
+                    Some(m.attitude_rmse_deg),
+                    Some(m.velocity_rmse_mps),
+                ];
+                row.extend(blocks.iter().map(|b| m.nees_mean.get(*b).copied()));
+                for s in &sensors {
+                    row.push(m.nis_mean.get(s).copied());
+                    row.push(count(&m.updates_accepted, s));
+                    row.push(count(&m.updates_rejected, s));
+                    row.push(count(&m.updates_refused, s));
+                }
+                row
+            })
+            .collect();
+        (header, rows)
+    }
+
+    /// `runs.csv`: one row per run (seed, ATE, attitude and velocity RMSE, ANEES per block,
+    /// mean NIS and accepted / gated-out / refused updates per sensor, each over the whole run
+    /// as [`Scorer::metrics`] gives it, start-up included); an empty cell where the run
+    /// estimated nothing.
+    ///
+    /// # Errors
+    /// When the CSV writer fails (it writes to memory).
+    pub fn runs_csv(&self) -> Result<String, String> {
+        let (header, rows) = self.run_rows();
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let err = |e: csv::Error| e.to_string();
+        w.write_record(std::iter::once("seed").chain(header.iter().map(String::as_str)))
+            .map_err(err)?;
+        for (row, r) in rows.iter().zip(&self.per_run) {
+            let mut cells = vec![r.seed.to_string()];
+            cells.extend(row.iter().map(|c| cell(*c)));
+            w.write_record(&cells).map_err(err)?;
+        }
+        let bytes = w.into_inner().map_err(|e| e.to_string())?;
+        String::from_utf8(bytes).map_err(|e| e.to_string())
+    }
+
+    /// `bands.csv`: the printed band table (statistic, value, expected, lower, upper,
+    /// fraction inside, holds); the fraction is empty for the NIS, which has none.
+    ///
+    /// # Errors
+    /// When the CSV writer fails (it writes to memory).
+    pub fn bands_csv(&self) -> Result<String, String> {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let err = |e: csv::Error| e.to_string();
+        w.write_record([
+            "statistic",
+            "value",
+            "expected",
+            "lower",
+            "upper",
+            "fraction_inside",
+            "holds",
+        ])
+        .map_err(err)?;
+        for (label, r) in self.bands() {
+            w.write_record([
+                label,
+                cell(Some(r.value)),
+                cell(Some(r.expected)),
+                cell(Some(r.lower)),
+                cell(Some(r.upper)),
+                cell(r.fraction_inside),
+                r.holds().to_string(),
+            ])
+            .map_err(err)?;
+        }
+        let bytes = w.into_inner().map_err(|e| e.to_string())?;
+        String::from_utf8(bytes).map_err(|e| e.to_string())
+    }
+
+    /// `montecarlo.json`: how the report was made (`host_sim_version`, `command_line`,
+    /// `scenario`, `precision`, `settle_s`, `runs`, `seeds`), whether every band holds
+    /// (`holds`), the bands (`bands`, as `bands.csv`) and the runs (`per_run`, one object per
+    /// row of `runs.csv` with its column names; `null` where the cell is empty).
+    #[must_use]
+    pub fn json(&self, command_line: &[String]) -> Value {
+        let bands: Vec<Value> = self
+            .bands()
+            .map(|(label, r)| {
+                json!({
+                    "statistic": label,
+                    "value": number(Some(r.value)),
+                    "expected": number(Some(r.expected)),
+                    "lower": number(Some(r.lower)),
+                    "upper": number(Some(r.upper)),
+                    "fraction_inside": number(r.fraction_inside),
+                    "holds": r.holds(),
+                })
+            })
+            .collect();
+        let (header, rows) = self.run_rows();
+        let per_run: Vec<Value> = rows
+            .iter()
+            .zip(&self.per_run)
+            .map(|(row, r)| {
+                let mut obj = Map::new();
+                obj.insert("seed".into(), Value::from(r.seed));
+                for (name, c) in header.iter().zip(row) {
+                    // Counts are whole numbers; write them as integers.
+                    let v = match c {
+                        Some(n)
+                            if ["accepted_", "gated_out_", "refused_"]
+                                .iter()
+                                .any(|p| name.starts_with(p)) =>
+                        {
+                            Value::from(*n as u64)
+                        }
+                        _ => number(*c),
+                    };
+                    obj.insert(name.clone(), v);
+                }
+                Value::Object(obj)
+            })
+            .collect();
+        json!({
+            "host_sim_version": env!("CARGO_PKG_VERSION"),
+            "command_line": command_line,
+            "scenario": self.scenario,
+            "precision": self.precision,
+            "settle_s": self.settle_s,
+            "runs": self.runs,
+            "seeds": self.seeds(),
+            "holds": self.holds(),
+            "bands": bands,
+            "per_run": per_run,
+        })
+    }
+
+    /// Writes [`FILES`] into `dir`.
+    ///
+    /// # Errors
+    /// A file that cannot be written, named.
+    pub fn write(&self, dir: &Path, command_line: &[String]) -> Result<(), String> {
+        let json = serde_json::to_string_pretty(&self.json(command_line))
+            .map_err(|e| format!("montecarlo.json: {e}"))?;
+        for (name, text) in [
+            ("runs.csv", self.runs_csv()?),
+            ("bands.csv", self.bands_csv()?),
+            ("montecarlo.json", json + "\n"),
+        ] {
+            let path = dir.join(name);
+            std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+        Ok(())
+    }
 }
 
-/// Runs `runs` seeds (1..=runs) of `scenario`, with the scenario's replay configuration.
+/// Runs `runs` seeds (1..=runs) of `scenario`, with the scenario's replay configuration: as
+/// [`run_from`] from seed 1.
+///
+/// # Errors
+/// As [`run_from`].
 pub fn run(
     scenario: &Scenario,
     runs: u64,
     settle_s: f64,
     progress: bool,
 ) -> Result<Report, String> {
+    run_from(scenario, 1, runs, settle_s, progress)
+}
+
+/// Runs `runs` seeds, `first_seed` to `first_seed + runs - 1`, of `scenario`, with the
+/// scenario's replay configuration; the bands leave out the first `settle_s` seconds.
+///
+/// # Errors
+/// No run, seeds past `u64::MAX`, or the first run that failed to simulate or replay.
+pub fn run_from(
+    scenario: &Scenario,
+    first_seed: u64,
+    runs: u64,
+    settle_s: f64,
+    progress: bool,
+) -> Result<Report, String> {
+    if runs == 0 {
+        return Err("no runs: --runs must be at least 1".into());
+    }
+    let last_seed = first_seed.checked_add(runs - 1).ok_or_else(|| {
+        format!(
+            "seed {first_seed} and {runs} runs: the last seed would pass {}",
+            u64::MAX
+        )
+    })?;
     let base: PathBuf = std::env::temp_dir().join(format!(
         "host-sim-mc-{}-{}",
         std::process::id(),
@@ -92,7 +428,7 @@ pub fn run(
         plots: false,
         ..scenario.replay.clone()
     };
-    let results: Vec<Result<Scorer, String>> = (1..=runs)
+    let results: Vec<Result<Scorer, String>> = (first_seed..=last_seed)
         .into_par_iter()
         .map(|seed| {
             let dir = base.join(format!("seed-{seed}"));
@@ -156,7 +492,7 @@ pub fn run(
         }
     }
     let mut nis = Vec::new();
-    let sensors: std::collections::BTreeSet<String> = scorers
+    let sensors: BTreeSet<String> = scorers
         .iter()
         .flat_map(|s| s.sensors.keys().cloned())
         .collect();
@@ -166,8 +502,7 @@ pub fn run(
             if let Some(st) = s.sensors.get(&name) {
                 // After the start-up, like the NEES (the history holds every update unless a
                 // run is long enough to be decimated, when it holds a uniform subsample).
-                for &(t, nis, d) in st.history.points().iter().filter(|p| p.0 >= settle_s) {
-                    let _ = t;
+                for &(_, nis, d) in st.history.points().iter().filter(|p| p.0 >= settle_s) {
                     total += nis;
                     dof += d as f64;
                     count += 1.0;
@@ -185,5 +520,20 @@ pub fn run(
             });
         }
     }
-    Ok(Report { runs: n, nees, nis })
+    let per_run = (first_seed..=last_seed)
+        .zip(&scorers)
+        .map(|(seed, s)| RunResult {
+            seed,
+            metrics: s.metrics(),
+        })
+        .collect();
+    Ok(Report {
+        scenario: scenario.name.clone(),
+        precision: scenario.replay.precision.clone(),
+        settle_s,
+        runs: n,
+        nees,
+        nis,
+        per_run,
+    })
 }

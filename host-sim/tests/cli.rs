@@ -1094,3 +1094,24 @@ fn montecarlo_writes_runs_bands_and_json() {
     assert!(partial_folders_in(&base).is_empty());
     let _ = std::fs::remove_dir_all(&base);
 }
+
+/// `run` of a short scenario writes every plot.
+#[test]
+fn run_writes_the_plots() {
+    let base = tmp("plots");
+    let scenario = short_montecarlo_scenario(&base);
+    let out = base.join("out");
+    let o = host_sim(&[
+        "run",
+        "--scenario",
+        scenario.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for png in ["trajectory.png", "errors.png", "biases.png", "nis.png"] {
+        let len = std::fs::metadata(out.join(png)).map_or(0, |m| m.len());
+        assert!(len > 0, "{png} missing or empty");
+    }
+    let _ = std::fs::remove_dir_all(&base);
+}

@@ -1,13 +1,25 @@
-//! The PNG plots a person looks at after a run: trajectory top view against truth, per-axis
-//! errors inside their ±3σ bands, bias estimates against truth, and NIS per sensor against its
-//! chi-square bounds.
+//! The PNG plots a person looks at after a run, each with a legend for every line, band and
+//! marker, placed outside the plotting areas so that it covers no data:
+//!
+//! * `trajectory.png`: the estimate against the truth, top view (x-y, equal scale) and side view
+//!   (height against the distance along the true track, or against time when the track is
+//!   shorter than 1 m), with start and end markers;
+//! * `errors.png`: per-axis errors inside their ±3σ bands;
+//! * `biases.png`: bias estimates against the truth;
+//! * `nis.png`: NIS per update and sensor against its 95 % chi-square bounds and expected mean;
+//!   a point above the scale is drawn at its top edge with a marker of its own, never dropped.
+//!   The scorer's history ([`crate::metrics::SensorStats::history`]) holds the accepted and the
+//!   gated-out updates together, without telling them apart, so the points are drawn alike and
+//!   the panel's caption gives both counts.
 //!
 //! Text needs a TrueType font: DejaVu Sans from the system (Debian's `fonts-dejavu-core`), Arial on
 //! macOS and Windows, or the file named by `HOST_SIM_FONT`. Without one the plots are skipped with a warning.
 
-use crate::metrics::{HistoryPoint, Scorer, BLOCKS};
+use crate::metrics::{HistoryPoint, Scorer, SensorStats, BLOCKS};
 use crate::stats::chi2_quantile;
+use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{register_font, FontStyle};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -16,6 +28,8 @@ use std::sync::OnceLock;
 pub const FILES: [&str; 4] = ["trajectory.png", "errors.png", "biases.png", "nis.png"];
 
 type PlotResult = Result<(), Box<dyn std::error::Error>>;
+
+type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 
 /// Where the common systems keep a sans-serif TrueType font: Debian/Ubuntu, Fedora, Arch,
 /// macOS, Windows.
@@ -51,6 +65,9 @@ fn font_ready() -> bool {
 }
 
 /// Writes every plot into `dir`; returns the files written.
+///
+/// # Errors
+/// When a file cannot be drawn or written.
 pub fn write_all(
     dir: &Path,
     scorer: &Scorer,
@@ -77,7 +94,11 @@ pub fn write_all(
     let f = dir.join("biases.png");
     biases(&f, pts, title)?;
     written.push(f);
-    if !scorer.sensors.is_empty() {
+    if scorer
+        .sensors
+        .values()
+        .any(|s| !s.history.points().is_empty())
+    {
         let f = dir.join("nis.png");
         nis(&f, scorer, title)?;
         written.push(f);
@@ -98,9 +119,153 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// The colours of the plots.
+const ESTIMATE: RGBColor = RED;
+const TRUTH: RGBColor = BLACK;
+const START: RGBColor = RGBColor(0, 150, 0);
+const END: RGBColor = RGBColor(30, 90, 220);
+const POINT: RGBColor = BLUE;
+const CLIPPED: RGBColor = RGBColor(230, 120, 0);
+const EXPECTED: RGBColor = RGBColor(0, 150, 0);
+
+/// Pixel size of the markers.
+const MARKER: i32 = 6;
+
+/// How a legend entry is drawn.
+#[derive(Clone, Copy)]
+enum Mark {
+    /// A line segment.
+    Line(ShapeStyle),
+    /// A filled box (a band).
+    Band(ShapeStyle),
+    /// A dot of this radius.
+    Dot(ShapeStyle, i32),
+    /// An upward triangle.
+    Triangle(ShapeStyle),
+    /// A square.
+    Square(ShapeStyle),
+}
+
+/// A legend entry.
+struct Entry {
+    mark: Mark,
+    label: String,
+}
+
+impl Entry {
+    fn new(mark: Mark, label: impl Into<String>) -> Self {
+        Self {
+            mark,
+            label: label.into(),
+        }
+    }
+}
+
+/// Width of a legend entry's mark, px.
+const MARK_W: i32 = 26;
+
+/// Draws a legend mark whose left edge is at `x`, centred on `y`.
+fn draw_mark(area: &Area<'_>, mark: Mark, x: i32, y: i32) -> PlotResult {
+    let c = x + MARK_W / 2;
+    match mark {
+        Mark::Line(s) => area.draw(&PathElement::new(vec![(x, y), (x + MARK_W, y)], s))?,
+        Mark::Band(s) => area.draw(&Rectangle::new([(x, y - 7), (x + MARK_W, y + 7)], s))?,
+        Mark::Dot(s, r) => area.draw(&Circle::new((c, y), r, s))?,
+        Mark::Triangle(s) => area.draw(&TriangleMarker::new((c, y), MARKER, s))?,
+        Mark::Square(s) => area.draw(&Rectangle::new(
+            [
+                (c - MARKER + 1, y - MARKER + 1),
+                (c + MARKER - 1, y + MARKER - 1),
+            ],
+            s,
+        ))?,
+    }
+    Ok(())
+}
+
+/// A legend in one row across `area` (a strip outside the plotting areas), framed.
+fn legend_row(area: &Area<'_>, entries: &[Entry]) -> PlotResult {
+    let font = ("sans-serif", 16).into_font();
+    let text = font
+        .clone()
+        .into_text_style(area)
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    let (_, h) = area.dim_in_pixel();
+    let y = i32::try_from(h / 2).unwrap_or(0);
+    let mut widths = Vec::with_capacity(entries.len());
+    for e in entries {
+        let (w, _) = area.estimate_text_size(&e.label, &text)?;
+        widths.push(i32::try_from(w).unwrap_or(0));
+    }
+    let total: i32 = widths.iter().map(|w| MARK_W + 8 + w + 28).sum::<i32>() - 28;
+    let x0 = 15;
+    area.draw(&Rectangle::new(
+        [(x0 - 8, y - 14), (x0 + total + 8, y + 14)],
+        BLACK.stroke_width(1),
+    ))?;
+    let mut x = x0;
+    for (e, w) in entries.iter().zip(widths) {
+        draw_mark(area, e.mark, x, y)?;
+        area.draw(&Text::new(
+            e.label.clone(),
+            (x + MARK_W + 8, y),
+            text.clone(),
+        ))?;
+        x += MARK_W + 8 + w + 28;
+    }
+    Ok(())
+}
+
+/// A legend in one column down `area` (beside a plotting area).
+fn legend_column(area: &Area<'_>, entries: &[Entry]) -> PlotResult {
+    let text = ("sans-serif", 14)
+        .into_font()
+        .into_text_style(area)
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    let mut y = 30;
+    for e in entries {
+        draw_mark(area, e.mark, 8, y)?;
+        area.draw(&Text::new(
+            e.label.clone(),
+            (8 + MARK_W + 8, y),
+            text.clone(),
+        ))?;
+        y += 24;
+    }
+    Ok(())
+}
+
+/// The plotting area inside a chart cell of `dim` pixels with these margins and label areas.
+fn plotting_pixels(dim: (u32, u32), margin: u32, x_label: u32, y_label: u32) -> (f64, f64) {
+    let w = dim.0.saturating_sub(2 * margin + y_label).max(1);
+    let h = dim.1.saturating_sub(2 * margin + x_label).max(1);
+    (f64::from(w), f64::from(h))
+}
+
 fn trajectory(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
-    let root = BitMapBackend::new(path, (900, 800)).into_drawing_area();
+    let root = BitMapBackend::new(path, (1600, 860)).into_drawing_area();
     root.fill(&WHITE)?;
+    let (top, body) = root.split_vertically(50);
+    top.titled(
+        &format!("{title}: trajectory, estimate against truth"),
+        ("sans-serif", 24),
+    )?;
+    let (strip, body) = body.split_vertically(44);
+    let thin = |c: RGBColor| ShapeStyle::from(c).stroke_width(2);
+    legend_row(
+        &strip,
+        &[
+            Entry::new(Mark::Line(thin(TRUTH)), "truth"),
+            Entry::new(Mark::Line(ShapeStyle::from(ESTIMATE)), "estimate"),
+            Entry::new(Mark::Dot(START.filled(), MARKER), "start"),
+            Entry::new(Mark::Square(END.filled()), "end"),
+        ],
+    )?;
+    let (left, right) = body.split_horizontally(800);
+    let (margin, x_label, y_label) = (15_u32, 45_u32, 65_u32);
+
+    // Top view, equal scale on both axes.
+    let left = left.titled("top view", ("sans-serif", 18))?;
     let xs = pts
         .iter()
         .flat_map(|p| [p.est_position.x, p.true_position.x]);
@@ -108,43 +273,99 @@ fn trajectory(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
         .iter()
         .flat_map(|p| [p.est_position.y, p.true_position.y]);
     let ((x0, x1), (y0, y1)) = (range(xs), range(ys));
-    // Equal scale on both axes.
-    let span = (x1 - x0).max(y1 - y0);
+    let (pw, ph) = plotting_pixels(left.dim_in_pixel(), margin, x_label, y_label);
+    let per_px = ((x1 - x0) / pw).max((y1 - y0) / ph);
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{title}: trajectory, top view"), ("sans-serif", 22))
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(55)
-        .build_cartesian_2d(
-            cx - span / 2.0..cx + span / 2.0,
-            cy - span / 2.0..cy + span / 2.0,
-        )?;
+    let (hx, hy) = (0.5 * per_px * pw, 0.5 * per_px * ph);
+    let mut chart = ChartBuilder::on(&left)
+        .margin(margin)
+        .x_label_area_size(x_label)
+        .y_label_area_size(y_label)
+        .build_cartesian_2d(cx - hx..cx + hx, cy - hy..cy + hy)?;
     chart
         .configure_mesh()
         .x_desc("east x [m]")
         .y_desc("north y [m]")
         .draw()?;
+    let top_view: [Vec<(f64, f64)>; 2] = [
+        pts.iter()
+            .map(|p| (p.true_position.x, p.true_position.y))
+            .collect(),
+        pts.iter()
+            .map(|p| (p.est_position.x, p.est_position.y))
+            .collect(),
+    ];
+    draw_tracks(&mut chart, &top_view)?;
+
+    // Side view: height against the distance along the true track (time when it stays put).
+    let right = right.titled("side view", ("sans-serif", 18))?;
+    let mut along = Vec::with_capacity(pts.len());
+    let mut d = 0.0;
+    for (i, p) in pts.iter().enumerate() {
+        if i > 0 {
+            let q = &pts[i - 1];
+            d += (p.true_position.xy() - q.true_position.xy()).norm();
+        }
+        along.push(d);
+    }
+    let (abscissa, x_desc) = if d >= 1.0 {
+        (along, "distance along the true track, horizontal [m]")
+    } else {
+        (pts.iter().map(|p| p.t).collect(), "t [s]")
+    };
+    let side: [Vec<(f64, f64)>; 2] = [
+        abscissa
+            .iter()
+            .zip(pts)
+            .map(|(a, p)| (*a, p.true_position.z))
+            .collect(),
+        abscissa
+            .iter()
+            .zip(pts)
+            .map(|(a, p)| (*a, p.est_position.z))
+            .collect(),
+    ];
+    let (a0, a1) = range(abscissa.iter().copied());
+    let (z0, z1) = range(side.iter().flatten().map(|p| p.1));
+    let mut chart = ChartBuilder::on(&right)
+        .margin(margin)
+        .x_label_area_size(x_label)
+        .y_label_area_size(y_label)
+        .build_cartesian_2d(a0..a1, z0..z1)?;
     chart
-        .draw_series(LineSeries::new(
-            pts.iter().map(|p| (p.true_position.x, p.true_position.y)),
-            BLACK.stroke_width(2),
-        ))?
-        .label("truth")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
-    chart
-        .draw_series(LineSeries::new(
-            pts.iter().map(|p| (p.est_position.x, p.est_position.y)),
-            RED,
-        ))?
-        .label("estimate")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc("up z [m] (own scale)")
         .draw()?;
+    draw_tracks(&mut chart, &side)?;
     root.present()?;
+    Ok(())
+}
+
+type Chart<'a, 'b> = ChartContext<
+    'a,
+    BitMapBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// The truth and the estimate (in that order) with their start and end markers.
+fn draw_tracks(chart: &mut Chart<'_, '_>, tracks: &[Vec<(f64, f64)>; 2]) -> PlotResult {
+    let styles = [TRUTH.stroke_width(2), ESTIMATE.into()];
+    for (track, style) in tracks.iter().zip(styles) {
+        chart.draw_series(LineSeries::new(track.iter().copied(), style))?;
+    }
+    for track in tracks {
+        if let (Some(&first), Some(&last)) = (track.first(), track.last()) {
+            chart.draw_series(std::iter::once(Circle::new(first, MARKER, START.filled())))?;
+            chart.draw_series(std::iter::once(
+                EmptyElement::at(last)
+                    + Rectangle::new(
+                        [(-MARKER + 1, -MARKER + 1), (MARKER - 1, MARKER - 1)],
+                        END.filled(),
+                    ),
+            ))?;
+        }
+    }
     Ok(())
 }
 
@@ -152,12 +373,22 @@ fn errors(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
     let blocks: Vec<usize> = (0..5)
         .filter(|b| pts.iter().any(|p| p.sigma[3 * b].is_finite()))
         .collect();
-    let root = BitMapBackend::new(path, (1500, 260 * blocks.len() as u32 + 60)).into_drawing_area();
+    let root =
+        BitMapBackend::new(path, (1500, 260 * blocks.len() as u32 + 100)).into_drawing_area();
     root.fill(&WHITE)?;
     let (top, body) = root.split_vertically(50);
     top.titled(
-        &format!("{title}: errors (red) inside ±3σ (grey)"),
+        &format!("{title}: errors inside ±3σ (the first second clipped to the scale of the rest)"),
         ("sans-serif", 24),
+    )?;
+    let (strip, body) = body.split_vertically(40);
+    let band = BLACK.mix(0.15).filled();
+    legend_row(
+        &strip,
+        &[
+            Entry::new(Mark::Line(ESTIMATE.into()), "error"),
+            Entry::new(Mark::Band(band), "±3σ"),
+        ],
     )?;
     let cells = body.split_evenly((blocks.len(), 3));
     let units = ["deg", "m/s", "m", "deg/s", "m/s²"];
@@ -177,7 +408,8 @@ fn errors(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
                 // Skip the first second, where the prior's wide bands would flatten the rest.
                 .zip(pts.iter().map(|p| p.t))
                 .filter(|(_, t)| *t > 1.0)
-                .fold(1e-6_f64, |a, (v, _)| a.max(v));
+                .fold(1e-6_f64, |a, (v, _)| a.max(v))
+                * 1.1;
             let mut chart = ChartBuilder::on(cell)
                 .caption(
                     format!("{} {}", BLOCKS[b], ["x", "y", "z"][axis]),
@@ -186,7 +418,7 @@ fn errors(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
                 .margin(6)
                 .x_label_area_size(28)
                 .y_label_area_size(60)
-                .build_cartesian_2d(0.0..t1, -lim * 1.1..lim * 1.1)?;
+                .build_cartesian_2d(0.0..t1, -lim..lim)?;
             chart
                 .configure_mesh()
                 .x_desc("t [s]")
@@ -195,17 +427,14 @@ fn errors(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
                 .draw()?;
             let upper: Vec<(f64, f64)> = pts
                 .iter()
-                .map(|p| (p.t, (3.0 * p.sigma[i] * k).min(lim * 1.1)))
+                .map(|p| (p.t, (3.0 * p.sigma[i] * k).min(lim)))
                 .collect();
-            let mut band = upper.clone();
-            band.extend(upper.iter().rev().map(|(t, v)| (*t, -v)));
-            chart.draw_series(std::iter::once(Polygon::new(
-                band,
-                BLACK.mix(0.15).filled(),
-            )))?;
+            let mut band_pts = upper.clone();
+            band_pts.extend(upper.iter().rev().map(|(t, v)| (*t, -v)));
+            chart.draw_series(std::iter::once(Polygon::new(band_pts, band)))?;
             chart.draw_series(LineSeries::new(
-                pts.iter().map(|p| (p.t, p.error[i] * k)),
-                RED,
+                pts.iter().map(|p| (p.t, (p.error[i] * k).clamp(-lim, lim))),
+                ESTIMATE,
             ))?;
         }
     }
@@ -214,12 +443,20 @@ fn errors(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
 }
 
 fn biases(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
-    let root = BitMapBackend::new(path, (1500, 620)).into_drawing_area();
+    let root = BitMapBackend::new(path, (1500, 660)).into_drawing_area();
     root.fill(&WHITE)?;
     let (top, body) = root.split_vertically(50);
     top.titled(
-        &format!("{title}: bias estimates (red) against truth (black)"),
+        &format!("{title}: bias estimates against truth"),
         ("sans-serif", 24),
+    )?;
+    let (strip, body) = body.split_vertically(40);
+    legend_row(
+        &strip,
+        &[
+            Entry::new(Mark::Line(TRUTH.stroke_width(2)), "truth"),
+            Entry::new(Mark::Line(ESTIMATE.into()), "estimate"),
+        ],
     )?;
     let cells = body.split_evenly((2, 3));
     let t1 = pts.last().map_or(1.0, |p| p.t.max(1e-3));
@@ -251,16 +488,19 @@ fn biases(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
             .draw()?;
         chart.draw_series(LineSeries::new(
             pts.iter().map(|p| (p.t, p.true_bias[i] * k)),
-            BLACK.stroke_width(2),
+            TRUTH.stroke_width(2),
         ))?;
         chart.draw_series(LineSeries::new(
             pts.iter().map(|p| (p.t, p.est_bias[i] * k)),
-            RED,
+            ESTIMATE,
         ))?;
     }
     root.present()?;
     Ok(())
 }
+
+/// Width of the legend column beside each NIS panel, px.
+const NIS_LEGEND_W: u32 = 300;
 
 fn nis(path: &Path, scorer: &Scorer, title: &str) -> PlotResult {
     let sensors: Vec<_> = scorer
@@ -272,56 +512,209 @@ fn nis(path: &Path, scorer: &Scorer, title: &str) -> PlotResult {
         return Ok(());
     }
     let root =
-        BitMapBackend::new(path, (1200, 280 * sensors.len() as u32 + 60)).into_drawing_area();
+        BitMapBackend::new(path, (1400, 280 * sensors.len() as u32 + 60)).into_drawing_area();
     root.fill(&WHITE)?;
     let (top, body) = root.split_vertically(50);
     top.titled(
         &format!("{title}: NIS per update, with its 95 % chi-square interval"),
         ("sans-serif", 24),
     )?;
+    // One time axis for every sensor.
+    let t1 = sensors
+        .iter()
+        .filter_map(|(_, s)| s.history.points().last().map(|p| p.0))
+        .fold(1e-3, f64::max);
     let cells = body.split_evenly((sensors.len(), 1));
     for ((name, stats), cell) in sensors.iter().zip(cells.iter()) {
-        let h = stats.history.points();
-        let dof = h.first().map_or(1, |p| p.2).max(1);
-        let (lo, hi) = (
-            chi2_quantile(0.025, dof as f64),
-            chi2_quantile(0.975, dof as f64),
-        );
-        let t1 = h.last().map_or(1.0, |p| p.0.max(1e-3));
-        let ymax = h
-            .iter()
-            .map(|p| p.1)
-            .filter(|v| v.is_finite())
-            .fold(hi * 1.5, f64::max)
-            .min(hi * 6.0);
-        let mut chart = ChartBuilder::on(cell)
-            .caption(
-                format!(
-                    "{name} (dof {dof}): mean {:.2}, accepted {}, rejected {}",
-                    stats.nis_mean(),
-                    stats.accepted,
-                    stats.rejected
-                ),
-                ("sans-serif", 16),
-            )
-            .margin(6)
-            .x_label_area_size(28)
-            .y_label_area_size(50)
-            .build_cartesian_2d(0.0..t1, 0.0..ymax)?;
-        chart
-            .configure_mesh()
-            .x_desc("t [s]")
-            .y_desc("NIS")
-            .label_style(("sans-serif", 12))
-            .draw()?;
-        chart.draw_series(
-            h.iter()
-                .map(|p| Circle::new((p.0, p.1.min(ymax)), 2, BLUE.filled())),
-        )?;
-        for (v, style) in [(lo, BLACK), (hi, BLACK), (dof as f64, GREEN)] {
-            chart.draw_series(LineSeries::new([(0.0, v), (t1, v)], style.stroke_width(2)))?;
-        }
+        let (w, _) = cell.dim_in_pixel();
+        let (plot, legend) = cell.split_horizontally(w.saturating_sub(NIS_LEGEND_W));
+        nis_panel(&plot, &legend, name, stats, t1)?;
     }
     root.present()?;
     Ok(())
+}
+
+/// One sensor's NIS: the chart in `plot`, its legend in `legend`.
+fn nis_panel(
+    plot: &Area<'_>,
+    legend: &Area<'_>,
+    name: &str,
+    stats: &SensorStats,
+    t1: f64,
+) -> PlotResult {
+    let h = stats.history.points();
+    // The bounds are those of the most frequent measurement dimension.
+    let mut dofs = std::collections::BTreeMap::<usize, usize>::new();
+    for p in h {
+        *dofs.entry(p.2).or_default() += 1;
+    }
+    let dof = dofs
+        .iter()
+        .max_by_key(|(_, n)| **n)
+        .map_or(1, |(d, _)| *d)
+        .max(1);
+    let (lo, hi) = (
+        chi2_quantile(0.025, dof as f64),
+        chi2_quantile(0.975, dof as f64),
+    );
+    let ymax = h
+        .iter()
+        .map(|p| p.1)
+        .filter(|v| v.is_finite())
+        .fold(hi * 1.5, f64::max)
+        .min(hi * 6.0);
+    // Above the scale: drawn at its top edge, with a marker of their own.
+    let edge = ymax * 0.97;
+    let (inside, above): (Vec<&(f64, f64, usize)>, Vec<_>) = h
+        .iter()
+        .filter(|p| !p.1.is_nan())
+        .partition(|p| p.1 <= ymax);
+    let not_a_number = h.iter().filter(|p| p.1.is_nan()).count();
+    let dof_note = if dofs.len() > 1 {
+        format!(
+            "dof {}–{}, bounds for dof {dof}",
+            dofs.keys().min().unwrap_or(&dof),
+            dofs.keys().max().unwrap_or(&dof)
+        )
+    } else {
+        format!("dof {dof}")
+    };
+    let mut chart = ChartBuilder::on(plot)
+        .caption(
+            format!(
+                "{name} ({dof_note}): mean {:.2}, accepted {}, gated out {}, refused {}",
+                stats.nis_mean(),
+                stats.accepted,
+                stats.rejected,
+                stats.refused
+            ),
+            ("sans-serif", 16),
+        )
+        .margin(6)
+        .x_label_area_size(28)
+        .y_label_area_size(50)
+        .build_cartesian_2d(0.0..t1, 0.0..ymax)?;
+    chart
+        .configure_mesh()
+        .x_desc("t [s]")
+        .y_desc("NIS")
+        .label_style(("sans-serif", 12))
+        .draw()?;
+    // The lines first, so that they hide no point.
+    let bound = BLACK.stroke_width(2);
+    let expected = EXPECTED.stroke_width(2);
+    for (v, style) in [(lo, bound), (hi, bound), (dof as f64, expected)] {
+        chart.draw_series(LineSeries::new([(0.0, v), (t1, v)], style))?;
+    }
+    chart.draw_series(
+        inside
+            .iter()
+            .map(|p| Circle::new((p.0, p.1), 2, POINT.filled())),
+    )?;
+    chart.draw_series(
+        above
+            .iter()
+            .map(|p| TriangleMarker::new((p.0, edge), MARKER, CLIPPED.filled())),
+    )?;
+    let mut entries = vec![
+        Entry::new(Mark::Dot(POINT.filled(), 3), "NIS (accepted and gated out)"),
+        Entry::new(Mark::Line(bound), "95 % bounds"),
+        Entry::new(Mark::Line(expected), format!("expected mean ({dof})")),
+    ];
+    if !above.is_empty() {
+        entries.insert(
+            1,
+            Entry::new(
+                Mark::Triangle(CLIPPED.filled()),
+                format!("clipped (off scale): {}", above.len()),
+            ),
+        );
+    }
+    if not_a_number > 0 {
+        entries.push(Entry::new(
+            Mark::Line(WHITE.into()),
+            format!("not a number (not drawn): {not_a_number}"),
+        ));
+    }
+    legend_column(legend, &entries)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dataset::read::Truth;
+    use crate::metrics::{Estimate, Outcome};
+    use estimator_core::lie::{LieGroup, So3};
+    use nalgebra::{Matrix3, Vector3};
+
+    /// A short synthetic run: a circle with a small error, and NIS values some of which are
+    /// far above the scale or not numbers.
+    fn scorer(with_position: bool) -> Scorer {
+        let mut s = Scorer::default();
+        for k in 0..400_u64 {
+            let t_ns = k * 50_000_000;
+            let a = k as f64 * 0.02;
+            let position = Vector3::new(10.0 * a.cos(), 10.0 * a.sin(), 0.1 * a);
+            let truth = Truth {
+                t_ns,
+                position,
+                attitude: So3::exp(&Vector3::new(0.0, 0.0, a)),
+                velocity: Vector3::new(-0.2 * a.sin(), 0.2 * a.cos(), 0.0),
+                gyro_bias: Vector3::new(0.001, 0.0, 0.0),
+                accel_bias: Vector3::new(0.0, 0.02, 0.0),
+            };
+            let cov = Some(Matrix3::identity() * 0.01);
+            let est = Estimate {
+                t_ns,
+                position: position + Vector3::new(0.05, -0.05, 0.02),
+                attitude: So3::exp(&Vector3::new(0.0, 0.0, a + 0.01)),
+                velocity: truth.velocity,
+                gyro_bias: Vector3::zeros(),
+                accel_bias: Vector3::zeros(),
+                cov: if with_position {
+                    [cov, cov, cov, cov, cov]
+                } else {
+                    [cov, None, None, cov, cov]
+                },
+            };
+            s.add(&est, &truth);
+            let nis = match k % 40 {
+                0 => 500.0,
+                1 => f64::INFINITY,
+                2 => f64::NAN,
+                _ => (k % 7) as f64,
+            };
+            let outcome = if nis > 20.0 {
+                Outcome::Rejected { nis, dof: 3 }
+            } else {
+                Outcome::Accepted { nis, dof: 3 }
+            };
+            s.measurement("gnss_position", t_ns, outcome);
+        }
+        s
+    }
+
+    #[test]
+    fn the_plots_are_written() {
+        if !font_ready() {
+            eprintln!("no font: the plots are skipped, nothing to check");
+            return;
+        }
+        let dir = std::env::temp_dir().join(format!("host-sim-plot-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("temp folder");
+        let written = write_all(&dir, &scorer(true), "test").expect("plots");
+        assert_eq!(written.len(), FILES.len());
+        for f in FILES {
+            let len = std::fs::metadata(dir.join(f)).map_or(0, |m| m.len());
+            assert!(len > 0, "{f} missing or empty");
+        }
+        // Without a position there is no trajectory.
+        std::fs::remove_file(dir.join("trajectory.png")).expect("remove");
+        let written = write_all(&dir, &scorer(false), "test").expect("plots");
+        assert_eq!(written.len(), FILES.len() - 1);
+        assert!(!dir.join("trajectory.png").exists());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -750,3 +750,52 @@ fn instruction_probe() {
     }
     println!("mean iterations {}", iterations as f64 / 10.0);
 }
+
+/// A solution whose normalization moved a point onto `min_depth` is refused, not returned:
+/// the depth promise is checked on the returned pose (an input found by fuzzing, f64,
+/// Levenberg-Marquardt, where the last step ends at depth 0.000999999999998 < 0.001).
+#[test]
+fn pnp_depth_is_checked_after_the_final_normalization() {
+    use estimator_core::gn::{Method, SolveError};
+    let world = [
+        Vector3::new(-1.890625, -1.890625, -1.890625),
+        Vector3::new(-2.0, -0.234375, 0.0),
+        Vector3::new(1.359375, 1.359375, -1.9375),
+    ];
+    let pixels = [
+        Vector2::new(912.7509780682076, 891.7561822687094),
+        Vector2::new(-1540.75439143522, -3.125e-8),
+        Vector2::new(5736.57896121083, 5078.922545193781),
+    ];
+    let camera = PinholeCamera {
+        fx: 400.0,
+        fy: 410.0,
+        cx: 320.0,
+        cy: 240.0,
+    };
+    let guess = Se3::from_parts(So3::identity(), Vector3::new(0.0, 0.0, 5.0));
+    let options = PnpOptions {
+        method: Method::LevenbergMarquardt,
+        loss: Loss::LeastSquares,
+        sigma_px: 3.125e-8,
+        max_iterations: 513,
+        step_tolerance: 5e-324,
+        cost_tolerance: 1e-20,
+        information_step_tolerance: 1e-20,
+        min_depth: 0.001,
+        inlier_chi2: 9.21,
+    };
+    match solve_pnp(&world, &pixels, &camera, &guess, &options) {
+        Ok(sol) => {
+            let (r, t) = (
+                sol.camera_from_world.rotation(),
+                sol.camera_from_world.translation(),
+            );
+            for p in &world {
+                let depth = (r.act(p) + t).z;
+                assert!(depth > options.min_depth, "depth {depth} returned");
+            }
+        }
+        Err(e) => assert_eq!(e, SolveError::PointBehindCamera),
+    }
+}

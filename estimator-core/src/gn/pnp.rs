@@ -479,6 +479,15 @@ pub fn solve_pnp<T: Real>(
     if !pose.is_finite() {
         return Err(SolveError::NonFiniteResidual);
     }
+    // The promise holds for the pose returned, not for the one before its normalization: the
+    // rounding of `normalize` can move a point that was just beyond `min_depth` onto it.
+    let (r, t) = (pose.rotation().rotation_matrix(), pose.translation());
+    let in_front = world_points
+        .iter()
+        .all(|p| (mat3::mul_vec(&r, p) + t).z > options.min_depth);
+    if !in_front {
+        return Err(SolveError::PointBehindCamera);
+    }
     Ok(PnpSolution {
         camera_from_world: pose,
         covariance: sol.covariance,

@@ -5,7 +5,7 @@ use super::config::{check_dt, FilterConfig, ImuSample};
 use super::error::EskfError;
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use crate::kernels::block::{add_scaled_identity, block, block_in, set_block};
-use crate::kernels::{all_finite, mat3};
+use crate::kernels::{all_finite, mat3, positive_finite};
 use crate::lie::{skew, LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -120,8 +120,10 @@ fn predict_ins<T: Real>(
     // P is finite (an invariant of the filter), so N = F P Fᵀ is finite exactly when its
     // diagonal is: a non-finite entry of row i of F makes N_ii = Σ_kl F_ik P_kl F_il infinite
     // or NaN, and for a positive semi-definite N, |N_ij| ≤ √(N_ii N_jj) bounds every other
-    // entry. The diagonal of N is the diagonal of L's top 9 × 9.
-    let diagonal_finite = (0..9).all(|k| l.get((k, k)).is_some_and(|d| d.is_finite()));
+    // entry. The diagonal of N is the diagonal of L's top 9 × 9. It must also be positive (P
+    // is positive definite and F invertible): rounding in an extreme step (a huge `dt` times a
+    // huge rate) can leave it zero or negative, and such a P is refused, not stored.
+    let diagonal_finite = (0..9).all(|k| l.get((k, k)).is_some_and(|d| positive_finite(*d)));
     if !(diagonal_finite && new_x.is_finite()) {
         return Err(EskfError::NonFinite);
     }
@@ -184,8 +186,9 @@ fn predict_attitude<T: Real, const N: usize>(
     );
     let next = attitude.compose(&dr).renormalize();
     // As in the 15-state prediction: a non-finite F or an overflow shows on the diagonal of
-    // N00, which bounds M01 and M02 through the positive semi-definite P⁺.
-    let diagonal_finite = (0..3).all(|k| n00.get((k, k)).is_some_and(|d| d.is_finite()));
+    // N00, which bounds M01 and M02 through the positive semi-definite P⁺; a diagonal that
+    // rounding left at zero or below is refused too.
+    let diagonal_finite = (0..3).all(|k| n00.get((k, k)).is_some_and(|d| positive_finite(*d)));
     if !(diagonal_finite && next.is_finite()) {
         return Err(EskfError::NonFinite);
     }

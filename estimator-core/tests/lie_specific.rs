@@ -575,3 +575,33 @@ fn non_finite_entries_are_refused() {
     assert!(So2::from_angle(0.3).is_finite());
     assert!(Se2::new(1.0, 2.0, 0.3).is_finite());
 }
+
+/// `So3::from_quaternion` accepts any non-zero finite quaternion, as its docs promise: also
+/// those whose squared norm overflows or underflows (found by fuzzing).
+#[test]
+fn so3_from_quaternion_takes_huge_and_tiny_quaternions() {
+    use nalgebra::Quaternion;
+    for (w, x) in [
+        (1e154, 1e154),
+        (1e-170, 1e-170),
+        (f64::MAX, f64::MAX),
+        (5e-324, 0.0),
+    ] {
+        let r = So3::from_quaternion(&Quaternion::new(w, x, 0.0, 0.0)).expect("finite, non-zero");
+        let q = r.quaternion();
+        let expected = if x == 0.0 {
+            (1.0, 0.0)
+        } else {
+            (0.5f64.sqrt(), 0.5f64.sqrt())
+        };
+        assert!(
+            (q.w - expected.0).abs() < 1e-15 && (q.i - expected.1).abs() < 1e-15,
+            "{q:?}"
+        );
+    }
+    let r = So3::from_quaternion(&Quaternion::new(1e20f32, 1e20, 0.0, 0.0)).expect("f32");
+    assert!((r.quaternion().w - 0.5f32.sqrt()).abs() < 1e-7);
+    assert!(So3::from_quaternion(&Quaternion::new(0.0f64, 0.0, 0.0, 0.0)).is_none());
+    assert!(So3::from_quaternion(&Quaternion::new(f64::NAN, 1.0, 0.0, 0.0)).is_none());
+    assert!(So3::from_quaternion(&Quaternion::new(f64::INFINITY, 1.0, 0.0, 0.0)).is_none());
+}

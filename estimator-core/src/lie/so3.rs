@@ -56,14 +56,23 @@ pub struct So3<T: Real> {
 impl<T: Real> So3<T> {
     /// From a quaternion of any non-zero finite norm (it is normalized; `w < 0` is fine).
     /// `None` for a zero or non-finite quaternion.
+    ///
+    /// The quaternion is first divided by its largest component, so that its squared norm lies
+    /// in `[1, 4]`: components up to the largest finite value and down to the smallest
+    /// subnormal are accepted (their squares alone would overflow or underflow).
     #[must_use]
     pub fn from_quaternion(q: &Quaternion<T>) -> Option<Self> {
-        let n2 = q.coords.norm_squared();
-        if !positive_finite(n2) {
+        if !all_finite(q.coords.as_slice()) {
             return None;
         }
+        let largest = q.coords.iter().fold(T::zero(), |m, c| m.max(c.abs()));
+        if !positive_finite(largest) {
+            return None;
+        }
+        let scaled = q.coords / largest;
+        let n = scaled.norm_squared().sqrt_rn();
         Some(Self {
-            q: UnitQuaternion::new_unchecked(q * (T::one() / n2.sqrt_rn())),
+            q: UnitQuaternion::new_unchecked(Quaternion::from(scaled / n)),
         })
     }
 

@@ -14,9 +14,10 @@ use clap::Parser;
 use cli::{Cli, Command};
 use host_sim::bench::{replay_config, BenchOptions};
 use host_sim::dataset::write::simulate;
-use host_sim::metrics::Metrics;
+use host_sim::metrics::trajectory::Alignment;
+use host_sim::metrics::{Metrics, Scorer, ATE_ALIGNMENT};
 use host_sim::output::Staging;
-use host_sim::replay::{replay, ReplayConfig};
+use host_sim::replay::{replay, replay_scored, ReplayConfig};
 use host_sim::scenario::{builtin_scenarios, Scenario};
 use std::path::Path;
 use std::process::ExitCode;
@@ -75,9 +76,13 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             let dataset = staging.dir().join("dataset");
             simulate(&sc, seed, &dataset)?;
             let cfg = sc.replay.clone();
-            let m = replay(&dataset, staging.dir(), &cfg, &sc.name)?;
+            let mut scorer = Scorer::default();
+            scorer.provenance.scenario = Some(sc.name.clone());
+            scorer.provenance.seed = Some(seed);
+            scorer.provenance.dataset = Some(out.join("dataset").display().to_string());
+            let m = replay_scored(&dataset, staging.dir(), &cfg, &sc.name, scorer)?.metrics();
             staging.commit()?;
-            print_summary(&sc.name, seed, &cfg, &m, &out);
+            print_summary(&sc.name, Some(seed), &cfg, &m, &out, None);
             Ok(())
         }
         Command::Replay {
@@ -86,6 +91,9 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             config,
             force,
         } => {
+            // A EuRoC sequence's folder (holding mav0/) is read as its mav0/.
+            let located = host_sim::dataset::locate(&dataset);
+            let dataset = located.dir.clone();
             if let (Ok(d), Ok(o)) = (dataset.canonicalize(), out.canonicalize()) {
                 if d.starts_with(&o) {
                     return Err(format!(
@@ -98,7 +106,10 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             }
             // The given configuration, else the dataset's replay.toml, else the defaults.
             let cfg = replay_config(config.as_deref(), &dataset)?;
-            let title = dataset
+            let title = located
+                .root
+                .as_deref()
+                .unwrap_or(&dataset)
                 .file_name()
                 .map_or("dataset".into(), |n| n.to_string_lossy().into_owned());
             let staging = Staging::new(&out, force, "replay")?;
@@ -112,7 +123,7 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                 .into());
             }
             staging.commit()?;
-            print_summary(&title, 0, &cfg, &m, &out);
+            print_summary(&title, None, &cfg, &m, &out, located.note());
             Ok(())
         }
         Command::Bench {
@@ -207,20 +218,76 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
     }
 }
 
-fn print_summary(name: &str, seed: u64, cfg: &ReplayConfig, m: &Metrics, out: &Path) {
-    out!("scenario {name}  seed {seed}  precision {}", cfg.precision);
+/// The summary table of a run (`seed`: the simulated scenario's) or of a replay (`None`).
+fn print_summary(
+    name: &str,
+    seed: Option<u64>,
+    cfg: &ReplayConfig,
+    m: &Metrics,
+    out: &Path,
+    dataset_note: Option<String>,
+) {
+    match seed {
+        Some(seed) => out!("scenario {name}  seed {seed}  precision {}", cfg.precision),
+        None => out!("dataset {name}  precision {}", cfg.precision),
+    }
+    if let Some(note) = dataset_note {
+        out!("  dataset: {note}");
+    }
     if m.samples_scored == 0 {
         out!("  not scored: the dataset has no ground truth (the estimate is in the outputs)");
     }
     out!(
         "  {:<28} {:>12}",
-        "position RMSE (ATE) [m]",
+        "position RMSE, unaligned [m]",
         fmt(m.ate_position_rmse_m)
     );
+    // evo's figures: the ATE after the alignment of `ate`, the others beside it, and the RPE.
+    if let Some(a) = &m.ate {
+        let others: Vec<String> = m
+            .ate_by_alignment
+            .values()
+            .filter(|o| o.alignment != ATE_ALIGNMENT)
+            .map(|o| format!("{} {}", o.alignment.describe(), fmt(o.stats.rmse)))
+            .collect();
+        let evo = if a.alignment == Alignment::Se3 {
+            " (evo_ape -a)"
+        } else {
+            ""
+        };
+        out!(
+            "  {:<28} {:>12}   max {}, {} pairs{evo}; {}",
+            format!("ATE RMSE, {} [m]", a.alignment.describe()),
+            fmt(a.stats.rmse),
+            fmt(a.stats.max),
+            a.stats.pairs,
+            others.join(", ")
+        );
+    }
+    if let Some(r) = &m.rpe {
+        out!(
+            "  {:<28} {:>12}   max {}, {} pairs (evo_rpe, translation)",
+            format!("RPE RMSE over {} {} [m]", r.delta, r.delta_unit),
+            fmt(r.stats.rmse),
+            fmt(r.stats.max),
+            r.stats.pairs
+        );
+    }
     out!(
         "  {:<28} {:>12}",
         "attitude RMSE [deg]",
         fmt(m.attitude_rmse_deg)
+    );
+    let yaw_note = if m.heading_reference == Some(false) {
+        "IMU only (no heading reference), the figure to read: "
+    } else {
+        ""
+    };
+    out!(
+        "  {:<28} {:>12}   {yaw_note}constant heading offset {}° over the run removed",
+        "attitude RMSE, yaw-aligned [deg]",
+        fmt(m.attitude_rmse_yaw_aligned_deg),
+        fmt(m.attitude_yaw_offset_deg)
     );
     out!(
         "  {:<28} {:>12}",

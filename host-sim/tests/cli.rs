@@ -34,11 +34,13 @@ fn read(p: &Path) -> Vec<u8> {
     std::fs::read(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
+/// `metrics.json` without what differs between identical runs: the time spent and where the
+/// run comes from (its command line).
 fn metrics_without_timing(p: &Path) -> serde_json::Value {
     let mut v: serde_json::Value = serde_json::from_slice(&read(p)).expect("json");
-    v.as_object_mut()
-        .expect("object")
-        .remove("filter_ns_per_imu_sample");
+    let o = v.as_object_mut().expect("object");
+    o.remove("filter_ns_per_imu_sample");
+    o.remove("provenance");
     v
 }
 
@@ -1114,4 +1116,302 @@ fn run_writes_the_plots() {
         assert!(len > 0, "{png} missing or empty");
     }
     let _ = std::fs::remove_dir_all(&base);
+}
+
+/// Kalibr's `imu0/sensor.yaml` as a EuRoC sequence ships it.
+const EUROC_IMU_YAML: &str = "#Default imu sensor yaml file
+sensor_type: imu
+comment: VI-Sensor IMU (ADIS16448)
+
+# Sensor extrinsics wrt. the body-frame.
+T_BS:
+  cols: 4
+  rows: 4
+  data: [1.0, 0.0, 0.0, 0.0,
+         0.0, 1.0, 0.0, 0.0,
+         0.0, 0.0, 1.0, 0.0,
+         0.0, 0.0, 0.0, 1.0]
+rate_hz: 200
+
+# inertial sensor noise model parameters (static)
+gyroscope_noise_density: 1.6968e-04     # [ rad / s / sqrt(Hz) ]   ( gyro \"white noise\" )
+gyroscope_random_walk: 1.9393e-05       # [ rad / s^2 / sqrt(Hz) ] ( gyro bias diffusion )
+accelerometer_noise_density: 2.0000e-3  # [ m / s^2 / sqrt(Hz) ]  ( accel \"white noise\" )
+accelerometer_random_walk: 3.0000e-3    # [ m / s^3 / sqrt(Hz) ].  ( accel bias diffusion )
+";
+
+/// A EuRoC camera's `sensor.yaml` (pinhole, radial-tangential), without host-sim's keys.
+const EUROC_CAM_YAML: &str = "# General sensor definitions.
+sensor_type: camera
+comment: VI-Sensor cam0 (MT9M034)
+
+# Sensor extrinsics wrt. the body-frame.
+T_BS:
+  cols: 4
+  rows: 4
+  data: [0.0148655429818, -0.999880929698, 0.00414029679422, -0.0216401454975,
+         0.999557249008, 0.0149672133247, 0.025715529948, -0.064676986768,
+        -0.0257744366974, 0.00375618835797, 0.999660727178, 0.00981073058949,
+         0.0, 0.0, 0.0, 1.0]
+
+# Camera specific definitions.
+rate_hz: 20
+resolution: [752, 480]
+camera_model: pinhole
+intrinsics: [458.654, 457.296, 367.215, 248.375] #fu, fv, cu, cv
+distortion_model: radial-tangential
+distortion_coefficients: [-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05]
+";
+
+const EUROC_GT_HEADER: &str = "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]";
+
+/// Writes a EuRoC sequence in its unpacked layout under `root`: `mav0/imu0` (Kalibr's
+/// `sensor.yaml`, EuRoC's `data.csv` header, CRLF line ends), `mav0/state_groundtruth_estimate0`
+/// (the 17 columns, EuRoC's header with its spaces, starting 1 s after the IMU, sampled 1 ms
+/// after each IMU sample), `mav0/cam0` and `mav0/cam1` (camera `sensor.yaml`, `data.csv` of image
+/// names, `data/` with the images' names), `mav0/leica0` and `mav0/body.yaml`.
+///
+/// The motion: `rest_s` at rest, then a rotation in place about a fixed tilted body axis at up to
+/// 0.97 rad/s (a 1 s smooth ramp), `duration_s` in all; the true heading at the start is 70°.
+/// The IMU is exact (instantaneous samples, no noise or bias).
+fn write_euroc_sequence(root: &Path, rest_s: f64, duration_s: f64) {
+    use host_sim::estimator_core::lie::{LieGroup, So3};
+    use nalgebra::Vector3;
+    let mav0 = root.join("mav0");
+    for d in [
+        "imu0",
+        "state_groundtruth_estimate0",
+        "cam0/data",
+        "cam1/data",
+        "leica0",
+    ] {
+        std::fs::create_dir_all(mav0.join(d)).unwrap();
+    }
+    let start: u64 = 1_403_636_579_758_555_392;
+    let axis = Vector3::new(0.3, -0.2, 0.9);
+    let rate = axis.norm();
+    let axis = axis / rate;
+    let r0 = So3::exp(&Vector3::new(0.0, 0.0, 70_f64.to_radians()))
+        .compose(&So3::exp(&Vector3::new(0.05, -0.08, 0.0)));
+    // The ramp s(u) = 3u² − 2u³ over the first second of motion; the angle is its integral.
+    let at = |t: f64| -> (So3<f64>, Vector3<f64>) {
+        let u = (t - rest_s).max(0.0);
+        let (s, angle) = if u < 1.0 {
+            (3.0 * u * u - 2.0 * u * u * u, u.powi(3) - 0.5 * u.powi(4))
+        } else {
+            (1.0, 0.5 + (u - 1.0))
+        };
+        (
+            r0.compose(&So3::exp(&(axis * rate * angle))),
+            axis * rate * s,
+        )
+    };
+    let mut imu = String::from("#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\r\n");
+    let mut gt = format!("{EUROC_GT_HEADER}\n");
+    let mut cam = String::from("#timestamp [ns],filename\n");
+    let mut leica = String::from("#timestamp [ns], p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m]\n");
+    let samples = (duration_s * 200.0) as u64;
+    for k in 0..samples {
+        let t_ns = start + k * 5_000_000;
+        let t = (k * 5_000_000) as f64 * 1e-9;
+        let (r, w) = at(t);
+        let f = r.inverse().act(&Vector3::new(0.0, 0.0, 9.81));
+        imu.push_str(&format!(
+            "{t_ns},{:.12},{:.12},{:.12},{:.12},{:.12},{:.12}\r\n",
+            w.x, w.y, w.z, f.x, f.y, f.z
+        ));
+        if t >= 1.0 {
+            let (r, _) = at(t + 1e-3);
+            let q = r.quaternion();
+            gt.push_str(&format!(
+                "{},4.688319,-1.786938,0.783338,{:.12},{:.12},{:.12},{:.12},0.0,0.0,0.0,0.0,0.0,0.0,0.0,0.0,0.0\n",
+                t_ns + 1_000_000,
+                q.w,
+                q.i,
+                q.j,
+                q.k
+            ));
+        }
+        if k % 10 == 0 {
+            cam.push_str(&format!("{t_ns},{t_ns}.png\n"));
+            for c in ["cam0", "cam1"] {
+                std::fs::write(mav0.join(c).join("data").join(format!("{t_ns}.png")), b"").unwrap();
+            }
+            leica.push_str(&format!("{t_ns},4.688319,-1.786938,0.783338\n"));
+        }
+    }
+    std::fs::write(mav0.join("imu0/data.csv"), imu).unwrap();
+    std::fs::write(mav0.join("imu0/sensor.yaml"), EUROC_IMU_YAML).unwrap();
+    std::fs::write(mav0.join("state_groundtruth_estimate0/data.csv"), gt).unwrap();
+    std::fs::write(
+        mav0.join("state_groundtruth_estimate0/sensor.yaml"),
+        "# Additional sensor information\nsensor_type: visual-inertial\ncomment: The nonlinear least-squares batch solution over the Vicon pose and IMU measurements including time offset estimation. The orientation is only accurate to within 3 degrees.\n",
+    )
+    .unwrap();
+    for c in ["cam0", "cam1"] {
+        std::fs::write(mav0.join(c).join("data.csv"), &cam).unwrap();
+        std::fs::write(mav0.join(c).join("sensor.yaml"), EUROC_CAM_YAML).unwrap();
+    }
+    std::fs::write(mav0.join("leica0/data.csv"), leica).unwrap();
+    std::fs::write(
+        mav0.join("leica0/sensor.yaml"),
+        "sensor_type: position\ncomment: position measurement of the prism\n",
+    )
+    .unwrap();
+    std::fs::write(mav0.join("body.yaml"), "comment: 'Body frame reference'\n").unwrap();
+}
+
+/// `host-sim replay ROOT` on a EuRoC sequence as it unpacks (`ROOT/mav0/...`): the dataset is
+/// found in `mav0/` (said in the summary), the image-only cameras are left out with a warning,
+/// the attitude navigator runs on the IMU alone, and the run is scored with the heading aligned
+/// (no heading reference), in the summary and in `metrics.json`.
+#[test]
+fn replay_of_a_euroc_sequence_root_scores_the_yaw_aligned_attitude() {
+    let base = tmp("euroc");
+    let root = base.join("MH_01_easy");
+    write_euroc_sequence(&root, 3.0, 12.0);
+    let out = base.join("out");
+    let o = host_sim(&[
+        "replay",
+        root.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{}\n{stdout}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(stdout.contains("dataset MH_01_easy"), "{stdout}");
+    assert!(
+        stdout.contains("holds mav0/ (EuRoC layout)") && stdout.contains("mav0"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("IMU only (no heading reference)"),
+        "{stdout}"
+    );
+    for cam in ["cam0", "cam1"] {
+        assert!(
+            stdout
+                .lines()
+                .any(|l| l.contains("warning:") && l.contains(cam)),
+            "{cam}: {stdout}"
+        );
+    }
+    let m: serde_json::Value =
+        serde_json::from_slice(&read(&out.join("metrics.json"))).expect("json");
+    let aligned = m["attitude_rmse_yaw_aligned_deg"]
+        .as_f64()
+        .expect("yaw-aligned RMSE");
+    let unaligned = m["attitude_rmse_deg"].as_f64().expect("RMSE");
+    assert!(aligned.is_finite() && aligned < 3.0, "{aligned}°: {m}");
+    assert!(unaligned > aligned + 10.0, "{unaligned}° vs {aligned}°");
+    assert_eq!(m["heading_reference"], false);
+    assert_eq!(m["warnings"].as_array().map(Vec::len), Some(2), "{m}");
+    // No position is estimated: no ATE or RPE, not zeros.
+    assert!(m["ate"].is_null() && m["rpe"].is_null(), "{m}");
+    assert!(m["samples_scored"].as_u64().unwrap_or(0) > 1000);
+    let dataset = m["provenance"]["dataset"].as_str().unwrap_or("");
+    assert!(dataset.ends_with("mav0"), "{dataset}");
+    let _ = std::fs::remove_dir_all(&base);
+}
+
+/// `host-sim run` writes evo's figures and where the run comes from in `metrics.json`.
+#[test]
+fn metrics_json_holds_ate_rpe_and_provenance() {
+    let out = tmp("ate-rpe");
+    let o = host_sim(&[
+        "run",
+        "--scenario",
+        "car",
+        "--seed",
+        "4",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(stdout.contains("ATE RMSE, SE(3)-aligned [m]"), "{stdout}");
+    assert!(stdout.contains("RPE RMSE over 1 s [m]"), "{stdout}");
+    let m: serde_json::Value =
+        serde_json::from_slice(&read(&out.join("metrics.json"))).expect("json");
+    assert_eq!(m["ate"]["alignment"], "se3");
+    for a in ["none", "se3", "yaw", "origin"] {
+        let s = &m["ate_by_alignment"][a];
+        for k in ["rmse", "mean", "median", "std", "min", "max", "sse"] {
+            assert!(s[k].as_f64().is_some_and(f64::is_finite), "{a} {k}: {s}");
+        }
+    }
+    // The SE(3) alignment can only lower the RMSE; unaligned is the existing figure.
+    let rmse = |a: &str| {
+        m["ate_by_alignment"][a]["rmse"]
+            .as_f64()
+            .unwrap_or(f64::NAN)
+    };
+    assert!(rmse("se3") <= rmse("none") + 1e-12);
+    assert!(rmse("se3") <= rmse("yaw") + 1e-12);
+    let unaligned = m["ate_position_rmse_m"].as_f64().unwrap_or(f64::NAN);
+    assert!((rmse("none") - unaligned).abs() < 1e-5, "{unaligned}");
+    assert_eq!(m["rpe"]["delta"], 1.0);
+    assert_eq!(m["rpe"]["delta_unit"], "s");
+    assert!(m["rpe"]["pairs"].as_u64().unwrap_or(0) > 10);
+    let p = &m["provenance"];
+    assert_eq!(p["scenario"], "car");
+    assert_eq!(p["seed"], 4);
+    assert_eq!(p["precision"], "f32");
+    assert_eq!(p["host_sim_version"], env!("CARGO_PKG_VERSION"));
+    assert!(
+        p["command_line"]
+            .as_array()
+            .is_some_and(|a| a.iter().any(|x| x == "--seed")),
+        "{p}"
+    );
+    assert_eq!(m["heading_reference"], true);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// evo (github.com/MichaelGrupp/evo) run on `estimate.tum` and `groundtruth.tum` reproduces the
+/// ATE (unaligned, SE(3)- and origin-aligned) and the RPE of `metrics.json` within 1e-6
+/// relative (`tools/evo_check.py`). Runs when `HOST_SIM_EVO` names a Python environment with
+/// evo installed (its folder or its `python`), e.g. after
+/// `python3 -m venv /tmp/evo-venv && /tmp/evo-venv/bin/pip install evo`:
+/// `HOST_SIM_EVO=/tmp/evo-venv cargo test -p host-sim --test cli evo`.
+#[test]
+fn evo_reproduces_the_ate_and_rpe() {
+    let Some(evo) = std::env::var_os("HOST_SIM_EVO") else {
+        eprintln!(
+            "skipped: HOST_SIM_EVO is not set (python3 -m venv /tmp/evo-venv && /tmp/evo-venv/bin/pip install evo; then HOST_SIM_EVO=/tmp/evo-venv)"
+        );
+        return;
+    };
+    let evo = PathBuf::from(evo);
+    let python = if evo.is_dir() {
+        evo.join("bin/python")
+    } else {
+        evo
+    };
+    assert!(
+        python.is_file(),
+        "HOST_SIM_EVO: {} is not a Python with evo",
+        python.display()
+    );
+    let out = tmp("evo");
+    let o = host_sim(&["run", "--out", out.to_str().expect("utf-8")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tools/evo_check.py");
+    let check = Command::new(&python)
+        .arg(&script)
+        .arg(&out)
+        .output()
+        .expect("python runs");
+    let text = String::from_utf8_lossy(&check.stdout);
+    assert!(
+        check.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&check.stderr)
+    );
+    assert!(text.contains("agree with evo"), "{text}");
+    let _ = std::fs::remove_dir_all(&out);
 }

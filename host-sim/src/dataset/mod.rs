@@ -20,6 +20,14 @@
 //! Every sensor folder but `imu0` is optional; files and keys the layout does not name are
 //! ignored.
 //!
+//! A real EuRoC sequence unpacks as `MH_01_easy/mav0/{imu0,cam0,cam1,leica0,
+//! state_groundtruth_estimate0,body.yaml}`: given the folder that holds `mav0/` (and no `imu0/`
+//! of its own), the dataset is `mav0/` ([`locate`]). Its `sensor.yaml` files are Kalibr's (the
+//! keys above, `T_BS` as `{cols, rows, data}`, comments), read as they are. Its camera folders
+//! hold images (`data.csv` of file names and `data/*.png`), not the landmark observations this
+//! layout names: the reader leaves such a camera out, with a warning, and the replay runs on the
+//! IMU alone. `leica0/`, `body.yaml` and other files are not read.
+//!
 //! Errors name the file and the line, in one line: `imu0/data.csv:17: expected 7 columns, got 6`.
 
 pub mod read;
@@ -27,6 +35,47 @@ pub mod write;
 pub mod yaml;
 
 use std::path::{Path, PathBuf};
+
+/// A dataset folder as found from the folder given.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Located {
+    /// The dataset folder (the one holding `imu0/`).
+    pub dir: PathBuf,
+    /// The folder given, when the dataset is its `mav0/` (EuRoC's layout).
+    pub root: Option<PathBuf>,
+}
+
+impl Located {
+    /// A sentence for the summary when the dataset is a `mav0/` found inside the folder given.
+    #[must_use]
+    pub fn note(&self) -> Option<String> {
+        self.root.as_ref().map(|root| {
+            format!(
+                "{} holds mav0/ (EuRoC layout): the dataset folder is {}",
+                root.display(),
+                self.dir.display()
+            )
+        })
+    }
+}
+
+/// The dataset folder of `dir`: `dir/mav0` when `dir` has no `imu0/` but a `mav0/` folder (a
+/// EuRoC sequence unpacked), else `dir` itself.
+#[must_use]
+pub fn locate(dir: &Path) -> Located {
+    let mav0 = dir.join("mav0");
+    if !dir.join("imu0").is_dir() && mav0.is_dir() {
+        Located {
+            dir: mav0,
+            root: Some(dir.to_path_buf()),
+        }
+    } else {
+        Located {
+            dir: dir.to_path_buf(),
+            root: None,
+        }
+    }
+}
 
 /// An error reading or writing a dataset: where, and what.
 #[derive(Debug, thiserror::Error)]

@@ -267,6 +267,21 @@ impl Dataset {
             ));
         }
         let y = SensorYaml::read(&imu_yaml)?;
+        let mut warnings = Vec::new();
+        // Kalibr's sensor.yaml gives the IMU's pose in the body frame; the filter's body is the
+        // IMU, and the ground truth is taken to be of the IMU.
+        if let Ok(t) = y.list("T_BS", 16) {
+            let identity = |i: usize| if i.is_multiple_of(5) { 1.0 } else { 0.0 };
+            if t.iter()
+                .enumerate()
+                .any(|(i, v)| (v - identity(i)).abs() > 1e-9)
+            {
+                warnings.push(format!(
+                    "{}: T_BS is not the identity; the body frame is taken to be the IMU's (the ground truth must be of the IMU)",
+                    imu_yaml.display()
+                ));
+            }
+        }
         let imu = ImuParams {
             rate_hz: y.f64("rate_hz")?,
             gyroscope_noise_density: y.f64("gyroscope_noise_density")?,
@@ -285,7 +300,6 @@ impl Dataset {
         } else {
             None
         };
-        let mut warnings = Vec::new();
         let gnss = if dir.join("gnss0/data.csv").is_file() {
             let path = dir.join("gnss0/sensor.yaml");
             let lever_arm = if path.is_file() {
@@ -339,6 +353,7 @@ impl Dataset {
         } else {
             None
         };
+        warnings.extend(unused_cameras(dir, camera.is_some()));
         let baro = if dir.join("baro0/data.csv").is_file() {
             let y = SensorYaml::read(&dir.join("baro0/sensor.yaml"))?;
             Some(BaroParams {
@@ -397,6 +412,39 @@ impl Dataset {
             },
         })
     }
+}
+
+/// Warnings for the camera folders (`cam0`, `cam1`, …) the replay does not use: EuRoC's hold
+/// images, not landmark observations; only `cam0` with `observations.csv` is read.
+fn unused_cameras(dir: &Path, cam0_used: bool) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut names: Vec<String> = entries
+        .filter_map(Result::ok)
+        .filter(|e| e.path().is_dir())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| {
+            n.strip_prefix("cam")
+                .is_some_and(|k| !k.is_empty() && k.chars().all(|c| c.is_ascii_digit()))
+        })
+        .collect();
+    names.sort();
+    names
+        .into_iter()
+        .filter(|n| !(n == "cam0" && cam0_used))
+        .map(|n| {
+            let why = if n == "cam0" {
+                "has no observations.csv and landmarks.csv (EuRoC's images are not used)"
+            } else {
+                "is not used (only cam0 is read)"
+            };
+            format!(
+                "{} {why}: the replay runs without this camera",
+                dir.join(&n).display()
+            )
+        })
+        .collect()
 }
 
 struct Source {
@@ -675,6 +723,93 @@ mod tests {
                 .to_string();
             assert!(err.contains(at) && err.contains(what), "{text:?}: {err}");
         }
+    }
+
+    /// A EuRoC sequence as it unpacks, in miniature: Kalibr's `imu0/sensor.yaml` with its
+    /// comments, EuRoC's `data.csv` headers (CRLF line ends in the IMU file), the ground truth's
+    /// 17 columns under a header with spaces after the commas, and image-only cameras.
+    #[test]
+    fn a_euroc_sequence_is_read_from_its_mav0_with_the_cameras_left_out() {
+        let root = std::env::temp_dir().join(format!("host-sim-euroc-read-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        let mav0 = root.join("mav0");
+        for d in [
+            "imu0",
+            "state_groundtruth_estimate0",
+            "cam0/data",
+            "cam1/data",
+            "leica0",
+        ] {
+            std::fs::create_dir_all(mav0.join(d)).expect("tmp");
+        }
+        let imu_yaml = "#Default imu sensor yaml file\nsensor_type: imu\ncomment: VI-Sensor IMU (ADIS16448)\n\n# Sensor extrinsics wrt. the body-frame.\nT_BS:\n  cols: 4\n  rows: 4\n  data: [1.0, 0.0, 0.0, 0.0,\n         0.0, 1.0, 0.0, 0.0,\n         0.0, 0.0, 1.0, 0.0,\n         0.0, 0.0, 0.0, 1.0]\nrate_hz: 200\n\n# inertial sensor noise model parameters (static)\ngyroscope_noise_density: 1.6968e-04     # [ rad / s / sqrt(Hz) ]   ( gyro \"white noise\" )\ngyroscope_random_walk: 1.9393e-05       # [ rad / s^2 / sqrt(Hz) ] ( gyro bias diffusion )\naccelerometer_noise_density: 2.0000e-3  # [ m / s^2 / sqrt(Hz) ]  ( accel \"white noise\" )\naccelerometer_random_walk: 3.0000e-3    # [ m / s^3 / sqrt(Hz) ].  ( accel bias diffusion )\n";
+        std::fs::write(mav0.join("imu0/sensor.yaml"), imu_yaml).expect("write");
+        std::fs::write(
+            mav0.join("imu0/data.csv"),
+            "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\r\n\
+             1403636579758555392,-0.099134701513277898,0.14730578886832138,0.02722713633111154,8.1476917083333333,-0.37592158333333331,-2.4026292499999999\r\n\
+             1403636579763555584,-0.099134701513277898,0.14032447186034408,0.029321531433504733,8.033280791666666,-0.40861041666666664,-2.4026292499999999\r\n",
+        )
+        .expect("write");
+        std::fs::write(
+            mav0.join("state_groundtruth_estimate0/data.csv"),
+            "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]\n\
+             1403636580838555648,4.688319,-1.786938,0.783338,0.534108,-0.153029,-0.827383,-0.082152,-0.027876,0.033207,0.800006,-0.003172,0.021267,0.078502,-0.025266,0.136696,0.075593\n",
+        )
+        .expect("write");
+        for cam in ["cam0", "cam1"] {
+            std::fs::write(
+                mav0.join(cam).join("sensor.yaml"),
+                "sensor_type: camera\ncomment: VI-Sensor cam0 (MT9M034)\nT_BS:\n  cols: 4\n  rows: 4\n  data: [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]\nrate_hz: 20\nresolution: [752, 480]\ncamera_model: pinhole\nintrinsics: [458.654, 457.296, 367.215, 248.375] #fu, fv, cu, cv\n",
+            )
+            .expect("write");
+            std::fs::write(
+                mav0.join(cam).join("data.csv"),
+                "#timestamp [ns],filename\n1403636579763555584,1403636579763555584.png\n",
+            )
+            .expect("write");
+        }
+        std::fs::write(mav0.join("body.yaml"), "comment: 'Body frame reference'\n").expect("write");
+
+        let located = crate::dataset::locate(&root);
+        assert_eq!(located.dir, mav0);
+        assert!(located.note().is_some_and(|n| n.contains("mav0")));
+        assert_eq!(crate::dataset::locate(&mav0).root, None);
+        let ds = Dataset::open(&located.dir).expect("a EuRoC sequence opens");
+        assert_eq!(ds.imu.rate_hz, 200.0);
+        assert_eq!(ds.imu.gyroscope_noise_density, 1.6968e-04);
+        assert_eq!(ds.imu.accelerometer_random_walk, 3.0e-3);
+        assert!(ds.camera.is_none() && ds.mag.is_none() && ds.gnss.is_none());
+        assert!(ds.has_groundtruth);
+        assert_eq!(ds.warnings.len(), 2, "{:?}", ds.warnings);
+        assert!(ds.warnings[0].contains("cam0") && ds.warnings[1].contains("cam1"));
+        let events: Vec<Event> = ds
+            .events()
+            .expect("stream")
+            .collect::<Result<_, _>>()
+            .expect("rows");
+        assert_eq!(events.len(), 2);
+        assert_eq!(events[1].t_ns(), 1_403_636_579_763_555_584);
+        let truth = TruthStream::open(&located.dir)
+            .expect("truth")
+            .next_truth()
+            .expect("row")
+            .expect("one row");
+        assert_eq!(truth.position, Vector3::new(4.688319, -1.786938, 0.783338));
+        assert!((truth.attitude.quaternion().w - 0.534108).abs() < 1e-4);
+
+        // An IMU that is not the body frame is named, not silently taken as it.
+        std::fs::write(
+            mav0.join("imu0/sensor.yaml"),
+            imu_yaml.replace("data: [1.0, 0.0, 0.0, 0.0,", "data: [1.0, 0.0, 0.0, 0.1,"),
+        )
+        .expect("write");
+        let ds = Dataset::open(&mav0).expect("opens");
+        assert!(ds
+            .warnings
+            .iter()
+            .any(|w| w.contains("T_BS is not the identity")));
+        let _ = std::fs::remove_dir_all(root);
     }
 
     #[test]

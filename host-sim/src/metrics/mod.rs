@@ -9,10 +9,18 @@
 //! Two further figures compare with published references: the attitude RMSE from 2 s after the
 //! first ground-truth sample (so that every filter is judged after the same start), and BROAD's
 //! total / heading / inclination RMSEs inside a trial's movement intervals ([`broad`]).
+//!
+//! The trajectory metrics users know from evo — the absolute trajectory error after an
+//! alignment and the relative pose error over 1 s — are computed from the scored pose pairs
+//! ([`trajectory`]); so is the attitude RMSE with the heading offset removed, the score of a run
+//! without a heading reference (IMU only). The pairs are kept as they are written to
+//! `estimate.tum` and `groundtruth.tum` (positions to the µm, quaternions to 1e-9), so that evo
+//! on those two files reproduces the figures; they take 120 bytes per scored sample.
 
 pub mod broad;
+pub mod trajectory;
 
-use crate::dataset::read::Truth;
+use crate::dataset::read::{Dataset, Truth};
 use crate::dataset::DatasetError;
 use broad::{broad_error, in_intervals, BroadAccumulator, BroadRmse};
 use estimator_core::lie::{LieGroup, So3};
@@ -20,9 +28,14 @@ use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
+use trajectory::{Alignment, Ate, Pose, PosePair, Rpe, DEFAULT_RPE_DELTA};
 
 /// The attitude RMSE after the start scores from this long after the first truth sample, ns.
 pub const AFTER_START_NS: u64 = 2_000_000_000;
+
+/// The alignment of the `ate` object of `metrics.json` (evo's `-a`); every alignment is in
+/// `ate_by_alignment`.
+pub const ATE_ALIGNMENT: Alignment = Alignment::Se3;
 
 /// The blocks of the 15-dimensional error state, in order.
 pub const BLOCKS: [&str; 5] = [
@@ -220,6 +233,63 @@ pub struct Scorer {
     truth_start_ns: Option<u64>,
     /// Sum of squared attitude errors and count from [`AFTER_START_NS`] after the truth start.
     after_start: (f64, u64),
+    /// The scored (estimate, truth) pose pairs, as written to the TUM files.
+    pairs: Vec<PosePair>,
+    /// Whether a scored estimate had a position (a position covariance block).
+    positions: bool,
+    /// Whether the dataset has a heading reference; `None` until [`Scorer::note_run`].
+    heading_reference: Option<bool>,
+    /// Where the run comes from (copied to `metrics.json`).
+    pub provenance: Provenance,
+}
+
+/// Where a run comes from, recorded in `metrics.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Provenance {
+    /// The command line of the process (`std::env::args_os`, lossily as UTF-8).
+    pub command_line: Vec<String>,
+    /// `host-sim`'s version.
+    pub host_sim_version: String,
+    /// The dataset folder the replay read.
+    pub dataset: Option<String>,
+    /// The scenario simulated, for `host-sim run`.
+    pub scenario: Option<String>,
+    /// The RNG seed of the simulation, for `host-sim run`.
+    pub seed: Option<u64>,
+    /// `f32` or `f64`.
+    pub precision: Option<String>,
+}
+
+impl Default for Provenance {
+    /// This process's command line and host-sim's version; the rest unknown.
+    fn default() -> Self {
+        Self {
+            command_line: std::env::args_os()
+                .map(|a| a.to_string_lossy().into_owned())
+                .collect(),
+            host_sim_version: env!("CARGO_PKG_VERSION").to_string(),
+            dataset: None,
+            scenario: None,
+            seed: None,
+            precision: None,
+        }
+    }
+}
+
+/// `x` as `{:.decimals}` writes it and a reader parses it back.
+fn as_written(x: f64, decimals: usize) -> f64 {
+    format!("{x:.decimals$}").parse().unwrap_or(x)
+}
+
+/// A pose as `estimate.tum` and `groundtruth.tum` hold it: position to 6 decimals, the
+/// quaternion's components to 9 (normalised when read, as evo does).
+fn written_pose(position: &Vector3<f64>, attitude: &So3<f64>) -> Pose {
+    let q = attitude.quaternion();
+    let w = |x: f64| as_written(x, 9);
+    Pose {
+        position: position.map(|x| as_written(x, 6)),
+        attitude: So3::from_wxyz(w(q.w), w(q.i), w(q.j), w(q.k)).unwrap_or(*attitude),
+    }
 }
 
 /// The figures of one run (`metrics.json`).
@@ -227,8 +297,27 @@ pub struct Scorer {
 pub struct Metrics {
     /// Position RMSE over the run, m (no alignment: the world frame is absolute).
     pub ate_position_rmse_m: f64,
+    /// Absolute trajectory error (translation part) after the [`ATE_ALIGNMENT`] alignment, with
+    /// evo's statistics ([`trajectory`]); `None` (`null`) when the position is not estimated or
+    /// nothing was scored.
+    pub ate: Option<Ate>,
+    /// The ATE after each alignment (`none`, `se3`, `yaw`, `origin`).
+    pub ate_by_alignment: BTreeMap<String, Ate>,
+    /// Relative pose error (translation part) over [`DEFAULT_RPE_DELTA`], with evo's
+    /// statistics; `None` (`null`) when the position is not estimated or no pair spans the delta.
+    pub rpe: Option<Rpe>,
     /// Attitude RMSE, degrees (NaN, written `null`, when nothing was scored).
     pub attitude_rmse_deg: f64,
+    /// Attitude RMSE with the heading offset removed: the constant rotation about the world
+    /// vertical that minimises the error over the whole run is applied to the estimate first
+    /// ([`trajectory::attitude_yaw_aligned`]), degrees. The score of a run without a heading
+    /// reference.
+    pub attitude_rmse_yaw_aligned_deg: f64,
+    /// That heading offset, degrees.
+    pub attitude_yaw_offset_deg: f64,
+    /// Whether the dataset has a heading reference (a magnetometer, GNSS or a camera); `false`:
+    /// IMU only, the heading is arbitrary and `attitude_rmse_yaw_aligned_deg` is the score.
+    pub heading_reference: Option<bool>,
     /// Attitude RMSE (geodesic angle) from 2 s after the first ground-truth sample, degrees
     /// (NaN, written `null`, when nothing was scored there).
     pub attitude_rmse_after_2s_deg: f64,
@@ -257,6 +346,8 @@ pub struct Metrics {
     pub baseline_attitude_rmse_deg: BTreeMap<String, f64>,
     /// What the run assumed for want of an optional file.
     pub warnings: Vec<String>,
+    /// Where the run comes from.
+    pub provenance: Provenance,
 }
 
 impl Scorer {
@@ -287,9 +378,33 @@ impl Scorer {
         Ok(self)
     }
 
+    /// Records what the dataset holds and the precision of the run: the reader's warnings, the
+    /// presence of a heading reference, the dataset folder (unless already set) and the
+    /// precision.
+    pub fn note_run(&mut self, ds: &Dataset, precision: &str) {
+        self.warnings.extend(ds.warnings.iter().cloned());
+        self.heading_reference = Some(ds.mag.is_some() || ds.gnss.is_some() || ds.camera.is_some());
+        if self.provenance.dataset.is_none() {
+            self.provenance.dataset = Some(ds.dir.display().to_string());
+        }
+        self.provenance.precision = Some(precision.to_string());
+    }
+
+    /// The scored (estimate, truth) pose pairs, in time order.
+    #[must_use]
+    pub fn pairs(&self) -> &[PosePair] {
+        &self.pairs
+    }
+
     /// Scores one estimate against the truth at the same time.
     pub fn add(&mut self, e: &Estimate, truth: &Truth) {
         let t0 = *self.t0_ns.get_or_insert(e.t_ns);
+        self.positions |= e.cov[2].is_some();
+        self.pairs.push(PosePair {
+            t_ns: e.t_ns,
+            estimate: written_pose(&e.position, &e.attitude),
+            truth: written_pose(&truth.position, &truth.attitude),
+        });
         let truth_start = *self.truth_start_ns.get_or_insert(truth.t_ns);
         let errs = errors(e, truth);
         if truth.t_ns >= truth_start.saturating_add(AFTER_START_NS) {
@@ -384,6 +499,21 @@ impl Scorer {
                 );
             }
         }
+        let (ate, ate_by_alignment, rpe) = if self.positions {
+            let all: BTreeMap<String, Ate> = Alignment::ALL
+                .iter()
+                .filter_map(|a| trajectory::ate(&self.pairs, *a))
+                .map(|a| (a.alignment.name().to_string(), a))
+                .collect();
+            (
+                all.get(ATE_ALIGNMENT.name()).copied(),
+                all,
+                trajectory::rpe(&self.pairs, DEFAULT_RPE_DELTA),
+            )
+        } else {
+            (None, BTreeMap::new(), None)
+        };
+        let yaw = trajectory::attitude_yaw_aligned(&self.pairs);
         let map = |f: &dyn Fn(&SensorStats) -> u64| {
             self.sensors
                 .iter()
@@ -396,12 +526,18 @@ impl Scorer {
             } else {
                 f64::NAN
             },
+            ate,
+            ate_by_alignment,
+            rpe,
             // Nothing scored is no number (`null` in metrics.json), never 0.
             attitude_rmse_deg: if self.n > 0 {
                 rmse(0).to_degrees()
             } else {
                 f64::NAN
             },
+            attitude_rmse_yaw_aligned_deg: yaw.map_or(f64::NAN, |y| y.rmse_rad.to_degrees()),
+            attitude_yaw_offset_deg: yaw.map_or(f64::NAN, |y| y.offset_rad.to_degrees()),
+            heading_reference: self.heading_reference,
             attitude_rmse_after_2s_deg: if self.after_start.1 > 0 {
                 (self.after_start.0 / self.after_start.1 as f64)
                     .sqrt()
@@ -437,6 +573,7 @@ impl Scorer {
                 .map(|(k, (sq, n))| (k.clone(), (sq / (*n).max(1) as f64).sqrt().to_degrees()))
                 .collect(),
             warnings: self.warnings.clone(),
+            provenance: self.provenance.clone(),
         }
     }
 }

@@ -270,6 +270,8 @@ pub fn replay(
 
 /// As [`replay`], starting from (and returning) a given scorer, for callers that need more than
 /// the summary (Monte Carlo keeps the per-sample NEES).
+///
+/// A folder holding `mav0/` (a EuRoC sequence) is read as its `mav0/` ([`crate::dataset::locate`]).
 pub fn replay_scored(
     dataset_dir: &Path,
     out: &Path,
@@ -277,6 +279,8 @@ pub fn replay_scored(
     title: &str,
     scorer: Scorer,
 ) -> Result<Scorer, ReplayError> {
+    let dataset_dir = crate::dataset::locate(dataset_dir).dir;
+    let dataset_dir = dataset_dir.as_path();
     let scorer = scorer.for_dataset(dataset_dir)?;
     match cfg.precision.as_str() {
         "f32" => replay_in::<f32>(dataset_dir, out, cfg, title, scorer),
@@ -295,7 +299,7 @@ fn replay_in<T: Real>(
     mut scorer: Scorer,
 ) -> Result<Scorer, ReplayError> {
     let ds = Dataset::open(dir)?;
-    scorer.warnings.extend(ds.warnings.iter().cloned());
+    scorer.note_run(&ds, &cfg.precision);
     std::fs::create_dir_all(out).map_err(out_err(out))?;
     if ds.gnss.is_none() && ds.camera.is_none() {
         return attitude::replay_attitude::<T>(&ds, dir, out, cfg, title, scorer);

@@ -605,3 +605,24 @@ fn so3_from_quaternion_takes_huge_and_tiny_quaternions() {
     assert!(So3::from_quaternion(&Quaternion::new(f64::NAN, 1.0, 0.0, 0.0)).is_none());
     assert!(So3::from_quaternion(&Quaternion::new(f64::INFINITY, 1.0, 0.0, 0.0)).is_none());
 }
+
+/// `So3::exp` of a finite but huge rotation vector is a rotation about the same axis (a unit
+/// quaternion), not NaN: `‖ω‖²` overflows from 1e155 (f64) and 1e20 (f32).
+#[test]
+fn so3_exp_of_huge_vectors_is_a_rotation() {
+    for w in [
+        Vector3::new(1e155, 0.0, 0.0),
+        Vector3::new(-3e200, 4e200, 0.0),
+        Vector3::new(f64::MAX, f64::MAX, f64::MAX),
+    ] {
+        let q = So3::exp(&w).quaternion();
+        assert!(q.coords.iter().all(|c| c.is_finite()), "{w:?} -> {q:?}");
+        assert!((q.coords.norm() - 1.0).abs() < 1e-12);
+        // The vector part lies along the axis.
+        let axis = w / w.amax();
+        assert!(q.vector().cross(&axis).norm() < 1e-9 * axis.norm());
+    }
+    let q = So3::exp(&Vector3::new(0.0f32, 1e20, 0.0)).quaternion();
+    assert!(q.coords.iter().all(|c| c.is_finite()) && (q.coords.norm() - 1.0).abs() < 1e-6);
+    assert!(q.i == 0.0 && q.k == 0.0);
+}

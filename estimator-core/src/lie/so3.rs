@@ -257,6 +257,9 @@ impl<T: Real> LieGroup<T> for So3<T> {
     /// kernel).
     fn exp(w: &Vector3<T>) -> Self {
         let theta_sq = w.norm_squared();
+        if !theta_sq.is_finite() && all_finite(w.as_slice()) {
+            return exp_huge(w);
+        }
         let theta = theta_sq.sqrt_rn();
         let (s, c) = (theta * T::lit(0.5)).sincos();
         let v = w * half_sinc(theta_sq, theta, s);
@@ -362,5 +365,26 @@ impl<T: Real> LieGroup<T> for So3<T> {
     fn act_jac(&self, p: &Vector3<T>) -> (Vector3<T>, Matrix3<T>, Matrix3<T>) {
         let r = self.rotation_matrix();
         (mul_vec(&r, p), mul_skew(&r, &-p), r)
+    }
+}
+
+/// `exp` of a finite `ω` whose `‖ω‖²` overflows (`‖ω‖ ≳ 1.8e19` in `f32`, `1.3e154` in `f64`):
+/// the same rotation `[cos(θ/2), sin(θ/2) ω/θ]`, with `θ = m ‖ω/m‖` computed from `ω` scaled by
+/// its largest component `m`, and `sin`/`cos` of the huge `θ/2` reduced exactly by
+/// [`Real::sincos`]. At such angles one unit in the last place of `θ` is many turns, so the
+/// angle is whatever that rounding makes it; the axis is kept and the result is a rotation, not
+/// NaN.
+#[cold]
+#[inline(never)]
+fn exp_huge<T: Real>(w: &Vector3<T>) -> So3<T> {
+    let m = w.iter().fold(T::zero(), |m, c| m.max(c.abs()));
+    let u = w / m;
+    let n = u.norm_squared().sqrt_rn();
+    let axis = u / n;
+    // Halved before the product: `m n` itself can overflow (all three components at the maximum).
+    let (s, c) = (m * T::lit(0.5) * n).sincos();
+    let v = axis * s;
+    So3 {
+        q: UnitQuaternion::new_unchecked(Quaternion::new(c, v.x, v.y, v.z)),
     }
 }

@@ -172,9 +172,9 @@ pub struct SensorStats {
     /// Sum of the measurement dimensions (the NIS expectation).
     #[serde(skip)]
     pub dof_sum: f64,
-    /// (s, NIS, dof) history for the plots.
+    /// (s, NIS, dof, accepted) history for the plots (`false`: gated out).
     #[serde(skip)]
-    pub history: History<(f64, f64, usize)>,
+    pub history: History<(f64, f64, usize, bool)>,
 }
 
 impl SensorStats {
@@ -471,7 +471,8 @@ impl Scorer {
         let s = self.sensors.entry(sensor.to_string()).or_default();
         match outcome {
             Outcome::Accepted { nis, dof } | Outcome::Rejected { nis, dof } => {
-                if matches!(outcome, Outcome::Accepted { .. }) {
+                let accepted = matches!(outcome, Outcome::Accepted { .. });
+                if accepted {
                     s.accepted += 1;
                 } else {
                     s.rejected += 1;
@@ -479,7 +480,7 @@ impl Scorer {
                 s.nis_sum += nis;
                 s.dof_sum += dof as f64;
                 s.history
-                    .push(((t_ns.saturating_sub(t0)) as f64 * 1e-9, nis, dof));
+                    .push(((t_ns.saturating_sub(t0)) as f64 * 1e-9, nis, dof, accepted));
             }
             Outcome::Refused => s.refused += 1,
         }

@@ -502,7 +502,7 @@ pub fn run_from(
             if let Some(st) = s.sensors.get(&name) {
                 // After the start-up, like the NEES (the history holds every update unless a
                 // run is long enough to be decimated, when it holds a uniform subsample).
-                for &(_, nis, d) in st.history.points().iter().filter(|p| p.0 >= settle_s) {
+                for &(_, nis, d, _) in st.history.points().iter().filter(|p| p.0 >= settle_s) {
                     total += nis;
                     dof += d as f64;
                     count += 1.0;

@@ -126,6 +126,7 @@ const START: RGBColor = RGBColor(0, 150, 0);
 const END: RGBColor = RGBColor(30, 90, 220);
 const POINT: RGBColor = BLUE;
 const CLIPPED: RGBColor = RGBColor(230, 120, 0);
+const GATED: RGBColor = RGBColor(200, 0, 0);
 const EXPECTED: RGBColor = RGBColor(0, 150, 0);
 
 /// Pixel size of the markers.
@@ -565,7 +566,7 @@ fn nis_panel(
         .min(hi * 6.0);
     // Above the scale: drawn at its top edge, with a marker of their own.
     let edge = ymax * 0.97;
-    let (inside, above): (Vec<&(f64, f64, usize)>, Vec<_>) = h
+    let (inside, above): (Vec<&(f64, f64, usize, bool)>, Vec<_>) = h
         .iter()
         .filter(|p| !p.1.is_nan())
         .partition(|p| p.1 <= ymax);
@@ -606,21 +607,39 @@ fn nis_panel(
     for (v, style) in [(lo, bound), (hi, bound), (dof as f64, expected)] {
         chart.draw_series(LineSeries::new([(0.0, v), (t1, v)], style))?;
     }
+    // Accepted updates as dots; gated-out ones as larger squares of their own colour.
+    let (accepted, gated): (Vec<&(f64, f64, usize, bool)>, Vec<_>) =
+        inside.iter().copied().partition(|p| p.3);
     chart.draw_series(
-        inside
+        accepted
             .iter()
             .map(|p| Circle::new((p.0, p.1), 2, POINT.filled())),
     )?;
+    chart.draw_series(gated.iter().map(|p| {
+        Rectangle::new(
+            [(p.0, p.1), (p.0, p.1)],
+            GATED.stroke_width(u32::try_from(MARKER).unwrap_or(6)),
+        )
+    }))?;
     chart.draw_series(
         above
             .iter()
             .map(|p| TriangleMarker::new((p.0, edge), MARKER, CLIPPED.filled())),
     )?;
     let mut entries = vec![
-        Entry::new(Mark::Dot(POINT.filled(), 3), "NIS (accepted and gated out)"),
+        Entry::new(Mark::Dot(POINT.filled(), 3), "NIS, accepted"),
         Entry::new(Mark::Line(bound), "95 % bounds"),
         Entry::new(Mark::Line(expected), format!("expected mean ({dof})")),
     ];
+    if !gated.is_empty() {
+        entries.insert(
+            1,
+            Entry::new(
+                Mark::Square(GATED.filled()),
+                format!("NIS, gated out: {}", gated.len()),
+            ),
+        );
+    }
     if !above.is_empty() {
         entries.insert(
             1,

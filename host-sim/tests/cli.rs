@@ -1415,3 +1415,46 @@ fn evo_reproduces_the_ate_and_rpe() {
     assert!(text.contains("agree with evo"), "{text}");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// The RPE's delta and unit come from the replay configuration (evo's `--delta`,
+/// `--delta_unit`), and a unit other than `s` or `m` is refused by name.
+#[test]
+fn rpe_delta_is_configurable() {
+    let base = tmp("rpe-delta");
+    let ds = base.join("ds");
+    simulate("car", &ds);
+    let cfg = base.join("rpe.toml");
+    std::fs::write(
+        &cfg,
+        "rpe_delta = 5.0\nrpe_delta_unit = \"m\"\nplots = false\n",
+    )
+    .expect("write");
+    let out = base.join("out");
+    let args = [
+        "replay",
+        ds.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--config",
+        cfg.to_str().expect("utf-8"),
+    ];
+    let o = host_sim(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let m: serde_json::Value =
+        serde_json::from_slice(&read(&out.join("metrics.json"))).expect("json");
+    assert_eq!(m["rpe"]["delta"].as_f64(), Some(5.0));
+    assert_eq!(m["rpe"]["delta_unit"].as_str(), Some("m"));
+    std::fs::write(&cfg, "rpe_delta_unit = \"km\"\n").expect("write");
+    let bad = base.join("bad");
+    let o = host_sim(&[
+        "replay",
+        ds.to_str().expect("utf-8"),
+        "--out",
+        bad.to_str().expect("utf-8"),
+        "--config",
+        cfg.to_str().expect("utf-8"),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("rpe_delta_unit"));
+    let _ = std::fs::remove_dir_all(&base);
+}

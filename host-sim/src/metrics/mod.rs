@@ -233,6 +233,8 @@ pub struct Scorer {
     truth_start_ns: Option<u64>,
     /// Sum of squared attitude errors and count from [`AFTER_START_NS`] after the truth start.
     after_start: (f64, u64),
+    /// The RPE's delta (`None`: [`DEFAULT_RPE_DELTA`], 1 s).
+    pub rpe_delta: Option<trajectory::Delta>,
     /// The scored (estimate, truth) pose pairs, as written to the TUM files.
     pairs: Vec<PosePair>,
     /// Whether a scored estimate had a position (a position covariance block).
@@ -509,7 +511,7 @@ impl Scorer {
             (
                 all.get(ATE_ALIGNMENT.name()).copied(),
                 all,
-                trajectory::rpe(&self.pairs, DEFAULT_RPE_DELTA),
+                trajectory::rpe(&self.pairs, self.rpe_delta.unwrap_or(DEFAULT_RPE_DELTA)),
             )
         } else {
             (None, BTreeMap::new(), None)

@@ -17,6 +17,7 @@
 use crate::baseline::{Madgwick, Mahony};
 use crate::dataset::read::{CameraParams, Dataset, Event, TruthStream};
 use crate::dataset::DatasetError;
+use crate::metrics::trajectory::Delta;
 use crate::metrics::{Estimate, Metrics, Outcome, Scorer};
 use estimator_core::eskf::{
     align_at_rest, BaroAltitude, EskfError, FilterConfig, GnssPosition, GnssVelocity, ImuNoise,
@@ -74,6 +75,10 @@ pub struct ReplayConfig {
     pub heading_noise_deg: f64,
     /// Attitude navigator: lower bound on the heading's 1σ with a magnetometer, °.
     pub heading_floor_deg: f64,
+    /// The relative pose error's delta (evo's `--delta`), in `rpe_delta_unit`.
+    pub rpe_delta: f64,
+    /// `"s"` (seconds) or `"m"` (metres travelled; evo's `--delta_unit`).
+    pub rpe_delta_unit: String,
     /// The IMU samples are instantaneous values (integrate with the trapezoidal rule) rather
     /// than means over the period ending at their timestamp.
     pub instantaneous_imu: bool,
@@ -87,6 +92,18 @@ impl ReplayConfig {
     /// # Errors
     /// The first value out of its domain, named.
     pub fn validate(&self) -> Result<(), String> {
+        if self.rpe_delta_unit != "s" && self.rpe_delta_unit != "m" {
+            return Err(format!(
+                "rpe_delta_unit = \"{}\": must be \"s\" or \"m\"",
+                self.rpe_delta_unit
+            ));
+        }
+        if !(self.rpe_delta.is_finite() && self.rpe_delta > 0.0) {
+            return Err(format!(
+                "rpe_delta = {}: must be a positive number",
+                self.rpe_delta
+            ));
+        }
         if self.precision != "f32" && self.precision != "f64" {
             return Err(format!(
                 "precision = \"{}\": must be \"f32\" or \"f64\"",
@@ -151,6 +168,8 @@ impl Default for ReplayConfig {
             acceleration_correlation_s: 0.15,
             motion_memory_s: 5.0,
             rotation_only: false,
+            rpe_delta: 1.0,
+            rpe_delta_unit: "s".into(),
             magnetometer_vector: false,
             accelerometer_bias_sigma: 0.1,
             gyro_bias_sigma_dps: 0.5,
@@ -281,7 +300,14 @@ pub fn replay_scored(
 ) -> Result<Scorer, ReplayError> {
     let dataset_dir = crate::dataset::locate(dataset_dir).dir;
     let dataset_dir = dataset_dir.as_path();
-    let scorer = scorer.for_dataset(dataset_dir)?;
+    let mut scorer = scorer.for_dataset(dataset_dir)?;
+    if scorer.rpe_delta.is_none() {
+        scorer.rpe_delta = Some(if cfg.rpe_delta_unit == "m" {
+            Delta::Metres(cfg.rpe_delta)
+        } else {
+            Delta::Seconds(cfg.rpe_delta)
+        });
+    }
     match cfg.precision.as_str() {
         "f32" => replay_in::<f32>(dataset_dir, out, cfg, title, scorer),
         "f64" => replay_in::<f64>(dataset_dir, out, cfg, title, scorer),

@@ -250,7 +250,13 @@ mod tests {
         assert!(!matches("Ins<f32>::predict", "Ins<f64>::predict"));
         assert!(matches("*::update(*)", "Ahrs<f64>::update(Heading)"));
         assert!(!matches("*::update(*)", "Ahrs<f64>::predict"));
-        assert!(matches("AttitudeNavigator<*>::imu", "AttitudeNavigator<f32>::imu"));
-        assert!(!matches("AttitudeNavigator<*>::imu", "AttitudeNavigator<f32>::magnetometer"));
+        assert!(matches(
+            "AttitudeNavigator<*>::imu",
+            "AttitudeNavigator<f32>::imu"
+        ));
+        assert!(!matches(
+            "AttitudeNavigator<*>::imu",
+            "AttitudeNavigator<f32>::magnetometer"
+        ));
     }
 }

@@ -7,7 +7,8 @@ use super::error::{EskfError, UpdateOutcome};
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use super::update::{update, Measurement, UpdateOptions};
 use crate::kernels::block::{add_scaled_identity, block, set_block};
-use crate::kernels::{all_finite, non_negative_finite, positive_finite};
+use crate::kernels::{all_finite, mat3, non_negative_finite, positive_finite};
+use crate::lie::{LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
@@ -280,6 +281,130 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
             sq(sigmas.accel_bias),
         ];
         Self::from_block_diagonal(state, &attitude, &variances, config)
+    }
+}
+
+impl<T: Real> Filter<T, InsState<T>, 15> {
+    /// An INS started from an attitude filter's estimate: `R`, `b_g`, `b_a` and their joint
+    /// covariance (the 9 × 9 `P` of `attitude`, blocks δθ, δb_g, δb_a) carried over, with
+    /// `velocity` and `position` independent of them, of 1σ `sigma_velocity` and
+    /// `sigma_position` per axis. The attitude is taken as `R·C` with `C = carry` (an attitude
+    /// estimated at another time, carried by a known rotation); the right error then becomes
+    /// `δθ' = Cᵀ δθ` (from `R Exp(δθ) C = R C Exp(Cᵀ δθ)`), so the attitude rows and columns
+    /// of `P` are multiplied by `Cᵀ`. `P = [P_θθ 0 0 P_θg P_θa; 0 σ_v² I …]` is positive
+    /// definite because the attitude filter's `P` is and both variances are positive.
+    ///
+    /// # Errors
+    /// A non-finite velocity or position, a sigma that is not positive and finite
+    /// ([`EskfError::CovarianceNotPositiveDefinite`]); nothing is built.
+    #[inline(never)] // once at start-up: its matrices stay out of the caller's frame
+    pub fn from_attitude_filter(
+        attitude: &AhrsAccelBias<T>,
+        carry: &So3<T>,
+        velocity: Vector3<T>,
+        position: Vector3<T>,
+        sigma_velocity: T,
+        sigma_position: T,
+    ) -> Result<Self, EskfError> {
+        let a = attitude.state();
+        let state = InsState {
+            attitude: a.attitude.compose(carry).renormalize(),
+            velocity,
+            position,
+            gyro_bias: a.gyro_bias,
+            accel_bias: a.accel_bias,
+        };
+        if !state.is_finite() {
+            return Err(EskfError::NonFinite);
+        }
+        if !(positive_finite(sigma_velocity * sigma_velocity)
+            && positive_finite(sigma_position * sigma_position))
+        {
+            return Err(EskfError::CovarianceNotPositiveDefinite);
+        }
+        let mut p = SMatrix::<T, 15, 15>::zeros();
+        // Block k of the attitude filter (δθ, δb_g, δb_a) is block `to[k]` of the INS.
+        let to = [0, 3, 4];
+        let m = carry.rotation_matrix().transpose();
+        for (i, bi) in to.iter().enumerate() {
+            for (j, bj) in to.iter().enumerate() {
+                let mut b = block(attitude.covariance(), i, j);
+                if i == 0 {
+                    b = mat3::mul(&m, &b);
+                }
+                if j == 0 {
+                    b = mat3::mul(&b, &m.transpose());
+                }
+                set_block(&mut p, *bi, *bj, &b);
+            }
+        }
+        add_scaled_identity(&mut p, 1, 1, sigma_velocity * sigma_velocity);
+        add_scaled_identity(&mut p, 2, 2, sigma_position * sigma_position);
+        Ok(Self {
+            state,
+            covariance: p,
+            config: *attitude.config(),
+        })
+    }
+
+    /// Resets the position to `position` with 1σ `sigma` per axis, forgetting what the filter
+    /// knew of it: the position rows and columns of `P` become `σ² I` on the diagonal and zero
+    /// elsewhere. What remains is block diagonal with a principal submatrix of a positive
+    /// definite `P`, so it stays positive definite. A navigator calls it when the aiding
+    /// sensor has disagreed with the estimate for so long that the estimate is the suspect.
+    ///
+    /// # Errors
+    /// [`EskfError::NonFinite`] for a non-finite position, or a sigma whose square is not
+    /// positive and finite; the filter is then unchanged.
+    pub fn reset_position(&mut self, position: Vector3<T>, sigma: T) -> Result<(), EskfError> {
+        self.reset_block(2, position, sigma)
+    }
+
+    /// Resets the velocity as [`Filter::reset_position`] resets the position.
+    ///
+    /// # Errors
+    /// As [`Filter::reset_position`].
+    pub fn reset_velocity(&mut self, velocity: Vector3<T>, sigma: T) -> Result<(), EskfError> {
+        self.reset_block(1, velocity, sigma)
+    }
+
+    /// Adds `σ² I` to the velocity block of `P`: a velocity change the IMU did not measure
+    /// (a clipped accelerometer), of 1σ `sigma` per axis, m/s. `P` stays positive definite.
+    ///
+    /// # Errors
+    /// [`EskfError::NonFinite`] for a negative or non-finite sigma, or one whose square
+    /// overflows `P`; the filter is then unchanged.
+    pub fn widen_velocity(&mut self, sigma: T) -> Result<(), EskfError> {
+        let v = sigma * sigma;
+        let fits = (0..3).all(|k| {
+            self.covariance
+                .get((3 + k, 3 + k))
+                .is_some_and(|d| (*d + v).is_finite())
+        });
+        if !(non_negative_finite(sigma) && v.is_finite() && fits) {
+            return Err(EskfError::NonFinite);
+        }
+        add_scaled_identity(&mut self.covariance, 1, 1, v);
+        Ok(())
+    }
+
+    /// Block `b` (1: velocity, 2: position) set to `value` with covariance `σ² I`, decoupled.
+    fn reset_block(&mut self, b: usize, value: Vector3<T>, sigma: T) -> Result<(), EskfError> {
+        let variance = sigma * sigma;
+        if !(all_finite(value.as_slice()) && positive_finite(variance)) {
+            return Err(EskfError::NonFinite);
+        }
+        for k in 0..5 {
+            set_block(&mut self.covariance, b, k, &Matrix3::zeros());
+            set_block(&mut self.covariance, k, b, &Matrix3::zeros());
+        }
+        add_scaled_identity(&mut self.covariance, b, b, variance);
+        if b == 1 {
+            self.state.velocity = value;
+        } else {
+            self.state.position = value;
+        }
+        Ok(())
     }
 }
 

@@ -15,6 +15,16 @@ pub enum NavError {
     TimeNotIncreasing,
     /// A configuration value out of its domain (named in the docs of the field).
     InvalidConfig,
+    /// A measurement's sigma is not positive (or its square not finite).
+    InvalidSigma,
+    /// A measurement stamped at or before the time the filter has reached (older than the
+    /// delayed-fusion horizon).
+    TooOld,
+    /// A measurement stamped after the newest IMU sample by more than `max_dt`.
+    InFuture,
+    /// The measurement queue is full: measurements arrive faster than the filter reaches
+    /// their time (a horizon too long for the queue, or a stalled IMU).
+    QueueFull,
     /// The filter refused a step the navigator built from valid samples (a numerical failure;
     /// the navigator is unchanged and the next sample is taken normally).
     Filter(EskfError),
@@ -27,6 +37,10 @@ impl core::fmt::Display for NavError {
             Self::ZeroVector => f.write_str("all-zero sample"),
             Self::TimeNotIncreasing => f.write_str("timestamp is not after the previous one"),
             Self::InvalidConfig => f.write_str("configuration value out of its domain"),
+            Self::InvalidSigma => f.write_str("sigma is not positive"),
+            Self::TooOld => f.write_str("measurement older than the fusion horizon"),
+            Self::InFuture => f.write_str("measurement stamped after the newest IMU sample"),
+            Self::QueueFull => f.write_str("measurement queue full"),
             Self::Filter(e) => write!(f, "filter: {e}"),
         }
     }

@@ -8,6 +8,9 @@
 //!
 //! * [`AttitudeNavigator`]: attitude and gyro bias from a gyro, an accelerometer and an
 //!   optional magnetometer (an AHRS).
+//! * [`InsNavigator`]: position, velocity, attitude and both IMU biases from an IMU and GNSS,
+//!   with an optional magnetometer and barometer; measurements delayed up to a horizon and
+//!   out of order, fault detection, per-quantity validity.
 //!
 //! Conventions: timestamps are `u64` nanoseconds on one clock, strictly increasing per
 //! sensor; the world frame is ENU (`z` up), gravity `[0, 0, −9.81]`; the body frame is the
@@ -43,6 +46,7 @@
 mod attitude;
 mod clock;
 mod error;
+mod ins;
 mod mean;
 
 pub use attitude::{
@@ -50,4 +54,8 @@ pub use attitude::{
     Fusions, MagneticConfig, MagneticFusion, MagneticStatus, Reason, Validity,
 };
 pub use error::NavError;
+pub use ins::{
+    AidStatus, Aiding, GnssFix, InsConfig, InsCounters, InsEstimate, InsEvent, InsFusion,
+    InsNavigator, InsReport, InsValidity,
+};
 pub use mean::VectorMean;

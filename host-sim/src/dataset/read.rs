@@ -40,6 +40,8 @@ pub struct MagParams {
 pub struct GnssParams {
     /// Antenna lever arm in the body frame, m.
     pub lever_arm: Vector3<f64>,
+    /// The fix was valid this long before its row's timestamp, s (`latency_s`; 0 when absent).
+    pub latency_s: f64,
 }
 
 /// Camera parameters from `cam0/sensor.yaml` and the landmark map from `cam0/landmarks.csv`.
@@ -302,8 +304,16 @@ impl Dataset {
         };
         let gnss = if dir.join("gnss0/data.csv").is_file() {
             let path = dir.join("gnss0/sensor.yaml");
+            let mut latency_s = 0.0;
             let lever_arm = if path.is_file() {
                 let y = SensorYaml::read(&path)?;
+                latency_s = y.f64_or("latency_s", 0.0)?;
+                if !(latency_s.is_finite() && latency_s >= 0.0) {
+                    return Err(DatasetError::file(
+                        &path,
+                        "latency_s must be a number of seconds, 0 or more",
+                    ));
+                }
                 match y.list("lever_arm", 3) {
                     Ok(l) => Vector3::new(l[0], l[1], l[2]),
                     Err(_) => {
@@ -321,7 +331,10 @@ impl Dataset {
                 ));
                 Vector3::zeros()
             };
-            Some(GnssParams { lever_arm })
+            Some(GnssParams {
+                lever_arm,
+                latency_s,
+            })
         } else {
             None
         };

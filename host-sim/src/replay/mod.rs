@@ -35,6 +35,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 mod attitude;
+mod ins;
 mod output;
 
 use output::{write_estimate_csv, write_tum, Partials, TruthCursor};
@@ -82,6 +83,12 @@ pub struct ReplayConfig {
     /// The IMU samples are instantaneous values (integrate with the trapezoidal rule) rather
     /// than means over the period ending at their timestamp.
     pub instantaneous_imu: bool,
+    /// INS navigator: how far in the past a measurement may be stamped, s (the filter runs
+    /// this far behind the newest IMU sample).
+    pub horizon_s: f64,
+    /// Take every GNSS fix as valid when its row is stamped, ignoring `latency_s` (to see
+    /// what the latency costs).
+    pub ignore_gnss_latency: bool,
     /// Write the plots.
     pub plots: bool,
 }
@@ -150,6 +157,12 @@ impl ReplayConfig {
                 return Err(format!("{name} = {x}: must be below 4 s"));
             }
         }
+        if !(self.horizon_s.is_finite() && (0.0..=1.0).contains(&self.horizon_s)) {
+            return Err(format!(
+                "horizon_s = {}: must be between 0 and 1 s",
+                self.horizon_s
+            ));
+        }
         if !self.gravity.iter().all(|g| g.is_finite()) {
             return Err("gravity: must be finite".into());
         }
@@ -177,6 +190,8 @@ impl Default for ReplayConfig {
             heading_noise_deg: 8.0,
             heading_floor_deg: 1.0,
             instantaneous_imu: true,
+            horizon_s: 0.3,
+            ignore_gnss_latency: false,
             plots: true,
         }
     }
@@ -329,6 +344,9 @@ fn replay_in<T: Real>(
     std::fs::create_dir_all(out).map_err(out_err(out))?;
     if ds.gnss.is_none() && ds.camera.is_none() {
         return attitude::replay_attitude::<T>(&ds, dir, out, cfg, title, scorer);
+    }
+    if ds.gnss.is_some() {
+        return ins::replay_ins::<T>(&ds, dir, out, cfg, title, scorer);
     }
     let gravity = Vector3::from(cfg.gravity);
     let config = FilterConfig::<T> {

@@ -14,6 +14,16 @@ pub enum Reason {
     Uncertain,
     /// Heading without a magnetometer: only relative to the start.
     NoMagnetometer,
+    /// No position fix has been fused yet (an INS navigator aligns its attitude meanwhile).
+    NoFix,
+    /// The position fixes have disagreed with the estimate for the last second or more: one
+    /// of them is wrong, and the navigator cannot yet say which.
+    FixesDisagree,
+    /// The state was just reset to the aiding sensor after a long disagreement, and is not
+    /// yet confirmed by it.
+    Reset,
+    /// The IMU is faulty (clipped or stuck): the prediction is not trusted.
+    ImuFault,
 }
 
 /// Whether a quantity of the estimate can be used.

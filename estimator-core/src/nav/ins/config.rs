@@ -1,0 +1,113 @@
+//! What an INS navigator is told about its sensors.
+
+use crate::kernels::{all_finite, non_negative_finite, positive_finite};
+use crate::nav::attitude::AttitudeConfig;
+use crate::nav::error::NavError;
+use crate::Real;
+use nalgebra::Vector3;
+
+/// The INS navigator's configuration. The IMU, the magnetometer and the start-up come from
+/// `attitude` (the navigator aligns with an [`AttitudeNavigator`](crate::nav::AttitudeNavigator)
+/// until its first position fix); the rest is the INS's own.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InsConfig<T: Real> {
+    /// The attitude navigator of the alignment, and through it the filter configuration (IMU
+    /// noise, gravity, `max_dt`: an IMU interval longer than that is a gap) and the
+    /// magnetometer (`attitude.magnetometer`: its sigma, its reference field).
+    pub attitude: AttitudeConfig<T>,
+    /// How far in the past a measurement may be stamped, s (0.3): the filter runs this far
+    /// behind the newest IMU sample, and an output predictor carries its estimate to the
+    /// present. The IMU buffer must hold `horizon_s × IMU rate` samples.
+    pub horizon_s: T,
+    /// GNSS antenna position in the body frame, m.
+    pub gnss_lever_arm: Vector3<T>,
+    /// The barometer's white noise per sample, m (1σ); `None`: no barometer.
+    pub barometer_sigma: Option<T>,
+    /// The accelerometer's range, m/s² (0: unknown): a sample with an axis at or beyond 99.9 %
+    /// of it is taken as clipped, and the velocity is widened by what the clipping may hide.
+    pub accelerometer_range: T,
+    /// The gyro's range, rad/s (0: unknown), as `accelerometer_range`.
+    pub gyro_range: T,
+    /// A gyro axis that repeats its value exactly for this long while the others change, s,
+    /// is taken as stuck (0: never). A real gyro's noise makes exact repeats rare, but a
+    /// coarse quantization at rest makes them common: keep it well above the sample period.
+    pub gyro_stuck_s: T,
+    /// Consecutive rejected GNSS fixes for this long, s, reset position and velocity to the
+    /// fixes (10 s): the filter's estimate is then taken for the wrong one.
+    pub gnss_reset_s: T,
+    /// Position valid below this 1σ, m (horizontal, the larger axis).
+    pub position_valid_sigma: T,
+    /// Velocity valid below this 1σ, m/s.
+    pub velocity_valid_sigma: T,
+    /// Attitude (tilt) valid below this 1σ, rad.
+    pub tilt_valid_sigma: T,
+    /// Heading valid below this 1σ, rad.
+    pub heading_valid_sigma: T,
+    /// Gyro bias valid below this 1σ, rad/s.
+    pub gyro_bias_valid_sigma: T,
+    /// Accelerometer bias valid below this 1σ, m/s².
+    pub accel_bias_valid_sigma: T,
+}
+
+impl<T: Real> InsConfig<T> {
+    /// Defaults around an attitude configuration: a 0.3 s horizon, no lever arm, no
+    /// barometer, ranges unknown, no stuck-axis check, reset after 10 s of rejected fixes;
+    /// valid below 10 m, 1 m/s, 5° tilt, 10° heading, 0.05 °/s gyro bias, 0.05 m/s²
+    /// accelerometer bias.
+    #[must_use]
+    pub fn new(attitude: AttitudeConfig<T>) -> Self {
+        Self {
+            attitude,
+            horizon_s: T::lit(0.3),
+            gnss_lever_arm: Vector3::zeros(),
+            barometer_sigma: None,
+            accelerometer_range: T::zero(),
+            gyro_range: T::zero(),
+            gyro_stuck_s: T::zero(),
+            gnss_reset_s: T::lit(10.0),
+            position_valid_sigma: T::lit(10.0),
+            velocity_valid_sigma: T::lit(1.0),
+            tilt_valid_sigma: T::lit(5.0_f64.to_radians()),
+            heading_valid_sigma: T::lit(10.0_f64.to_radians()),
+            gyro_bias_valid_sigma: T::lit(0.05_f64.to_radians()),
+            accel_bias_valid_sigma: T::lit(0.05),
+        }
+    }
+
+    /// `Ok` when every value is in its domain: the attitude configuration valid; `horizon_s`
+    /// in `[0, 10]` s; the lever arm finite; a barometer sigma positive; ranges, stuck time and
+    /// thresholds not negative; `gnss_reset_s` positive.
+    ///
+    /// # Errors
+    /// [`NavError::InvalidConfig`] (or the attitude configuration's error).
+    pub fn validate(&self) -> Result<(), NavError> {
+        self.attitude.validate()?;
+        let horizon = non_negative_finite(self.horizon_s) && self.horizon_s <= T::lit(10.0);
+        let baro = self.barometer_sigma.is_none_or(positive_finite);
+        let non_negative = [
+            self.accelerometer_range,
+            self.gyro_range,
+            self.gyro_stuck_s,
+            self.position_valid_sigma,
+            self.velocity_valid_sigma,
+            self.tilt_valid_sigma,
+            self.heading_valid_sigma,
+            self.gyro_bias_valid_sigma,
+            self.accel_bias_valid_sigma,
+        ]
+        .iter()
+        .all(|x| non_negative_finite(*x));
+        let ok = horizon
+            && baro
+            && non_negative
+            && positive_finite(self.gnss_reset_s)
+            && self.gnss_reset_s <= T::lit(3600.0)
+            && self.gyro_stuck_s <= T::lit(3600.0)
+            && all_finite(self.gnss_lever_arm.as_slice());
+        if ok {
+            Ok(())
+        } else {
+            Err(NavError::InvalidConfig)
+        }
+    }
+}

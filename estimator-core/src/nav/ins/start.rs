@@ -1,0 +1,86 @@
+//! Start and restart: the INS takes over from the alignment at the first usable fix, and an
+//! IMU gap sends it back to aligning.
+
+use super::report::{AidStatus, InsEvent};
+use super::window::Increment;
+use super::{InsNavigator, Mode, INVALID_START};
+use crate::eskf::Ins;
+use crate::lie::LieGroup;
+use crate::nav::attitude::AttitudeNavigator;
+use crate::Real;
+use nalgebra::Vector3;
+
+/// The velocity's 1σ at start when the first fix has none, m/s: a road vehicle or a drone
+/// moves slower than this.
+const UNKNOWN_VELOCITY_SIGMA: f64 = 30.0;
+
+impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
+    /// Starts the INS at the filter's time `t_f` from the alignment and a fix valid `dt`
+    /// earlier, if the alignment is ready (tilt valid; heading valid with a magnetometer);
+    /// otherwise the fix is counted as unused.
+    ///
+    /// The attitude navigator's estimate is at the newest sample; the output predictor's
+    /// rotation `ΔR` over the horizon carries it back, `R_f = R ΔRᵀ`
+    /// ([`Ins::from_attitude_filter`]). The antenna position is carried to `t_f` by the fix's
+    /// velocity (`p + v dt`), and the lever arm removed with that attitude (`p − R_f ℓ`).
+    #[inline(never)] // once per start: its matrices stay out of the caller's frame
+    pub(super) fn start(
+        &mut self,
+        dt: T,
+        position: Vector3<T>,
+        velocity: Option<Vector3<T>>,
+        sigma_position: T,
+        sigma_velocity: T,
+    ) {
+        let Mode::Aligning(att) = &self.mode else {
+            return;
+        };
+        let report = att.report();
+        let heading_ready =
+            self.config.attitude.magnetometer.is_none() || report.heading.is_valid();
+        let (Some(filter), true) = (att.filter(), report.tilt.is_valid() && heading_ready) else {
+            self.counters.unused = self.counters.unused.saturating_add(1);
+            return;
+        };
+        let carry = self.window.rotation.inverse();
+        let attitude = filter.state().attitude.compose(&carry);
+        let (v, sigma_v) = match velocity {
+            Some(v) => (v, sigma_velocity),
+            None => (Vector3::zeros(), T::lit(UNKNOWN_VELOCITY_SIGMA)),
+        };
+        let antenna = position + v * dt;
+        let p = antenna - attitude.act(&self.config.gnss_lever_arm);
+        let reference = att.magnetic_reference();
+        match Ins::from_attitude_filter(filter, &carry, v, p, sigma_v, sigma_position) {
+            Ok(ins) => {
+                self.mode = Mode::Running(ins);
+                self.magnetic_reference = reference;
+                self.gnss.last_position = Some(position);
+                self.report.gnss = AidStatus::Fused;
+                self.report.event = Some(InsEvent::Started);
+            }
+            Err(_) => {
+                self.counters.numerical_failures =
+                    self.counters.numerical_failures.saturating_add(1);
+            }
+        }
+    }
+
+    /// Back to aligning after an IMU gap: the buffers are emptied (their samples and
+    /// measurements belong to the time before the gap) and the report says nothing is valid.
+    pub(super) fn restart(&mut self) {
+        if let Ok(att) = AttitudeNavigator::new(self.config.attitude) {
+            self.mode = Mode::Aligning(att);
+        }
+        self.ring.clear();
+        self.queue.clear();
+        self.window = Increment::empty(Vector3::zeros(), Vector3::zeros());
+        self.fresh = self.window;
+        self.fresh_lag = 0;
+        self.filter_t = None;
+        self.last_sample = None;
+        self.gnss = super::GnssTrack::default();
+        self.stuck.since = [None; 3];
+        self.report.validity = INVALID_START;
+    }
+}

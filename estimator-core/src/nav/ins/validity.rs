@@ -1,0 +1,61 @@
+//! The validity of each quantity after a call: from the delayed filter's covariance (the
+//! present one differs by the horizon's growth, a fraction of the thresholds) and the GNSS
+//! policy's state.
+
+use super::aid::DISAGREEING_FIXES;
+use super::{InsNavigator, Mode, INVALID_START};
+use crate::kernels::block::block;
+use crate::kernels::mat3;
+use crate::nav::attitude::{Reason, Validity};
+use crate::Real;
+use nalgebra::Matrix3;
+
+/// Valid when `variance ≤ limit²`.
+fn within<T: Real>(variance: T, limit: T) -> Validity {
+    if variance <= limit * limit {
+        Validity::Valid
+    } else {
+        Validity::Invalid(Reason::Uncertain)
+    }
+}
+
+/// The largest diagonal entry.
+fn largest<T: Real>(m: &Matrix3<T>) -> T {
+    m.m11.max(m.m22).max(m.m33)
+}
+
+impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
+    pub(super) fn refresh_validity(&mut self) {
+        let c = &self.config;
+        let v = &mut self.report.validity;
+        match &self.mode {
+            Mode::Aligning(att) => {
+                *v = INVALID_START;
+                v.tilt = att.report().tilt;
+                v.heading = att.report().heading;
+            }
+            Mode::Running(ins) => {
+                let p = ins.covariance();
+                let r = ins.state().attitude.rotation_matrix();
+                // World-frame attitude covariance R P_θθ Rᵀ: tilt on x, y; heading on z (up).
+                let w = mat3::mul(&mat3::mul(&r, &block(p, 0, 0)), &r.transpose());
+                v.tilt = within(w.m11.max(w.m22), c.tilt_valid_sigma);
+                v.heading = within(w.m33, c.heading_valid_sigma);
+                v.velocity = within(largest(&block(p, 1, 1)), c.velocity_valid_sigma);
+                v.position = if self.gnss.rejected >= DISAGREEING_FIXES {
+                    Validity::Invalid(Reason::FixesDisagree)
+                } else if self.gnss.unconfirmed {
+                    Validity::Invalid(Reason::Reset)
+                } else {
+                    within(largest(&block(p, 2, 2)), c.position_valid_sigma)
+                };
+                v.gyro_bias = within(largest(&block(p, 3, 3)), c.gyro_bias_valid_sigma);
+                v.accel_bias = within(largest(&block(p, 4, 4)), c.accel_bias_valid_sigma);
+                if self.report.imu_fault {
+                    v.velocity = Validity::Invalid(Reason::ImuFault);
+                    v.position = Validity::Invalid(Reason::ImuFault);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,231 @@
+//! The GNSS replay (a dataset with an IMU and GNSS, optionally a magnetometer and a
+//! barometer): every sample goes to [`InsNavigator`], exactly as a firmware main loop would
+//! call it, each GNSS fix stamped with the time it was valid (its row's time minus the
+//! receiver's `latency_s`); this file only reads, writes and scores.
+
+use super::attitude::navigator_config;
+use super::output::{write_estimate_csv, write_tum, Partials, TruthCursor};
+use super::{lit3, out_err, up3, ReplayConfig, ReplayError};
+use crate::baseline::{Madgwick, Mahony};
+use crate::dataset::read::{Dataset, Event, TruthStream};
+use crate::metrics::{Estimate, Outcome, Scorer};
+use estimator_core::nav::{
+    Aiding, GnssFix, InsConfig, InsNavigator, InsReport, MagneticFusion, NavError,
+};
+use estimator_core::Real;
+use nalgebra::Matrix3;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The navigator's configuration from the dataset's sensor files and the replay options.
+pub(super) fn ins_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> InsConfig<T> {
+    let mut attitude = navigator_config::<T>(ds, cfg);
+    // The INS fuses the magnetometer's whole field: the GNSS velocity, not the magnetometer,
+    // holds the tilt, and the gate guards the heading.
+    if let Some(m) = attitude.magnetometer.as_mut() {
+        m.fusion = MagneticFusion::Vector;
+    }
+    let mut c = InsConfig::new(attitude);
+    c.horizon_s = T::lit(cfg.horizon_s);
+    if let Some(g) = &ds.gnss {
+        c.gnss_lever_arm = lit3(&g.lever_arm);
+    }
+    c.barometer_sigma = ds.baro.as_ref().map(|b| T::lit(b.sigma));
+    c
+}
+
+fn estimate<T: Real, const H: usize, const Q: usize>(
+    nav: &InsNavigator<T, H, Q>,
+) -> Option<Estimate> {
+    let e = nav.estimate()?;
+    let block =
+        |b: usize| -> Option<Matrix3<f64>> { e.covariance.get(b).map(|m| m.map(|x| x.to_f64())) };
+    Some(Estimate {
+        t_ns: e.t_ns,
+        position: up3(&e.state.position),
+        attitude: e.state.attitude.cast(),
+        velocity: up3(&e.state.velocity),
+        gyro_bias: up3(&e.state.gyro_bias),
+        accel_bias: up3(&e.state.accel_bias),
+        cov: [block(0), block(1), block(2), block(3), block(4)],
+    })
+}
+
+/// Scores the update a call made, or a refused sample.
+fn score<T: Real>(
+    scorer: &mut Scorer,
+    r: &Result<InsReport<T>, NavError>,
+    sensor: &str,
+    t_ns: u64,
+) {
+    match r {
+        Ok(report) => {
+            if let Some(f) = report.fused {
+                let (name, dof) = match f.aid {
+                    Aiding::GnssPosition => ("gnss_position", 3),
+                    Aiding::GnssVelocity => ("gnss_velocity", 3),
+                    Aiding::Magnetometer => ("mag", 3),
+                    Aiding::Barometer => ("baro", 1),
+                };
+                let nis = f.nis.to_f64();
+                let outcome = if f.accepted {
+                    Outcome::Accepted { nis, dof }
+                } else {
+                    Outcome::Rejected { nis, dof }
+                };
+                scorer.measurement(name, t_ns, outcome);
+            }
+        }
+        Err(_) => scorer.measurement(sensor, t_ns, Outcome::Refused),
+    }
+}
+
+/// Runs the navigator over the dataset and writes the outputs (see the module docs of
+/// `replay`).
+pub(super) fn replay_ins<T: Real>(
+    ds: &Dataset,
+    dir: &Path,
+    out: &Path,
+    cfg: &ReplayConfig,
+    title: &str,
+    mut scorer: Scorer,
+) -> Result<Scorer, ReplayError> {
+    // A ring for the horizon at the IMU's rate, with room: 0.3 s at 200 Hz is 60 intervals.
+    let mut nav = InsNavigator::<T, 256, 64>::new(ins_config(ds, cfg))
+        .map_err(|e| ReplayError::Config(format!("navigator: {e}")))?;
+    if cfg.horizon_s * ds.imu.rate_hz > 250.0 {
+        return Err(ReplayError::Config(format!(
+            "horizon_s = {} holds {:.0} IMU samples at {} Hz; at most 250",
+            cfg.horizon_s,
+            cfg.horizon_s * ds.imu.rate_hz,
+            ds.imu.rate_hz
+        )));
+    }
+    let latency_ns = ds
+        .gnss
+        .as_ref()
+        .map_or(0, |g| (g.latency_s * 1e9).round() as u64);
+    let latency_ns = if cfg.ignore_gnss_latency {
+        0
+    } else {
+        latency_ns
+    };
+    let mut partials = Partials::new(out);
+    partials.clear_previous();
+    let open = |name: &str| -> Result<(BufWriter<File>, PathBuf), ReplayError> {
+        let p = out.join(format!("{name}.partial"));
+        File::create(&p)
+            .map(|f| (BufWriter::new(f), p.clone()))
+            .map_err(|e| ReplayError::Output {
+                path: p,
+                message: e.to_string(),
+            })
+    };
+    let (mut tum, tum_path) = open("estimate.tum")?;
+    let (mut csv, csv_path) = open("estimate.csv")?;
+    super::write_csv_header(&mut csv).map_err(out_err(&csv_path))?;
+    let mut truth = if ds.has_groundtruth {
+        let (gt_tum, gt_path) = open("groundtruth.tum")?;
+        Some(TruthCursor {
+            stream: TruthStream::open(dir)?,
+            prev: None,
+            next: None,
+            tum: gt_tum,
+            tum_path: gt_path,
+        })
+    } else {
+        None
+    };
+    let mut baselines: Option<(Madgwick, Mahony)> = None;
+    let mut last_imu: Option<u64> = None;
+    for ev in ds.events()? {
+        let started = Instant::now();
+        match ev? {
+            Event::Imu { t_ns, gyro, accel } => {
+                let dt = last_imu.map_or(1.0 / ds.imu.rate_hz, |t| {
+                    t_ns.saturating_sub(t) as f64 * 1e-9
+                });
+                last_imu = Some(t_ns);
+                let r = nav.imu(t_ns, &lit3(&gyro), &lit3(&accel));
+                score(&mut scorer, &r, "imu", t_ns);
+                scorer.filter_ns += started.elapsed().as_nanos();
+                scorer.imu_samples += 1;
+                let Some(e) = estimate(&nav) else {
+                    continue;
+                };
+                match (&mut baselines, &ds.mag) {
+                    (None, Some(m)) => {
+                        baselines = Some((
+                            Madgwick::new(e.attitude, m.reference_field),
+                            Mahony::new(e.attitude, m.reference_field),
+                        ));
+                    }
+                    (Some((mw, mh)), _) => {
+                        mw.imu(&gyro, &accel, dt);
+                        mh.imu(&gyro, &accel, dt);
+                    }
+                    (None, None) => {}
+                }
+                write_tum(&mut tum, t_ns, &e.position, &e.attitude).map_err(out_err(&tum_path))?;
+                write_estimate_csv(&mut csv, &e).map_err(out_err(&csv_path))?;
+                if let Some(tr) = truth.as_mut() {
+                    if let Some(t) = tr.at(t_ns)? {
+                        scorer.add(&e, &t);
+                        if let Some((mw, mh)) = &baselines {
+                            scorer.add_baseline("madgwick", &mw.attitude, &t);
+                            scorer.add_baseline("mahony", &mh.attitude, &t);
+                        }
+                    }
+                }
+                continue;
+            }
+            Event::Mag { t_ns, field } => {
+                if let Some((mw, mh)) = baselines.as_mut() {
+                    mw.mag(&field);
+                    mh.mag(&field);
+                }
+                let r = nav.magnetometer(t_ns, &lit3(&field));
+                score(&mut scorer, &r, "mag", t_ns);
+            }
+            Event::Gnss {
+                t_ns,
+                position,
+                velocity,
+                sigma_p,
+                sigma_v,
+            } => {
+                let fix = GnssFix::new(
+                    lit3(&position),
+                    Some(lit3(&velocity)),
+                    T::lit(sigma_p),
+                    T::lit(sigma_v),
+                );
+                let r = nav.gnss(t_ns.saturating_sub(latency_ns), &fix);
+                score(&mut scorer, &r, "gnss_position", t_ns);
+            }
+            Event::Baro { t_ns, altitude } => {
+                let r = nav.barometer(t_ns, T::lit(altitude));
+                score(&mut scorer, &r, "baro", t_ns);
+            }
+            // The camera is the other replay's.
+            Event::Camera { .. } => {}
+        }
+        scorer.filter_ns += started.elapsed().as_nanos();
+    }
+    tum.flush().map_err(out_err(&tum_path))?;
+    csv.flush().map_err(out_err(&csv_path))?;
+    if let Some(tr) = truth.as_mut() {
+        tr.finish()?;
+    }
+    if nav.estimate().is_none() {
+        return Err(ReplayError::Start(format!(
+            "the INS never started: no GNSS fix came due with the alignment ready ({} fixes unused)",
+            nav.counters().unused
+        )));
+    }
+    super::finish(out, cfg, title, ds, &scorer)?;
+    partials.commit()?;
+    Ok(scorer)
+}

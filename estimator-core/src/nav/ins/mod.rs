@@ -485,8 +485,9 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// with the same time; the navigator is then unchanged.
     pub fn gnss(&mut self, t_ns: u64, fix: &GnssFix<T>) -> Result<InsReport<T>, NavError> {
         let velocity_ok = fix.velocity.is_none_or(|v| all_finite(v.as_slice()));
-        let sigmas_ok = positive_finite(fix.sigma_position * fix.sigma_position)
-            && (fix.velocity.is_none() || positive_finite(fix.sigma_velocity * fix.sigma_velocity));
+        let positive = |s: T| positive_finite(s) && positive_finite(s * s);
+        let sigmas_ok = positive(fix.sigma_position)
+            && (fix.velocity.is_none() || positive(fix.sigma_velocity));
         let checked = if !(all_finite(fix.position.as_slice()) && velocity_ok) {
             Err(NavError::NonFinite)
         } else if !sigmas_ok {

@@ -1,0 +1,422 @@
+//! The INS navigator on synthetic streams with exact truth: delayed and out-of-order
+//! measurements, refusals that leave it unchanged, start-up from a late fix, IMU gaps, and the
+//! GNSS faults it must detect (a frozen receiver, a persistent disagreement).
+
+use estimator_core::eskf::FilterConfig;
+use estimator_core::nav::{
+    AidStatus, AttitudeConfig, GnssFix, InsConfig, InsEvent, InsNavigator, MagneticConfig,
+    NavError, Reason, Validity,
+};
+use nalgebra::Vector3;
+
+const T0: u64 = 1_000_000_000;
+const IMU_NS: u64 = 5_000_000; // 200 Hz
+const FIELD: [f64; 3] = [0.0, 20.0, -40.0];
+const STILL_S: f64 = 4.0;
+const A: f64 = 1.5; // m/s², peak acceleration along east
+
+/// Truth at `t` s after the start: at rest for `STILL_S`, then along east with
+/// `a = A sin(τ/2)` (τ from the end of the rest), level, facing east: `(p, v, a)`.
+fn truth(t: f64) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    let tau = (t - STILL_S).max(0.0);
+    let a = A * (0.5 * tau).sin();
+    let v = 2.0 * A * (1.0 - (0.5 * tau).cos());
+    let s = 2.0 * A * (tau - 2.0 * (0.5 * tau).sin());
+    (
+        Vector3::new(s, 0.0, 0.0),
+        Vector3::new(v, 0.0, 0.0),
+        Vector3::new(a, 0.0, 0.0),
+    )
+}
+
+fn seconds(t_ns: u64) -> f64 {
+    (t_ns - T0) as f64 * 1e-9
+}
+
+fn config() -> InsConfig<f64> {
+    let mut attitude = AttitudeConfig::new(FilterConfig::default());
+    attitude.magnetometer = Some(MagneticConfig::new(0.5, Some(Vector3::from(FIELD))));
+    InsConfig::new(attitude)
+}
+
+/// A measurement of the stream: its validity time and what it is.
+#[derive(Clone, Copy, Debug)]
+enum Aid {
+    Gnss(GnssFix<f64>),
+    Mag(Vector3<f64>),
+}
+
+/// The IMU at `k` (noise-free, level, facing east: body = world).
+fn imu(k: u64) -> (u64, Vector3<f64>, Vector3<f64>) {
+    let t = T0 + k * IMU_NS;
+    let (_, _, a) = truth(seconds(t));
+    (t, Vector3::zeros(), a + Vector3::new(0.0, 0.0, 9.81))
+}
+
+/// Magnetometer at 50 Hz and fixes at 5 Hz (after `first_fix_s`), each with its validity time.
+fn aids(duration_s: f64, first_fix_s: f64) -> Vec<(u64, Aid)> {
+    let mut out = Vec::new();
+    let n = (duration_s / 0.02) as u64;
+    for j in 1..n {
+        let t = T0 + j * 20_000_000;
+        out.push((t, Aid::Mag(Vector3::from(FIELD))));
+        if j % 10 == 0 && seconds(t) >= first_fix_s {
+            let (p, v, _) = truth(seconds(t));
+            out.push((t, Aid::Gnss(GnssFix::new(p, Some(v), 0.5, 0.05))));
+        }
+    }
+    out
+}
+
+fn give(nav: &mut InsNavigator<f64>, t: u64, aid: &Aid) -> Result<(), NavError> {
+    match aid {
+        Aid::Gnss(fix) => nav.gnss(t, fix).map(|_| ()),
+        Aid::Mag(m) => nav.magnetometer(t, m).map(|_| ()),
+    }
+}
+
+/// Runs the stream with every measurement delivered at `arrival(validity time, index)`; returns
+/// the estimate's position at every IMU sample once the INS runs, and the navigator.
+fn run(
+    duration_s: f64,
+    deliveries: &[(u64, u64, Aid)], // (arrival, validity, aid), sorted by arrival
+) -> (Vec<(u64, Vector3<f64>, Vector3<f64>)>, InsNavigator<f64>) {
+    let mut nav = InsNavigator::<f64>::new(config()).unwrap();
+    let mut out = Vec::new();
+    let mut next = 0;
+    let n = (duration_s * 200.0) as u64;
+    for k in 0..n {
+        let (t, g, a) = imu(k);
+        while let Some((arrival, valid, aid)) = deliveries.get(next) {
+            if *arrival > t {
+                break;
+            }
+            give(&mut nav, *valid, aid).unwrap();
+            next += 1;
+        }
+        nav.imu(t, &g, &a).unwrap();
+        if let Some(e) = nav.estimate() {
+            out.push((t, e.state.position, e.state.velocity));
+        }
+    }
+    (out, nav)
+}
+
+/// Delivered `delay_ns` after validity, in time order.
+fn delayed(aids: &[(u64, Aid)], delay_ns: u64) -> Vec<(u64, u64, Aid)> {
+    aids.iter().map(|(t, a)| (t + delay_ns, *t, *a)).collect()
+}
+
+#[test]
+fn ins_navigator_out_of_order_within_horizon_matches_in_order_f64() {
+    let aids = aids(30.0, 5.0);
+    let in_order = delayed(&aids, 200_000_000);
+    // Each measurement delivered 20–280 ms after its time, by a fixed pseudo-random draw:
+    // arrival order differs from validity order throughout.
+    let mut shuffled: Vec<(u64, u64, Aid)> = aids
+        .iter()
+        .enumerate()
+        .map(|(i, (t, a))| {
+            let jitter = (i as u64).wrapping_mul(2_654_435_761) % 260_000_000;
+            (t + 20_000_000 + jitter, *t, *a)
+        })
+        .collect();
+    shuffled.sort_by_key(|d| d.0);
+    let swapped = shuffled.windows(2).filter(|w| w[1].1 < w[0].1).count();
+    assert!(
+        swapped > 100,
+        "only {swapped} measurements arrive out of order"
+    );
+    let (a, _) = run(30.0, &in_order);
+    let (b, nav) = run(30.0, &shuffled);
+    assert!(nav.counters().gnss_position_fused > 100);
+    assert_eq!(a.len(), b.len());
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| {
+            assert_eq!(x.0, y.0);
+            (x.1 - y.1).norm().max((x.2 - y.2).norm())
+        })
+        .fold(0.0, f64::max);
+    assert!(
+        worst <= 1e-5,
+        "in-order and shuffled runs differ by {worst}"
+    );
+}
+
+#[test]
+fn ins_navigator_fuses_delayed_fixes_at_their_own_time() {
+    // Fixes valid 0.2 s before they arrive, on a body reaching 6 m/s: stamped with their own
+    // time they agree with the truth; stamped on arrival they lag it by v·0.2 s ≈ 1.2 m.
+    let aids = aids(30.0, 5.0);
+    let (good, _) = run(30.0, &delayed(&aids, 200_000_000));
+    let stamped_on_arrival: Vec<(u64, u64, Aid)> = aids
+        .iter()
+        .map(|(t, a)| (t + 200_000_000, t + 200_000_000, *a))
+        .collect();
+    let (late, _) = run(30.0, &stamped_on_arrival);
+    let rms = |run: &[(u64, Vector3<f64>, Vector3<f64>)]| {
+        let tail: Vec<f64> = run
+            .iter()
+            .filter(|(t, ..)| seconds(*t) > 15.0)
+            .map(|(t, p, _)| (p - truth(seconds(*t)).0).norm_squared())
+            .collect();
+        (tail.iter().sum::<f64>() / tail.len() as f64).sqrt()
+    };
+    let (e_good, e_late) = (rms(&good), rms(&late));
+    assert!(
+        e_good < 0.1,
+        "delayed fixes at their own time: {e_good} m RMS"
+    );
+    assert!(
+        e_late > 5.0 * e_good,
+        "stamped on arrival: {e_late} m vs {e_good} m"
+    );
+}
+
+#[test]
+fn ins_navigator_refusals_leave_it_unchanged() {
+    let aids = aids(10.0, 5.0);
+    let (_, mut nav) = run(10.0, &delayed(&aids, 200_000_000));
+    assert!(nav.estimate().is_some());
+    let t_new = nav.report().t_ns;
+    let fix = GnssFix::new(
+        Vector3::new(1.0, 2.0, 3.0),
+        Some(Vector3::zeros()),
+        1.0,
+        0.1,
+    );
+    let nan = Vector3::new(f64::NAN, 0.0, 0.0);
+    let before = nav;
+    let cases: [(&str, Result<(), NavError>, NavError); 8] = [
+        (
+            "too old",
+            nav.gnss(t_new - 400_000_000, &fix).map(|_| ()),
+            NavError::TooOld,
+        ),
+        (
+            "in the future",
+            nav.gnss(t_new + 1_000_000_000, &fix).map(|_| ()),
+            NavError::InFuture,
+        ),
+        (
+            "non-finite fix",
+            nav.gnss(
+                t_new,
+                &GnssFix {
+                    position: nan,
+                    ..fix
+                },
+            )
+            .map(|_| ()),
+            NavError::NonFinite,
+        ),
+        (
+            "zero sigma",
+            nav.gnss(
+                t_new,
+                &GnssFix {
+                    sigma_position: 0.0,
+                    ..fix
+                },
+            )
+            .map(|_| ()),
+            NavError::InvalidSigma,
+        ),
+        (
+            "negative sigma",
+            nav.gnss(
+                t_new,
+                &GnssFix {
+                    sigma_velocity: -1.0,
+                    ..fix
+                },
+            )
+            .map(|_| ()),
+            NavError::InvalidSigma,
+        ),
+        (
+            "zero field",
+            nav.magnetometer(t_new, &Vector3::zeros()).map(|_| ()),
+            NavError::ZeroVector,
+        ),
+        (
+            "repeated IMU time",
+            nav.imu(t_new, &Vector3::zeros(), &Vector3::z()).map(|_| ()),
+            NavError::TimeNotIncreasing,
+        ),
+        (
+            "non-finite IMU",
+            nav.imu(t_new + IMU_NS, &nan, &Vector3::z()).map(|_| ()),
+            NavError::NonFinite,
+        ),
+    ];
+    for (what, got, want) in cases {
+        assert_eq!(got, Err(want), "{what}");
+    }
+    // Bit for bit what it was, but for the refusal counter.
+    assert_eq!(nav.counters().refused, before.counters().refused + 8);
+    let without_count = |n: &InsNavigator<f64>| {
+        format!("{n:?}").replace(&format!("refused: {}", n.counters().refused), "")
+    };
+    assert_eq!(without_count(&nav), without_count(&before));
+    // A duplicate fix (same time twice) is refused too.
+    nav.gnss(t_new - 100_000_000, &fix).unwrap();
+    assert_eq!(
+        nav.gnss(t_new - 100_000_000, &fix).map(|_| ()),
+        Err(NavError::TimeNotIncreasing)
+    );
+}
+
+#[test]
+fn ins_navigator_uses_minutes_of_imu_before_a_late_first_fix() {
+    // Two minutes of IMU and magnetometer at rest, then fixes: the alignment runs all along,
+    // and the INS starts at the first fix with the attitude it learned.
+    let still = 120.0;
+    let mut nav = InsNavigator::<f64>::new(config()).unwrap();
+    let mut started_at = None;
+    for k in 0..((still + 10.0) * 200.0) as u64 {
+        let t = T0 + k * IMU_NS;
+        let r = nav
+            .imu(t, &Vector3::zeros(), &Vector3::new(0.0, 0.0, 9.81))
+            .unwrap();
+        if r.event == Some(InsEvent::Started) {
+            started_at = Some(seconds(t));
+        }
+        if k % 4 == 0 {
+            nav.magnetometer(t, &Vector3::from(FIELD)).unwrap();
+        }
+        if seconds(t) < still {
+            assert_eq!(r.validity.position, Validity::Invalid(Reason::NoFix));
+        } else if k % 40 == 0 {
+            let fix = GnssFix::new(
+                Vector3::new(3.0, 4.0, 5.0),
+                Some(Vector3::zeros()),
+                1.0,
+                0.1,
+            );
+            nav.gnss(t - 100_000_000, &fix).unwrap();
+        }
+    }
+    let started = started_at.expect("the INS started");
+    assert!(
+        started > still && started < still + 1.0,
+        "started at {started} s"
+    );
+    let e = nav.estimate().unwrap();
+    assert!((e.state.position - Vector3::new(3.0, 4.0, 5.0)).norm() < 1.0);
+    let v = nav.report().validity;
+    assert!(
+        v.tilt.is_valid() && v.heading.is_valid() && v.position.is_valid() && v.velocity.is_valid()
+    );
+}
+
+#[test]
+fn ins_navigator_realigns_after_an_imu_gap() {
+    let aids = aids(10.0, 5.0);
+    let (_, mut nav) = run(10.0, &delayed(&aids, 0));
+    assert!(nav.estimate().is_some());
+    // 10 s without IMU samples: the estimate is no longer valid, and the navigator says so.
+    let t = nav.report().t_ns + 10_000_000_000;
+    let r = nav
+        .imu(t, &Vector3::zeros(), &Vector3::new(0.0, 0.0, 9.81))
+        .unwrap();
+    assert_eq!(r.event, Some(InsEvent::Realigned));
+    assert!(nav.estimate().is_none());
+    assert!(!r.validity.position.is_valid() && !r.validity.tilt.is_valid());
+    assert_eq!(nav.counters().realigned, 1);
+}
+
+/// Runs `duration_s` at rest with fixes at `position(t)`, returning every report.
+fn at_rest_with_fixes(
+    duration_s: f64,
+    position: impl Fn(f64) -> Vector3<f64>,
+    velocity: impl Fn(f64) -> Vector3<f64>,
+) -> Vec<(f64, estimator_core::nav::InsReport<f64>)> {
+    let mut nav = InsNavigator::<f64>::new(config()).unwrap();
+    let mut reports = Vec::new();
+    for k in 0..(duration_s * 200.0) as u64 {
+        let t = T0 + k * IMU_NS;
+        if k % 4 == 0 {
+            nav.magnetometer(t, &Vector3::from(FIELD)).unwrap();
+        }
+        if k % 40 == 20 && k > 200 {
+            let s = seconds(t);
+            nav.gnss(t, &GnssFix::new(position(s), Some(velocity(s)), 0.5, 0.05))
+                .unwrap();
+        }
+        let r = nav
+            .imu(t, &Vector3::zeros(), &Vector3::new(0.0, 0.0, 9.81))
+            .unwrap();
+        reports.push((seconds(t), r));
+    }
+    reports
+}
+
+#[test]
+fn ins_navigator_flags_then_resets_after_fixes_disagree() {
+    // Fixes jump 50 m east at 20 s and stay there: within 1 s the position is flagged; after
+    // `gnss_reset_s` (10 s) of rejected fixes the position is reset to them, and confirmed
+    // after 1 s of fused fixes.
+    let step = |s: f64| {
+        if s >= 20.0 {
+            Vector3::new(50.0, 0.0, 0.0)
+        } else {
+            Vector3::zeros()
+        }
+    };
+    let reports = at_rest_with_fixes(40.0, step, |_| Vector3::zeros());
+    let flagged = reports
+        .iter()
+        .find(|(s, r)| {
+            *s >= 20.0 && r.validity.position == Validity::Invalid(Reason::FixesDisagree)
+        })
+        .map(|(s, _)| *s)
+        .expect("the disagreement is flagged");
+    assert!(flagged < 21.0 + 0.3, "flagged at {flagged} s");
+    let reset = reports
+        .iter()
+        .find(|(_, r)| r.event == Some(InsEvent::PositionReset))
+        .map(|(s, _)| *s)
+        .expect("the position is reset");
+    assert!((30.0..31.0 + 0.3).contains(&reset), "reset at {reset} s");
+    let valid_again = reports
+        .iter()
+        .find(|(s, r)| *s > reset && r.validity.position.is_valid())
+        .map(|(s, _)| *s)
+        .expect("valid again");
+    assert!(valid_again < reset + 2.0, "valid again at {valid_again} s");
+    // Between the flag and the reset, never valid.
+    assert!(reports
+        .iter()
+        .filter(|(s, _)| *s >= flagged && *s < reset)
+        .all(|(_, r)| !r.validity.position.is_valid()));
+}
+
+#[test]
+fn ins_navigator_refuses_a_frozen_receiver() {
+    // A moving body whose receiver repeats its last fix: refused as frozen (the report says
+    // `Faulty`), never fused.
+    let aids = aids(30.0, 5.0);
+    let mut frozen = Vec::new();
+    let mut last = None;
+    for (t, a) in &aids {
+        let a = match a {
+            Aid::Gnss(f) if seconds(*t) >= 20.0 => Aid::Gnss(*last.get_or_insert(*f)),
+            other => *other,
+        };
+        frozen.push((*t, a));
+    }
+    let (_, nav) = run(30.0, &delayed(&frozen, 0));
+    // The body stops near 29 s (the truth's velocity returns to zero): there a repeated fix
+    // may be a receiver at rest, and the gate judges it (it is 9 s stale: rejected).
+    let c = nav.counters();
+    assert!(c.gnss_frozen >= 38, "{c:?}");
+    assert_eq!(c.gnss_frozen + c.gnss_position_rejected, 48, "{c:?}");
+    assert_ne!(nav.report().gnss, AidStatus::Fused);
+    let e = nav.estimate().unwrap();
+    // Dead reckoning on a noise-free IMU: still on the truth.
+    let truth_now = truth(seconds(nav.report().t_ns)).0;
+    assert!((e.state.position - truth_now).norm() < 1.0);
+}

@@ -1,4 +1,4 @@
-//! `host-sim replay`: runs the error-state filter over a dataset folder and writes its outputs:
+//! `host-sim replay`: runs a navigator over a dataset folder and writes its outputs:
 //!
 //! | file | content |
 //! |---|---|
@@ -8,11 +8,12 @@
 //! | `metrics.json` | where the truth exists: RMSEs, NEES, NIS and update counts per sensor, time per IMU sample |
 //! | `*.png` | trajectory, per-axis errors inside their ±3σ bands, biases, NIS |
 //!
-//! The filter configures itself from the dataset's `sensor.yaml` files and starts itself from the
-//! data: it averages the first `align_window_s` of IMU (and magnetometer) samples, at rest, for
-//! tilt, heading and the gyro bias (`eskf::align_at_rest`), and takes its position from the first
-//! GNSS fix. It never reads the ground truth to start or to run; the truth is only scored against.
-//! With a GNSS stream it runs the 15-state INS, otherwise the attitude-only filter.
+//! The navigator configures itself from the dataset's `sensor.yaml` files and starts itself from
+//! the data, at rest or moving; it never reads the ground truth to start or to run, the truth is
+//! only scored against. With GNSS, every sample goes to [`estimator_core::nav::InsNavigator`]
+//! (`ins`), each fix stamped with the time it was valid; with an IMU and a magnetometer alone, to
+//! [`estimator_core::nav::AttitudeNavigator`] (`attitude`). A camera dataset without GNSS runs the
+//! 15-state filter here, started from a window at rest and a PnP pose of the first frame.
 
 use crate::baseline::{Madgwick, Mahony};
 use crate::dataset::read::{CameraParams, Dataset, Event, TruthStream};
@@ -20,8 +21,8 @@ use crate::dataset::DatasetError;
 use crate::metrics::trajectory::Delta;
 use crate::metrics::{Estimate, Metrics, Outcome, Scorer};
 use estimator_core::eskf::{
-    align_at_rest, BaroAltitude, EskfError, FilterConfig, GnssPosition, GnssVelocity, ImuNoise,
-    ImuSample, InitialSigmas, Ins, Magnetometer, MagnetometerWindow, UpdateOptions, UpdateOutcome,
+    align_at_rest, BaroAltitude, EskfError, FilterConfig, ImuNoise, ImuSample, InitialSigmas, Ins,
+    Magnetometer, MagnetometerWindow, UpdateOptions, UpdateOutcome,
 };
 use estimator_core::eskf::{Alignment, CameraLandmark, PinholeIntrinsics};
 use estimator_core::gn::{solve_pnp, Loss, PinholeCamera, PnpOptions};
@@ -361,15 +362,12 @@ fn replay_in<T: Real>(
     };
     let mut events = ds.events()?.peekable();
 
-    // --- Start-up: a window at rest, then the first GNSS fix (or, without GNSS, the first
-    // camera frame, solved for the pose) for the position. ---
+    // --- Start-up: a window at rest, then the first camera frame, solved for the pose. ---
     let window_ns = (cfg.align_window_s * 1e9) as u64;
     let (mut accel, mut gyro, mut mags) = (Vec::new(), Vec::new(), Vec::new());
     let mut t_first: Option<u64> = None;
     let mut last_imu: Option<u64> = None;
-    let mut first_fix: Option<Vector3<f64>> = None;
     let mut first_frame: Option<Vec<(u64, Vector2<f64>)>> = None;
-    let pnp_start = ds.gnss.is_none() && ds.camera.is_some();
     while let Some(ev) = events.peek() {
         let ev = match ev {
             Ok(e) => e.clone(),
@@ -382,8 +380,7 @@ fn replay_in<T: Real>(
         };
         let t0 = *t_first.get_or_insert(ev.t_ns());
         let in_window = ev.t_ns() < t0 + window_ns;
-        let need_fix =
-            (ds.gnss.is_some() && first_fix.is_none()) || (pnp_start && first_frame.is_none());
+        let need_fix = first_frame.is_none();
         if !in_window && !need_fix {
             break;
         }
@@ -399,16 +396,13 @@ fn replay_in<T: Real>(
             }
             Event::Imu { t_ns, .. } => last_imu = Some(*t_ns),
             Event::Mag { field, .. } if in_window => mags.push(lit3::<T>(field)),
-            Event::Gnss { position, .. } => first_fix = Some(*position),
-            Event::Camera { observations, .. }
-                if pnp_start && !in_window && observations.len() >= 6 =>
-            {
+            Event::Camera { observations, .. } if !in_window && observations.len() >= 6 => {
                 first_frame = Some(observations.clone());
             }
             _ => {}
         }
         events.next();
-        if !in_window && (first_fix.is_some() || first_frame.is_some()) {
+        if !in_window && first_frame.is_some() {
             break;
         }
     }
@@ -430,22 +424,8 @@ fn replay_in<T: Real>(
         ))
     })?;
     let sigmas = InitialSigmas::<T>::default();
-    let mut filter = match (first_fix, &ds.gnss, first_frame, &ds.camera) {
-        (Some(p), Some(g), _, _) => {
-            let p0 = p - alignment.attitude.cast::<f64>().act(&g.lever_arm);
-            let ins = Ins::from_alignment(
-                &alignment,
-                lit3(&p0),
-                &InitialSigmas {
-                    position: T::lit(2.0),
-                    ..sigmas
-                },
-                config,
-            )
-            .map_err(|e| ReplayError::Start(e.to_string()))?;
-            Filter(Box::new(ins))
-        }
-        (_, _, Some(frame), Some(cam)) => {
+    let mut filter = match (first_frame, &ds.camera) {
+        (Some(frame), Some(cam)) => {
             let world_from_body = pnp_pose(&frame, cam, &alignment.attitude.cast())?;
             let start = Alignment {
                 attitude: world_from_body.rotation().cast(),
@@ -465,8 +445,7 @@ fn replay_in<T: Real>(
         }
         _ => {
             return Err(ReplayError::Start(
-                "no GNSS fix (gnss0/data.csv) or camera frame with 6 known landmarks to take the position from"
-                    .into(),
+                "no camera frame with 6 known landmarks to take the position from".into(),
             ))
         }
     };
@@ -512,7 +491,6 @@ fn replay_in<T: Real>(
     let ekf = UpdateOptions::<T>::default();
     // Projections are strongly nonlinear near the camera: re-linearize (iterated update).
     let camera_options = UpdateOptions::<T>::iterated(ekf.gate, 3, T::lit(1e-6));
-    let mut last_gyro = Vector3::zeros();
     let mut last_sample: Option<(Vector3<f64>, Vector3<f64>)> = None;
     for ev in events {
         let ev = ev?;
@@ -538,7 +516,6 @@ fn replay_in<T: Real>(
                 if filter.predict(&g_mid, &a_mid, dt).is_err() {
                     scorer.measurement("imu", t_ns, Outcome::Refused);
                 }
-                last_gyro = gyro;
                 scorer.filter_ns += started.elapsed().as_nanos();
                 scorer.imu_samples += 1;
                 let e = filter.estimate(t_ns);
@@ -567,31 +544,8 @@ fn replay_in<T: Real>(
                     scorer.measurement("mag", t_ns, outcome(r, 3));
                 }
             }
-            Event::Gnss {
-                t_ns,
-                position,
-                velocity,
-                sigma_p,
-                sigma_v,
-            } => {
-                if let (Filter(f), Some(g)) = (&mut filter, &ds.gnss) {
-                    let r = f.update(
-                        &GnssPosition::new(lit3(&position), lit3(&g.lever_arm), T::lit(sigma_p)),
-                        &ekf,
-                    );
-                    scorer.measurement("gnss_position", t_ns, outcome(r, 3));
-                    // The antenna moves with the body's rotation: v_ant = v + R (ω × l). The model
-                    // measures v, so remove the lever-arm term with the current estimate.
-                    let s = f.state();
-                    let omega = last_gyro - up3(&s.gyro_bias);
-                    let lever = s.attitude.cast::<f64>().act(&omega.cross(&g.lever_arm));
-                    let r = f.update(
-                        &GnssVelocity::new(lit3(&(velocity - lever)), T::lit(sigma_v)),
-                        &ekf,
-                    );
-                    scorer.measurement("gnss_velocity", t_ns, outcome(r, 3));
-                }
-            }
+            // GNSS datasets replay through the INS navigator (`ins`).
+            Event::Gnss { .. } => {}
             Event::Baro { t_ns, altitude } => {
                 if let (Filter(f), Some(b)) = (&mut filter, &ds.baro) {
                     let r = f.update(&BaroAltitude::new(T::lit(altitude), T::lit(b.sigma)), &ekf);

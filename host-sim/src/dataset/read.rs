@@ -683,6 +683,102 @@ pub fn parse_movement(path: &Path, text: &str) -> Result<Vec<(u64, u64)>, Datase
     Ok(intervals)
 }
 
+/// One row of `faults.csv`, which `host-sim simulate` writes at the dataset root when its
+/// scenario has faults: the rows of `sensor`'s data stamped in `[start_ns, end_ns)` carry the
+/// fault `kind`.
+///
+/// `sensor` is `imu`, `mag`, `gnss` or `baro`; `kind` is `clip`, `stuck` (IMU), `rotated`,
+/// `disturbance` (magnetometer), `outage`, `outliers`, `step`, `frozen` (GNSS) or `step`
+/// (barometer). GNSS outliers, drawn fix by fix, are one `outliers` row over the whole run.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FaultInterval {
+    /// First timestamp of the interval, ns (the dataset's clock, as `imu0/data.csv`).
+    pub start_ns: u64,
+    /// End of the interval, ns, excluded.
+    pub end_ns: u64,
+    /// The sensor at fault.
+    pub sensor: String,
+    /// What the fault is.
+    pub kind: String,
+}
+
+/// The fault intervals of `DIR/faults.csv`, empty when the file is absent.
+///
+/// The file holds one interval a line, `start [ns],end [ns],sensor,kind` (see
+/// [`FaultInterval`]); lines starting with `#`, blank lines and a first line that is not a number
+/// (a header) are skipped. Intervals may overlap and come in any order.
+///
+/// # Errors
+/// An unreadable file, or a malformed line, naming the file and line.
+pub fn read_faults(dir: &Path) -> Result<Vec<FaultInterval>, DatasetError> {
+    let path = dir.join("faults.csv");
+    let text = match std::fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(DatasetError::file(&path, e)),
+    };
+    parse_faults(&path, &text)
+}
+
+/// Parses the text of a `faults.csv` (see [`read_faults`]); `path` names it in errors.
+///
+/// # Errors
+/// A line that is not `start,end,sensor,kind` with integer `start ≤ end` and non-empty names.
+pub fn parse_faults(path: &Path, text: &str) -> Result<Vec<FaultInterval>, DatasetError> {
+    let mut faults = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = i as u64 + 1;
+        let row = raw.trim();
+        if row.is_empty() || row.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = row.split(',').map(str::trim).collect();
+        if line == 1 && fields.first().is_some_and(|f| f.parse::<u64>().is_err()) {
+            continue; // a header without '#'
+        }
+        if fields.len() != 4 {
+            return Err(DatasetError::at(
+                path,
+                line,
+                format!(
+                    "expected 4 columns (start [ns],end [ns],sensor,kind), got {}",
+                    fields.len()
+                ),
+            ));
+        }
+        let parse = |f: &str, what: &str| {
+            f.parse::<u64>().map_err(|_| {
+                DatasetError::at(
+                    path,
+                    line,
+                    format!("{what} '{f}' is not an integer number of ns"),
+                )
+            })
+        };
+        let start_ns = parse(fields[0], "start")?;
+        let end_ns = parse(fields[1], "end")?;
+        if end_ns < start_ns {
+            return Err(DatasetError::at(
+                path,
+                line,
+                format!("end {end_ns} before start {start_ns}"),
+            ));
+        }
+        for (f, what) in [(fields[2], "sensor"), (fields[3], "kind")] {
+            if f.is_empty() {
+                return Err(DatasetError::at(path, line, format!("empty {what}")));
+            }
+        }
+        faults.push(FaultInterval {
+            start_ns,
+            end_ns,
+            sensor: fields[2].to_string(),
+            kind: fields[3].to_string(),
+        });
+    }
+    Ok(faults)
+}
+
 /// The timestamp of the first row of `DIR/state_groundtruth_estimate0/data.csv`, or `None`
 /// when the file is absent or has no rows.
 ///
@@ -823,6 +919,47 @@ mod tests {
             .iter()
             .any(|w| w.contains("T_BS is not the identity")));
         let _ = std::fs::remove_dir_all(root);
+    }
+
+    #[test]
+    fn fault_intervals_are_read_and_malformed_lines_name_file_and_line() {
+        let text = "#start [ns],end [ns],sensor,kind\n10,20,gnss,step\n\n 5 , 5 , imu , stuck \n";
+        let got = parse_faults(Path::new("d/faults.csv"), text).expect("parses");
+        let row = |start_ns, end_ns, sensor: &str, kind: &str| FaultInterval {
+            start_ns,
+            end_ns,
+            sensor: sensor.into(),
+            kind: kind.into(),
+        };
+        assert_eq!(
+            got,
+            vec![row(10, 20, "gnss", "step"), row(5, 5, "imu", "stuck")]
+        );
+        let cases = [
+            ("#h\n1,2,gnss\n", "faults.csv:2:", "expected 4 columns"),
+            ("#h\n1,2,gnss,step\nx,4,baro,step\n", "faults.csv:3:", "'x'"),
+            (
+                "#h\n5,4,mag,rotated\n",
+                "faults.csv:2:",
+                "end 4 before start 5",
+            ),
+            ("#h\n1,2,,step\n", "faults.csv:2:", "empty sensor"),
+            ("#h\n1,2,imu,\n", "faults.csv:2:", "empty kind"),
+            ("#h\n-1,2,imu,clip\n", "faults.csv:2:", "'-1'"),
+        ];
+        for (text, at, what) in cases {
+            let err = parse_faults(Path::new("d/faults.csv"), text)
+                .expect_err(text)
+                .to_string();
+            assert!(err.contains(at) && err.contains(what), "{text:?}: {err}");
+        }
+        let dir = std::env::temp_dir().join(format!("host-sim-faults-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("tmp");
+        assert!(read_faults(&dir).expect("absent is fine").is_empty());
+        std::fs::write(dir.join("faults.csv"), "#h\n1,2,gnss,frozen\nbad\n").expect("write");
+        let err = read_faults(&dir).expect_err("malformed").to_string();
+        assert!(err.contains("faults.csv:3:"), "{err}");
+        let _ = std::fs::remove_dir_all(dir);
     }
 
     #[test]

@@ -3,7 +3,12 @@
 //! Each sensor is sampled at its own exact times `start + round(j·10⁹/rate)` ns from the analytic
 //! trajectory; the IMU loop also writes the ground truth. The folder is written under a
 //! temporary name and renamed when complete, so a failed run leaves nothing that looks finished.
+//!
+//! A scenario with faults also gets `faults.csv` at the dataset root, one interval of the rows
+//! each fault changes a line ([`faults`], read back by [`super::read::read_faults`]); other tools
+//! ignore the file, and a scenario without faults gets none.
 
+use super::read::FaultInterval;
 use super::DatasetError;
 use crate::scenario::Scenario;
 use crate::sensors::baro::Baro;
@@ -75,7 +80,86 @@ pub fn simulate(scenario: &Scenario, seed: u64, dir: &Path) -> Result<(), Datase
     write_all(scenario, &traj, seed, &out)?;
     let replay = toml::to_string(&scenario.replay).map_err(|e| DatasetError::file(dir, e))?;
     out.write("replay.toml", &format!("# How host-sim runs the filter on this dataset (host-sim replay reads it when no --config is given).\n{replay}"))?;
+    let faults = faults(scenario);
+    if !faults.is_empty() {
+        let mut text = String::from("#start [ns],end [ns],sensor,kind\n");
+        for f in &faults {
+            text += &format!("{},{},{},{}\n", f.start_ns, f.end_ns, f.sensor, f.kind);
+        }
+        out.write("faults.csv", &text)?;
+    }
     Ok(())
+}
+
+/// The faults of `scenario` as `faults.csv` lists them, ordered by start: for each, the
+/// interval `[start_ns, end_ns)` of the timestamps of the rows it changes, in the dataset's clock
+/// (the scenario's `start_ns` plus its times in seconds). GNSS steps and freezes go by the state time
+/// of a fix, so their rows are stamped one latency later (see [`crate::sensors::gnss`]); GNSS
+/// outliers, drawn fix by fix, are one `gnss,outliers` row from the first fix to just after the
+/// last. Sensors the scenario does not have contribute nothing.
+#[must_use]
+pub fn faults(scenario: &Scenario) -> Vec<FaultInterval> {
+    let t0 = scenario.start_ns;
+    // Seconds to the dataset's clock, as `stamp_ns` does (validated times are non-negative).
+    let ns = |s: f64| t0 + (s * 1e9).round() as u64;
+    let mut rows = Vec::new();
+    let mut add = |start: f64, end: f64, sensor: &str, kind: &str| {
+        rows.push(FaultInterval {
+            start_ns: ns(start),
+            end_ns: ns(end),
+            sensor: sensor.into(),
+            kind: kind.into(),
+        });
+    };
+    let imu = &scenario.imu;
+    for f in &imu.accel_clip {
+        add(f[0], f[1], "imu", "clip");
+    }
+    for f in &imu.gyro_stuck {
+        add(f[0], f[1], "imu", "stuck");
+    }
+    if let Some(c) = &scenario.mag {
+        for f in &c.disturbances {
+            add(f[0], f[1], "mag", "disturbance");
+        }
+        for f in &c.rotated {
+            add(f[0], f[1], "mag", "rotated");
+        }
+    }
+    if let Some(c) = &scenario.gnss {
+        for f in &c.outages {
+            add(f[0], f[1], "gnss", "outage");
+        }
+        // A fix stamped t has state time max(t − latency, 0): a time after 0 moves by the
+        // latency, 0 itself covers the fixes stamped before the latency too.
+        let stamped = |s: f64| if s > 0.0 { s + c.latency_s } else { s };
+        for f in &c.steps {
+            add(stamped(f[0]), stamped(f[1]), "gnss", "step");
+        }
+        for f in &c.frozen {
+            add(stamped(f[0]), stamped(f[1]), "gnss", "frozen");
+        }
+    }
+    if let Some(c) = &scenario.baro {
+        for f in &c.steps {
+            add(f[0], f[1], "baro", "step");
+        }
+    }
+    if let Some(c) = scenario
+        .gnss
+        .as_ref()
+        .filter(|c| c.outlier_probability > 0.0)
+    {
+        let last = samples(scenario.duration_s, c.rate_hz) - 1;
+        rows.push(FaultInterval {
+            start_ns: t0,
+            end_ns: stamp_ns(t0, last, c.rate_hz) + 1,
+            sensor: "gnss".into(),
+            kind: "outliers".into(),
+        });
+    }
+    rows.sort_by_key(|f| (f.start_ns, f.end_ns));
+    rows
 }
 
 fn write_all(sc: &Scenario, traj: &Trajectory, seed: u64, out: &Out) -> Result<(), DatasetError> {

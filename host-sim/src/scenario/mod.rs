@@ -10,7 +10,7 @@ use crate::sensors::camera::CameraConfig;
 use crate::sensors::gnss::GnssConfig;
 use crate::sensors::imu::ImuConfig;
 use crate::sensors::mag::MagConfig;
-use crate::trajectory::{builtin, Trajectory};
+use crate::trajectory::{builtin, Signal, Sine, Trajectory};
 use serde::{Deserialize, Serialize};
 
 /// Accuracy ceilings the end-to-end tests hold a filter to on this scenario.
@@ -143,7 +143,9 @@ impl Scenario {
     }
 
     /// `Ok` when every value is in its domain: a positive finite duration, a non-negative static
-    /// period, positive sensor rates, a finite gravity, and a valid replay configuration.
+    /// period, positive sensor rates, a finite gravity, fault intervals with finite values and
+    /// `0 ≤ start_s < end_s` (a stuck gyro axis 0, 1 or 2, a positive clipping limit, an outlier
+    /// probability in `[0, 1]`), and a valid replay configuration.
     ///
     /// # Errors
     /// The first value out of its domain, named.
@@ -174,7 +176,49 @@ impl Scenario {
                 positive(name, r)?;
             }
         }
+        self.validate_faults()?;
         self.replay.validate().map_err(|e| format!("replay.{e}"))
+    }
+
+    /// The fault part of [`Scenario::validate`].
+    fn validate_faults(&self) -> Result<(), String> {
+        let imu = &self.imu;
+        intervals("imu.accel_clip", &imu.accel_clip)?;
+        intervals("imu.gyro_stuck", &imu.gyro_stuck)?;
+        for (i, f) in imu.accel_clip.iter().enumerate() {
+            if f[2] <= 0.0 {
+                return Err(format!(
+                    "imu.accel_clip[{i}] = {f:?}: the limit must be positive"
+                ));
+            }
+        }
+        for (i, f) in imu.gyro_stuck.iter().enumerate() {
+            if ![0.0, 1.0, 2.0].contains(&f[2]) {
+                return Err(format!(
+                    "imu.gyro_stuck[{i}] = {f:?}: the axis must be 0, 1 or 2"
+                ));
+            }
+        }
+        if let Some(c) = &self.mag {
+            intervals("mag.disturbances", &c.disturbances)?;
+            intervals("mag.rotated", &c.rotated)?;
+        }
+        if let Some(c) = &self.gnss {
+            intervals("gnss.outages", &c.outages)?;
+            intervals("gnss.steps", &c.steps)?;
+            intervals("gnss.frozen", &c.frozen)?;
+            let p = c.outlier_probability;
+            if !(0.0..=1.0).contains(&p) {
+                return Err(format!("gnss.outlier_probability = {p}: must be in [0, 1]"));
+            }
+            if !c.outlier_m.is_finite() {
+                return Err(format!("gnss.outlier_m = {}: must be finite", c.outlier_m));
+            }
+        }
+        if let Some(c) = &self.baro {
+            intervals("baro.steps", &c.steps)?;
+        }
+        Ok(())
     }
 
     /// A built-in scenario by name, or a TOML file by path.
@@ -212,6 +256,22 @@ impl Scenario {
     }
 }
 
+/// `Ok` when every entry of the fault list `name` is finite with `0 ≤ start_s < end_s` (its first
+/// two values).
+fn intervals<const N: usize>(name: &str, list: &[[f64; N]]) -> Result<(), String> {
+    for (i, f) in list.iter().enumerate() {
+        if !f.iter().all(|x| x.is_finite()) {
+            return Err(format!("{name}[{i}] = {f:?}: every value must be finite"));
+        }
+        if !(f[0] >= 0.0 && f[0] < f[1]) {
+            return Err(format!(
+                "{name}[{i}] = {f:?}: needs 0 ≤ start_s < end_s (seconds from the start)"
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The built-in scenarios. `default` is what `host-sim run` runs with no arguments.
 #[must_use]
 pub fn builtin_scenarios() -> Vec<Scenario> {
@@ -226,7 +286,8 @@ pub fn builtin_scenarios() -> Vec<Scenario> {
         accel_range: 0.0,
         ..ImuConfig::default()
     };
-    vec![
+    let faults = fault_scenarios(&base);
+    let mut all = vec![
         Scenario {
             name: "default".into(),
             description: "60 s figure-eight flight; IMU 200 Hz, magnetometer 50 Hz, GNSS 1 m at 5 Hz".into(),
@@ -340,6 +401,122 @@ pub fn builtin_scenarios() -> Vec<Scenario> {
             mag: Some(MagConfig::default()),
             ceilings: Ceilings { ate_m: f64::INFINITY, attitude_deg: 1.2 },
             ..base
+        },
+    ];
+    all.extend(faults);
+    all
+}
+
+/// The fault scenarios, one sensor fault each, for showing that a navigator detects a fault and
+/// recovers once good data returns. Each flies the `default` figure-eight (or a variant of it
+/// where the fault needs a particular motion) with every sensor a navigator fuses (IMU 200 Hz,
+/// magnetometer 50 Hz, GNSS 5 Hz, barometer 25 Hz), with at least 50 s after the fault ends.
+/// Their ceilings are left open.
+fn fault_scenarios(base: &Scenario) -> Vec<Scenario> {
+    fn sine(amplitude: f64, frequency_hz: f64, phase: f64) -> Sine {
+        Sine {
+            amplitude,
+            frequency_hz,
+            phase,
+        }
+    }
+    let all_sensors = Scenario {
+        duration_s: 120.0,
+        mag: Some(MagConfig::default()),
+        gnss: Some(GnssConfig::default()),
+        baro: Some(BaroConfig::default()),
+        ceilings: Ceilings::default(),
+        ..base.clone()
+    };
+    let figure8 = |edit: fn(&mut Trajectory)| {
+        builtin("figure8", base.static_s).map(|mut t| {
+            edit(&mut t);
+            t
+        })
+    };
+    // Ten times the size at half the frequency: x = 100 sin(ωτ), y = 50 sin(2ωτ), ω = 2π/40 s,
+    // so the speed stays between 10.4 and 22 m/s (a 0.2 s latency is 2 to 4.4 m of lag).
+    let fast = figure8(|t| {
+        t.position[0] = Signal {
+            sines: vec![sine(100.0, 1.0 / 40.0, 0.0)],
+            ..Signal::default()
+        };
+        t.position[1] = Signal {
+            sines: vec![sine(50.0, 1.0 / 20.0, 0.0)],
+            ..Signal::default()
+        };
+    });
+    // A 25 Hz vertical vibration of 1.6 mm (motors on a stiff mount): ±39.5 m/s², so the vertical
+    // specific force peaks near 5 g and a ±4 g range clips it, on one side only.
+    let vibrating = figure8(|t| t.position[2].sines.push(sine(0.0016, 25.0, 0.0)));
+    // The heading swing phased so that its rate crosses zero, rising, at 40 s (τ = 34 s): a turn
+    // begins, and by 42 s the heading has moved 0.19 rad that a stuck z gyro does not see.
+    let turning = figure8(|t| {
+        t.euler[2] = Signal {
+            offset: 0.4,
+            sines: vec![sine(1.0, 1.0 / 20.0, 0.1 * std::f64::consts::PI)],
+            ..Signal::default()
+        };
+    });
+    vec![
+        Scenario {
+            name: "fault_gnss_step".into(),
+            description: "GNSS fixes 50 m off (30 m east, 40 m north) from 40 s to 70 s; figure-eight, IMU, magnetometer, GNSS 5 Hz, barometer, 120 s".into(),
+            gnss: Some(GnssConfig { steps: vec![[40.0, 70.0, 30.0, 40.0, 0.0]], ..GnssConfig::default() }),
+            ..all_sensors.clone()
+        },
+        Scenario {
+            name: "fault_gnss_frozen".into(),
+            description: "GNSS receiver repeats its last fix from 40 s to 55 s; figure-eight, IMU, magnetometer, GNSS 5 Hz, barometer, 120 s".into(),
+            gnss: Some(GnssConfig { frozen: vec![[40.0, 55.0]], ..GnssConfig::default() }),
+            ..all_sensors.clone()
+        },
+        Scenario {
+            name: "fault_gnss_outage".into(),
+            description: "10 min GNSS outage from 30 s to 630 s, then 70 s of fixes; figure-eight, IMU, magnetometer, GNSS 5 Hz, barometer".into(),
+            duration_s: 700.0,
+            gnss: Some(GnssConfig { outages: vec![[30.0, 630.0]], ..GnssConfig::default() }),
+            ..all_sensors.clone()
+        },
+        Scenario {
+            name: "fault_gnss_outliers".into(),
+            description: "5 % of GNSS fixes 50 m off horizontally, at random; figure-eight, IMU, magnetometer, GNSS 5 Hz, barometer, 120 s".into(),
+            gnss: Some(GnssConfig { outlier_probability: 0.05, outlier_m: 50.0, ..GnssConfig::default() }),
+            ..all_sensors.clone()
+        },
+        Scenario {
+            name: "fault_gnss_latency".into(),
+            description: "GNSS fixes 0.2 s late on a 200 m figure-eight at 10-22 m/s; IMU, magnetometer, GNSS 5 Hz, barometer, 120 s".into(),
+            trajectory: fast,
+            gnss: Some(GnssConfig { latency_s: 0.2, ..GnssConfig::default() }),
+            ..all_sensors.clone()
+        },
+        Scenario {
+            name: "fault_mag_rotated".into(),
+            description: "magnetometer reads rotated 90° about body z from 40 s to 100 s; figure-eight, IMU, magnetometer, GNSS 5 Hz, barometer, 160 s".into(),
+            duration_s: 160.0,
+            mag: Some(MagConfig { rotated: vec![[40.0, 100.0, 90.0]], ..MagConfig::default() }),
+            ..all_sensors.clone()
+        },
+        Scenario {
+            name: "fault_baro_step".into(),
+            description: "barometer reads 20 m high from 40 s to 70 s; figure-eight, IMU, magnetometer, GNSS 5 Hz, barometer, 120 s".into(),
+            baro: Some(BaroConfig { steps: vec![[40.0, 70.0, 20.0]], ..BaroConfig::default() }),
+            ..all_sensors.clone()
+        },
+        Scenario {
+            name: "fault_accel_clip".into(),
+            description: "accelerometer clipped at ±4 g from 40 s to 42 s under a 25 Hz vibration peaking near 5 g; figure-eight, IMU, magnetometer, GNSS 5 Hz, barometer, 120 s".into(),
+            trajectory: vibrating,
+            imu: ImuConfig { accel_clip: vec![[40.0, 42.0, 4.0 * 9.81]], ..ImuConfig::default() },
+            ..all_sensors.clone()
+        },
+        Scenario {
+            name: "fault_gyro_stuck".into(),
+            description: "z gyro stuck from 40 s to 42 s as a turn begins (0.19 rad unseen); figure-eight, IMU, magnetometer, GNSS 5 Hz, barometer, 120 s".into(),
+            trajectory: turning,
+            imu: ImuConfig { gyro_stuck: vec![[40.0, 42.0, 2.0]], ..ImuConfig::default() },
+            ..all_sensors
         },
     ]
 }

@@ -1,7 +1,9 @@
-//! A barometric altimeter: `h̃ = p_z + b + σ n`, with a constant bias `b` drawn at start.
-//! Defaults: a BMP388 class sensor, about 0.1 m rms at 25 Hz after its filter, referenced to the
-//! local pressure (offset 0 by default: the 15-state filter has no barometer-bias state, so an
-//! offset would go straight into its altitude; set `bias_sigma` to study that).
+//! A barometric altimeter: `h̃ = p_z + b + s(t) + σ n`, with a constant bias `b` drawn at start
+//! and `s(t)` the sum of the `steps` active at `t` (a pressure jump: a door, a weather front, a
+//! prop wash). Defaults: a BMP388 class sensor, about 0.1 m rms at 25 Hz after its filter,
+//! referenced to the local pressure (offset 0 by default: the 15-state filter has no
+//! barometer-bias state, so an offset would go straight into its altitude; set `bias_sigma` to
+//! study that), no steps.
 
 use super::Noise;
 use crate::trajectory::Kinematics;
@@ -18,6 +20,9 @@ pub struct BaroConfig {
     pub sigma: f64,
     /// 1σ of the constant offset, m.
     pub bias_sigma: f64,
+    /// Altitude steps `[start_s, end_s, dz_m]`: a sample taken in `[start_s, end_s)` (seconds
+    /// from the scenario's start) reads `dz_m` higher (overlapping steps add).
+    pub steps: Vec<[f64; 3]>,
 }
 
 impl Default for BaroConfig {
@@ -26,6 +31,7 @@ impl Default for BaroConfig {
             rate_hz: 25.0,
             sigma: 0.1,
             bias_sigma: 0.0,
+            steps: Vec::new(),
         }
     }
 }
@@ -46,8 +52,13 @@ impl Baro {
         Self { cfg, noise, bias }
     }
 
-    /// Altitude, m.
+    /// Altitude, m, with the steps active at `k.t`.
     pub fn sample(&mut self, k: &Kinematics) -> f64 {
-        k.position.z + self.bias + self.noise.normal() * self.cfg.sigma
+        let h = k.position.z + self.bias + self.noise.normal() * self.cfg.sigma;
+        self.cfg
+            .steps
+            .iter()
+            .filter(|s| k.t >= s[0] && k.t < s[1])
+            .fold(h, |h, s| h + s[2])
     }
 }

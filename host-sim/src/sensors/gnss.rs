@@ -1,10 +1,16 @@
-//! A GNSS receiver: position and velocity fixes with noise, latency, outages and gross outliers.
+//! A GNSS receiver: position and velocity fixes with noise, latency, outages, gross outliers,
+//! position steps and a frozen output.
 //!
 //! The antenna sits at the body-frame lever arm `l`: `p_ant = p + R l`, `v_ant = v + R(ω_b × l)`.
-//! A fix stamped `t` describes the state at `t − latency`. During an outage no fix is produced; a
-//! gross outlier adds `outlier_m` metres in a random horizontal direction. The reported
-//! `sigma_p`, `sigma_v` are the configured 1-σ (what a receiver would report), whatever the
-//! outliers. Defaults: a u-blox M8/M9 class receiver at 5 Hz, 1 m horizontal and 1.5 m vertical.
+//! A fix stamped `t` describes the state at `t − latency` (its *state time*). During an outage no
+//! fix is produced; a gross outlier adds `outlier_m` metres in a random horizontal direction; a
+//! step adds a constant world-frame offset to the position; a frozen receiver repeats the position
+//! and velocity of its last fix under new timestamps. Outages go by the stamp (the receiver sends
+//! nothing then); steps and freezes go by the state time (they corrupt what is measured then), so
+//! with a latency the rows they change are those stamped `[start + latency, end + latency)`. The
+//! reported `sigma_p`, `sigma_v` are the configured 1-σ (what a receiver would report), whatever
+//! the faults. Defaults: a u-blox M8/M9 class receiver at 5 Hz, 1 m horizontal and 1.5 m vertical,
+//! without faults.
 
 use super::Noise;
 use crate::trajectory::Kinematics;
@@ -29,12 +35,21 @@ pub struct GnssConfig {
     pub latency_s: f64,
     /// Antenna lever arm in the body frame, m.
     pub lever_arm: [f64; 3],
-    /// Outages `[start_s, end_s]`.
+    /// Outages `[start_s, end_s]`: no fix stamped in `[start_s, end_s)` (seconds from the
+    /// scenario's start).
     pub outages: Vec<[f64; 2]>,
     /// Probability that a fix is a gross outlier.
     pub outlier_probability: f64,
     /// Size of a gross outlier, m.
     pub outlier_m: f64,
+    /// Position steps `[start_s, end_s, dx, dy, dz]`: every fix whose state time (stamp −
+    /// latency) is in `[start_s, end_s)` is offset by `(dx, dy, dz)` m in the world frame
+    /// (overlapping steps add). The end lets a test see the recovery once good fixes return.
+    pub steps: Vec<[f64; 5]>,
+    /// Frozen output `[start_s, end_s]`: every fix whose state time is in `[start_s, end_s)`
+    /// repeats the position and velocity of the last fix produced before it, under its own new
+    /// timestamp (the first fix of the interval is held when none came before).
+    pub frozen: Vec<[f64; 2]>,
 }
 
 impl Default for GnssConfig {
@@ -49,6 +64,8 @@ impl Default for GnssConfig {
             outages: Vec::new(),
             outlier_probability: 0.0,
             outlier_m: 20.0,
+            steps: Vec::new(),
+            frozen: Vec::new(),
         }
     }
 }
@@ -71,13 +88,19 @@ pub struct GnssFix {
 pub struct Gnss {
     cfg: GnssConfig,
     noise: Noise,
+    /// The last fix produced, which a frozen receiver repeats.
+    last: Option<GnssFix>,
 }
 
 impl Gnss {
     /// A new receiver.
     #[must_use]
     pub fn new(cfg: GnssConfig, noise: Noise) -> Self {
-        Self { cfg, noise }
+        Self {
+            cfg,
+            noise,
+            last: None,
+        }
     }
 
     /// The configuration.
@@ -86,16 +109,23 @@ impl Gnss {
         &self.cfg
     }
 
-    /// A fix of the (already delayed) true state `k`, or `None` during an outage.
+    /// A fix of the (already delayed) true state `k`, or `None` during an outage. `stamp_s` is
+    /// the fix's timestamp; `k.t` its state time, which steps and freezes go by.
     pub fn sample(&mut self, k: &Kinematics, stamp_s: f64) -> Option<GnssFix> {
         let c = &self.cfg;
-        // Draw every random number first, so the stream does not depend on outages.
+        // Draw every random number first, so the stream does not depend on the faults.
         let n_p = self.noise.normal3();
         let n_v = self.noise.normal3();
         let outlier = self.noise.uniform() < c.outlier_probability;
         let dir = self.noise.uniform() * std::f64::consts::TAU;
         if c.outages.iter().any(|o| stamp_s >= o[0] && stamp_s < o[1]) {
             return None;
+        }
+        let during = |start: f64, end: f64| k.t >= start && k.t < end;
+        if c.frozen.iter().any(|f| during(f[0], f[1])) {
+            if let Some(held) = self.last {
+                return Some(held);
+            }
         }
         let l = Vector3::from(c.lever_arm);
         let mut position = k.position
@@ -108,13 +138,18 @@ impl Gnss {
         if outlier {
             position += Vector3::new(dir.cos(), dir.sin(), 0.0) * c.outlier_m;
         }
+        for s in c.steps.iter().filter(|s| during(s[0], s[1])) {
+            position += Vector3::new(s[2], s[3], s[4]);
+        }
         let velocity =
             k.velocity + k.attitude.act(&k.omega_body.cross(&l)) + n_v * c.sigma_velocity;
-        Some(GnssFix {
+        let fix = GnssFix {
             position,
             velocity,
             sigma_p: c.sigma_horizontal.max(c.sigma_vertical),
             sigma_v: c.sigma_velocity,
-        })
+        };
+        self.last = Some(fix);
+        Some(fix)
     }
 }

@@ -1,5 +1,6 @@
 //! A MEMS IMU: white noise density, bias random walk, turn-on bias, scale factor and
-//! misalignment, quantization, saturation and rate.
+//! misalignment, quantization, saturation and rate; and two faults, a clipping accelerometer and
+//! a stuck gyro axis.
 //!
 //! Measurement model at sample `k` (body frame = sensor frame):
 //!
@@ -11,6 +12,11 @@
 //!
 //! with `M = I + (scale and misalignment)` and `Q` quantization and saturation. The densities
 //! are continuous-time, in Kalibr units (rad/s/√Hz, m/s²/√Hz, rad/s²/√Hz, m/s³/√Hz).
+//!
+//! Faults act on the output, at the sample's time `t` (seconds from the scenario's start): during
+//! an `accel_clip` interval `f̃ᵢ ← clamp(f̃ᵢ, −limit, limit)` on every axis (a range too small for
+//! the motion); during a `gyro_stuck` interval the named axis repeats the value it gave at the
+//! sample before the interval. The ground truth's biases stay those of the model above.
 //!
 //! Defaults are those of a Bosch BMI088 class IMU: gyro noise density 0.014 °/s/√Hz, accelerometer
 //! 175 µg/√Hz (datasheet typicals); ±2000 °/s and ±24 g ranges with 16-bit output; bias random
@@ -52,6 +58,12 @@ pub struct ImuConfig {
     pub gyro_range: f64,
     /// Accelerometer range, m/s².
     pub accel_range: f64,
+    /// Clipping `[start_s, end_s, limit_mps2]`: every accelerometer axis of a sample taken in
+    /// `[start_s, end_s)` (seconds from the scenario's start) is clamped to `±limit_mps2`.
+    pub accel_clip: Vec<[f64; 3]>,
+    /// Stuck gyro axes `[start_s, end_s, axis]` (axis 0, 1 or 2): in `[start_s, end_s)` that axis
+    /// repeats the last value it gave before `start_s` (its first value if none came before).
+    pub gyro_stuck: Vec<[f64; 3]>,
 }
 
 impl Default for ImuConfig {
@@ -72,6 +84,8 @@ impl Default for ImuConfig {
             accel_lsb: 24.0 * g / 32768.0,
             gyro_range: 2000.0 * deg,
             accel_range: 24.0 * g,
+            accel_clip: Vec::new(),
+            gyro_stuck: Vec::new(),
         }
     }
 }
@@ -99,6 +113,8 @@ pub struct Imu {
     accel_bias: Vector3<f64>,
     m_g: Matrix3<f64>,
     m_a: Matrix3<f64>,
+    /// The gyro output of the previous sample, which a stuck axis repeats.
+    last_gyro: Option<Vector3<f64>>,
 }
 
 impl Imu {
@@ -118,11 +134,13 @@ impl Imu {
             accel_bias,
             m_g,
             m_a,
+            last_gyro: None,
         }
     }
 
     /// Samples the IMU at the true state `k` (instantaneous values, as a sensor without a
-    /// decimation filter gives them), then advances the biases by one period.
+    /// decimation filter gives them) with the faults active at `k.t`, then advances the biases by
+    /// one period.
     pub fn sample(&mut self, k: &Kinematics) -> ImuSample {
         let c = &self.cfg;
         let sqrt_rate = c.rate_hz.sqrt();
@@ -131,9 +149,24 @@ impl Imu {
             + self.noise.normal3() * (c.gyroscope_noise_density * sqrt_rate);
         let accel = self.m_a * (specific_force + self.accel_bias)
             + self.noise.normal3() * (c.accelerometer_noise_density * sqrt_rate);
+        let mut gyro = gyro.map(|x| quantize_saturate(x, c.gyro_lsb, c.gyro_range));
+        let mut accel = accel.map(|x| quantize_saturate(x, c.accel_lsb, c.accel_range));
+        let during = |f: &[f64; 3]| k.t >= f[0] && k.t < f[1];
+        for f in c.gyro_stuck.iter().filter(|f| during(f)) {
+            // The last output holds the stuck value already when the interval has begun.
+            let axis = f[2] as usize;
+            if let (Some(last), true) = (self.last_gyro, axis < 3) {
+                gyro[axis] = last[axis];
+            }
+        }
+        for f in c.accel_clip.iter().filter(|f| during(f)) {
+            // Not `clamp`, which panics on a limit `Scenario::validate` would refuse.
+            accel = accel.map(|x| x.max(-f[2]).min(f[2]));
+        }
+        self.last_gyro = Some(gyro);
         let out = ImuSample {
-            gyro: gyro.map(|x| quantize_saturate(x, c.gyro_lsb, c.gyro_range)),
-            accel: accel.map(|x| quantize_saturate(x, c.accel_lsb, c.accel_range)),
+            gyro,
+            accel,
             gyro_bias: self.gyro_bias,
             accel_bias: self.accel_bias,
         };

@@ -1,10 +1,12 @@
-//! A 3-axis magnetometer: white noise, hard and soft iron, disturbance episodes.
+//! A 3-axis magnetometer: white noise, hard and soft iron, disturbance episodes, rotated output.
 //!
-//! `m̃ = A (Rᵀ (m_w + d(t))) + b + σ n`, with `A = I + S` (soft iron), `b` (hard iron, µT), `d(t)`
-//! a world-frame disturbance that is non-zero during episodes (a steel structure nearby), `σ` the
-//! per-sample white noise (µT). Defaults: an ICM-20948 class magnetometer (AK09916: 0.15 µT/LSB,
-//! about 0.4 µT rms noise) under a mid-latitude field of 48 µT, 60° inclination, with calibrated
-//! (zero) iron terms.
+//! `m̃ = R_z(α(t)) (A (Rᵀ (m_w + d(t))) + b + σ n)`, with `A = I + S` (soft iron), `b` (hard iron,
+//! µT), `d(t)` a world-frame disturbance that is non-zero during episodes (a steel structure
+//! nearby), `σ` the per-sample white noise (µT), and `R_z(α)` a rotation by `α` about the body z
+//! axis, the identity outside `rotated` intervals (a sensor remounted or its axes mislabelled).
+//! Defaults: an ICM-20948 class magnetometer (AK09916: 0.15 µT/LSB, about 0.4 µT rms noise) under
+//! a mid-latitude field of 48 µT, 60° inclination, with calibrated (zero) iron terms and no
+//! faults.
 
 use super::Noise;
 use crate::sensors::imu::InverseAct;
@@ -29,6 +31,10 @@ pub struct MagConfig {
     pub soft_iron: [f64; 9],
     /// Disturbance episodes `[start_s, end_s, magnitude_uT]`, a world-frame field along east.
     pub disturbances: Vec<[f64; 3]>,
+    /// Rotated output `[start_s, end_s, angle_deg]`: a sample taken in `[start_s, end_s)`
+    /// (seconds from the scenario's start) is rotated by `angle_deg` about the body z axis,
+    /// `(x, y) ← (x cos α − y sin α, x sin α + y cos α)` (overlapping intervals add).
+    pub rotated: Vec<[f64; 3]>,
 }
 
 impl Default for MagConfig {
@@ -41,6 +47,7 @@ impl Default for MagConfig {
             hard_iron: [0.0; 3],
             soft_iron: [0.0; 9],
             disturbances: Vec::new(),
+            rotated: Vec::new(),
         }
     }
 }
@@ -59,7 +66,7 @@ impl Mag {
         Self { cfg, noise }
     }
 
-    /// One sample at the true state `k`, µT, body frame.
+    /// One sample at the true state `k`, µT, body frame, with the faults active at `k.t`.
     pub fn sample(&mut self, k: &Kinematics) -> Vector3<f64> {
         let c = &self.cfg;
         let mut world = Vector3::from(c.reference_field);
@@ -69,8 +76,20 @@ impl Mag {
             }
         }
         let a = Matrix3::identity() + Matrix3::from_row_slice(&c.soft_iron);
-        a * k.attitude.inverse_act(&world)
+        let m = a * k.attitude.inverse_act(&world)
             + Vector3::from(c.hard_iron)
-            + self.noise.normal3() * c.sigma
+            + self.noise.normal3() * c.sigma;
+        let angle_deg: f64 = c
+            .rotated
+            .iter()
+            .filter(|r| k.t >= r[0] && k.t < r[1])
+            .map(|r| r[2])
+            .sum();
+        if angle_deg == 0.0 {
+            // Outside every interval the sample is as it always was, bit for bit.
+            return m;
+        }
+        let (s, co) = angle_deg.to_radians().sin_cos();
+        Vector3::new(m.x * co - m.y * s, m.x * s + m.y * co, m.z)
     }
 }

@@ -333,7 +333,10 @@ fn at_rest_with_fixes(
     duration_s: f64,
     position: impl Fn(f64) -> Vector3<f64>,
     velocity: impl Fn(f64) -> Vector3<f64>,
-) -> Vec<(f64, estimator_core::nav::InsReport<f64>)> {
+) -> (
+    Vec<(f64, estimator_core::nav::InsReport<f64>)>,
+    InsNavigator<f64>,
+) {
     let mut nav = InsNavigator::<f64>::new(config()).unwrap();
     let mut reports = Vec::new();
     for k in 0..(duration_s * 200.0) as u64 {
@@ -351,47 +354,70 @@ fn at_rest_with_fixes(
             .unwrap();
         reports.push((seconds(t), r));
     }
-    reports
+    (reports, nav)
 }
 
 #[test]
-fn ins_navigator_flags_then_resets_after_fixes_disagree() {
-    // Fixes jump 50 m east at 20 s and stay there: within 1 s the position is flagged; after
-    // `gnss_reset_s` (10 s) of rejected fixes the position is reset to them, and confirmed
-    // after 1 s of fused fixes.
+fn ins_navigator_holds_through_a_jump_of_the_fixes() {
+    // Fixes jump 50 m east from 20 s to 35 s: within 1 s the position is flagged; a jump is the
+    // receiver's (the estimate cannot move 50 m in one fix interval), so the estimate is kept,
+    // never reset, and valid again within 1 s of the fixes coming back.
     let step = |s: f64| {
-        if s >= 20.0 {
+        if (20.0..35.0).contains(&s) {
             Vector3::new(50.0, 0.0, 0.0)
         } else {
             Vector3::zeros()
         }
     };
-    let reports = at_rest_with_fixes(40.0, step, |_| Vector3::zeros());
-    let flagged = reports
-        .iter()
-        .find(|(s, r)| {
-            *s >= 20.0 && r.validity.position == Validity::Invalid(Reason::FixesDisagree)
-        })
-        .map(|(s, _)| *s)
-        .expect("the disagreement is flagged");
-    assert!(flagged < 21.0 + 0.3, "flagged at {flagged} s");
-    let reset = reports
-        .iter()
-        .find(|(_, r)| r.event == Some(InsEvent::PositionReset))
-        .map(|(s, _)| *s)
-        .expect("the position is reset");
-    assert!((30.0..31.0 + 0.3).contains(&reset), "reset at {reset} s");
-    let valid_again = reports
-        .iter()
-        .find(|(s, r)| *s > reset && r.validity.position.is_valid())
-        .map(|(s, _)| *s)
-        .expect("valid again");
-    assert!(valid_again < reset + 2.0, "valid again at {valid_again} s");
-    // Between the flag and the reset, never valid.
+    let (reports, nav) = at_rest_with_fixes(45.0, step, |_| Vector3::zeros());
+    let flagged = first(&reports, 20.0, |r| {
+        r.validity.position == Validity::Invalid(Reason::FixesDisagree)
+    });
+    assert!(flagged < 21.0, "flagged at {flagged} s");
     assert!(reports
         .iter()
-        .filter(|(s, _)| *s >= flagged && *s < reset)
+        .all(|(_, r)| r.event != Some(InsEvent::PositionReset)));
+    let back = first(&reports, 35.0, |r| r.validity.position.is_valid());
+    assert!(back < 36.0, "valid again at {back} s");
+    assert!(reports
+        .iter()
+        .filter(|(s, _)| (flagged..35.0).contains(s))
         .all(|(_, r)| !r.validity.position.is_valid()));
+    assert!(nav.estimate().unwrap().state.position.norm() < 1.0);
+}
+
+#[test]
+fn ins_navigator_resets_when_the_fixes_drift_away_for_good() {
+    // Fixes leave the estimate gradually (2 m/s east from 20 s, reported as standing still):
+    // not a jump, so after `gnss_reset_s` (10 s) of rejected fixes the estimate is taken for
+    // the wrong one and reset to them, then confirmed by 1 s of fused fixes.
+    let drift = |s: f64| Vector3::new(2.0 * (s - 20.0).max(0.0), 0.0, 0.0);
+    let (reports, _) = at_rest_with_fixes(50.0, drift, |_| Vector3::zeros());
+    let flagged = first(&reports, 20.0, |r| {
+        r.validity.position == Validity::Invalid(Reason::FixesDisagree)
+    });
+    let reset = first(&reports, 0.0, |r| r.event == Some(InsEvent::PositionReset));
+    assert!(
+        reset >= flagged + 9.0 && reset < flagged + 11.0,
+        "flagged {flagged} s, reset {reset} s"
+    );
+    assert!(reports
+        .iter()
+        .filter(|(s, _)| (flagged..reset).contains(s))
+        .all(|(_, r)| !r.validity.position.is_valid()));
+}
+
+/// The first time at or after `from` s when `pred` holds.
+fn first(
+    reports: &[(f64, estimator_core::nav::InsReport<f64>)],
+    from: f64,
+    pred: impl Fn(&estimator_core::nav::InsReport<f64>) -> bool,
+) -> f64 {
+    reports
+        .iter()
+        .find(|(s, r)| *s >= from && pred(r))
+        .map(|(s, _)| *s)
+        .expect("it happens")
 }
 
 #[test]

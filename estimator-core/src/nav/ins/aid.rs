@@ -20,6 +20,15 @@ pub(super) const DISAGREEING_FIXES: u16 = 3;
 /// rest a receiver's rounded output may repeat).
 const FROZEN_MIN_SPEED: f64 = 0.5;
 
+/// A first rejected fix this far outside the gate (NIS), right after fused fixes, is a jump of
+/// the receiver: the estimate cannot move that far in one fix interval. Its streak never
+/// resets the estimate; the fixes must come back to it, or the estimate's own growing
+/// uncertainty must let them through the gate.
+const JUMP_NIS: f64 = 100.0;
+
+/// "Right after": the previous fix was fused less than this before, ns.
+const JUMP_WINDOW_NS: u64 = 1_000_000_000;
+
 /// Fixes fused for this long after a reset confirm it, ns.
 const CONFIRM_NS: u64 = 1_000_000_000;
 
@@ -121,6 +130,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         match self.record(Aiding::GnssPosition, t_m, r) {
             Fused::Accepted => {
                 self.report.gnss = AidStatus::Fused;
+                self.gnss.last_fused = Some(t_m);
+                self.gnss.jump = false;
                 self.gnss.rejected = 0;
                 self.gnss.rejected_since = None;
                 let since = *self.gnss.fused_since.get_or_insert(t_f);
@@ -130,10 +141,18 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             }
             Fused::Rejected => {
                 self.report.gnss = AidStatus::Rejected;
+                if self.gnss.rejected == 0 {
+                    let nis = self.report.fused.map_or(T::zero(), |f| f.nis);
+                    let recent = self
+                        .gnss
+                        .last_fused
+                        .is_some_and(|t| t_m.saturating_sub(t) < JUMP_WINDOW_NS);
+                    self.gnss.jump = recent && nis > T::lit(JUMP_NIS);
+                }
                 self.gnss.rejected = self.gnss.rejected.saturating_add(1);
                 self.gnss.fused_since = None;
                 let since = *self.gnss.rejected_since.get_or_insert(t_m);
-                if t_m.saturating_sub(since) >= self.reset_ns {
+                if !self.gnss.jump && t_m.saturating_sub(since) >= self.reset_ns {
                     self.reset_to_fix(shifted - s.attitude.act(&lever), sigma);
                 }
             }

@@ -51,7 +51,8 @@ pub struct InsConfig<T: Real> {
 
 impl<T: Real> InsConfig<T> {
     /// Defaults around an attitude configuration: a 0.3 s horizon, no lever arm, no
-    /// barometer, ranges unknown, no stuck-axis check, reset after 10 s of rejected fixes;
+    /// barometer, ranges unknown (learned), a gyro axis stuck after 0.1 s, reset after 10 s of
+    /// rejected fixes;
     /// valid below 10 m, 1 m/s, 5° tilt, 10° heading, 0.05 °/s gyro bias, 0.05 m/s²
     /// accelerometer bias.
     #[must_use]
@@ -63,7 +64,7 @@ impl<T: Real> InsConfig<T> {
             barometer_sigma: None,
             accelerometer_range: T::zero(),
             gyro_range: T::zero(),
-            gyro_stuck_s: T::zero(),
+            gyro_stuck_s: T::lit(0.1),
             gnss_reset_s: T::lit(10.0),
             position_valid_sigma: T::lit(10.0),
             velocity_valid_sigma: T::lit(1.0),

@@ -4,22 +4,62 @@
 use super::report::InsEvent;
 use super::window::Interval;
 use super::{InsNavigator, Mode};
+use crate::kernels::mat3;
 use crate::Real;
 use nalgebra::Vector3;
 
-/// The rate error a stuck gyro axis may hide when the gyro's range is not configured, rad/s.
-const STUCK_RATE_UNKNOWN_RANGE: f64 = 1.0;
+/// The smallest rate error a stuck gyro axis is taken to hide, rad/s.
+const STUCK_RATE_FLOOR: f64 = 1.0;
 
-/// `true` when some axis of `v` is at 99.9 % of `range` or beyond (`range > 0`).
-fn at_limit<T: Real>(v: &Vector3<T>, range: T) -> bool {
-    range > T::zero() && v.iter().any(|x| x.abs() >= range * T::lit(0.999))
+/// Samples of each accelerometer axis remembered for the saturation check.
+const HISTORY: usize = 8;
+
+/// Per accelerometer axis, the magnitudes of the last [`HISTORY`] samples: a magnitude above
+/// 2 g met again exactly is a saturation level (noise and motion never repeat a large value
+/// exactly; a clipped axis does, sample after sample).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Repeats<T: Real> {
+    history: [[T; HISTORY]; 3],
+    next: usize,
+}
+
+impl<T: Real> Repeats<T> {
+    pub(super) fn new() -> Self {
+        Self {
+            history: [[T::zero(); HISTORY]; 3],
+            next: 0,
+        }
+    }
+
+    /// Takes a sample; returns the saturation level when an axis sits at one (its configured
+    /// `range`, or a repeated magnitude above `floor`).
+    fn clipped(&mut self, v: &Vector3<T>, range: T, floor: T) -> Option<T> {
+        let mut level = None;
+        let slot = self.next % HISTORY;
+        for (x, past) in v.iter().zip(self.history.iter_mut()) {
+            let a = x.abs();
+            if range > T::zero() && a >= range * T::lit(0.999) {
+                level = Some(range);
+            } else if a > floor && past.contains(&a) {
+                level = Some(a);
+            }
+            if let Some(p) = past.get_mut(slot) {
+                *p = a;
+            }
+        }
+        self.next = (slot + 1) % HISTORY;
+        level
+    }
 }
 
 impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
-    /// Checks one IMU sample for clipping (an axis at its range) and a stuck gyro axis (the
-    /// same value for `gyro_stuck_s` while another axis changes). A faulty sample widens the
-    /// filter: velocity by `σ = range_a dt` for a clipped accelerometer, attitude by
-    /// `σ = range_g dt` (tilt and heading) for a clipped or stuck gyro.
+    /// Checks one IMU sample for saturation (an accelerometer axis at its configured range, or
+    /// at a magnitude above 2 g met exactly within the last [`HISTORY`] samples; a gyro axis
+    /// at its configured range) and a stuck gyro axis (the same value for `gyro_stuck_s` while
+    /// another axis changes). A faulty sample widens the filter by what it may hide: the
+    /// velocity by `σ = a_max dt` for a saturated accelerometer (`a_max` the saturation
+    /// level), the attitude by `σ = 2 ω_max dt` (tilt and heading; `ω_max` the largest rate
+    /// seen, at least 1 rad/s) for a saturated or stuck gyro.
     pub(super) fn check_imu_faults(
         &mut self,
         t_ns: u64,
@@ -28,8 +68,17 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         interval: Option<&Interval<T>>,
     ) {
         let c = &self.config;
-        let accel_clipped = at_limit(accel, c.accelerometer_range);
-        let gyro_clipped = at_limit(gyro, c.gyro_range);
+        let two_g = mat3::norm(&c.attitude.filter.gravity) * T::lit(2.0);
+        let accel_level = self
+            .stuck
+            .accel_repeats
+            .clipped(accel, c.accelerometer_range, two_g);
+        let accel_clipped = accel_level.is_some();
+        let gyro_clipped = c.gyro_range > T::zero()
+            && gyro.iter().any(|w| w.abs() >= c.gyro_range * T::lit(0.999));
+        for (w, peak) in gyro.iter().zip(self.stuck.gyro_peak.iter_mut()) {
+            *peak = peak.max(w.abs());
+        }
         let mut stuck = false;
         if c.gyro_stuck_s > T::zero() && self.last_sample.is_some() {
             let last = self.stuck.last;
@@ -51,21 +100,27 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         }
         self.report.imu_fault = true;
         self.counters.imu_faults = self.counters.imu_faults.saturating_add(1);
+        let accel_range = accel_level.unwrap_or(c.accelerometer_range);
+        let peak = self
+            .stuck
+            .gyro_peak
+            .x
+            .max(self.stuck.gyro_peak.y)
+            .max(self.stuck.gyro_peak.z);
+        let rate = c
+            .gyro_range
+            .max(peak * T::lit(2.0))
+            .max(T::lit(STUCK_RATE_FLOOR));
         let (Mode::Running(ins), Some(interval)) = (&mut self.mode, interval) else {
             return;
         };
         let dt = interval.dt;
         let mut failed = false;
         if accel_clipped {
-            failed |= ins.widen_velocity(c.accelerometer_range * dt).is_err();
+            failed |= ins.widen_velocity(accel_range * dt).is_err();
         }
         if gyro_clipped || stuck {
-            let range = if c.gyro_range > T::zero() {
-                c.gyro_range
-            } else {
-                T::lit(STUCK_RATE_UNKNOWN_RANGE)
-            };
-            failed |= ins.widen_attitude(range * dt, range * dt).is_err();
+            failed |= ins.widen_attitude(rate * dt, rate * dt).is_err();
         }
         if failed {
             self.counters.numerical_failures = self.counters.numerical_failures.saturating_add(1);

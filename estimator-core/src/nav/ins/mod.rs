@@ -35,19 +35,25 @@
 //!
 //! * **GNSS.** A fix that repeats the previous one exactly is a frozen receiver: refused. Three
 //!   rejected fixes in a row mark the position invalid (`FixesDisagree`): either the fixes
-//!   or the estimate is wrong, and the gate alone cannot say which. Fixes rejected for
-//!   `gnss_reset_s` take the estimate for the wrong one: position and velocity are reset to
-//!   the fixes ([`Ins::reset_position`]), and the position stays invalid (`Reset`) until fixes
-//!   have been fused again for 1 s. A consistent covariance needs no reset: after an outage,
-//!   the position's own growth lets the first fix through the gate.
+//!   or the estimate is wrong, and the gate alone cannot say which. A streak that begins with
+//!   a jump (NIS above 100 right after fused fixes: the estimate cannot move that far in one
+//!   fix interval) is the receiver's: the estimate is kept until the fixes come back to it or
+//!   its own growing uncertainty lets them through. Any other streak that lasts
+//!   `gnss_reset_s` takes the estimate for the wrong one (a covariance that claimed too
+//!   much): position and velocity are reset to the fixes ([`Ins::reset_position`]), and the
+//!   position stays invalid (`Reset`) until fixes have been fused again for 1 s. A consistent
+//!   covariance needs no reset: after an outage, the position's own growth lets the first fix
+//!   through the gate.
 //! * **Magnetometer.** A sample whose norm differs from the reference by more than
 //!   `norm_tolerance` is refused (`Faulty`); one that fails the gate is rejected. The heading
 //!   is then held by the GNSS velocity and the gyro.
 //! * **Barometer.** Gated.
-//! * **IMU.** With its range configured, a sample at the range's limit is clipped: the velocity
-//!   (accelerometer) or attitude (gyro) covariance is widened by what the clipping may hide,
-//!   `σ = range · dt` per sample. A gyro axis repeating its value exactly for `gyro_stuck_s`
-//!   while the others change is stuck: the attitude is widened the same way.
+//! * **IMU.** A sample with an axis at the sensor's range (configured, or for the
+//!   accelerometer learned: a magnitude above 2 g met again exactly within 8 samples, which
+//!   noise and motion never do) is saturated; a
+//!   gyro axis repeating its value exactly for `gyro_stuck_s` while another changes is stuck.
+//!   Such a sample is still integrated (nothing else measures the motion), and the velocity
+//!   (accelerometer) or attitude (gyro) covariance is widened by what it may hide.
 //!
 //! Nothing allocates; the navigator is a plain value.
 
@@ -95,6 +101,10 @@ struct GnssTrack<T: Real> {
     /// Consecutive rejected position fixes, and the time of the first.
     rejected: u16,
     rejected_since: Option<u64>,
+    /// The time of the last fused fix.
+    last_fused: Option<u64>,
+    /// The current rejection streak began with a jump of the fixes (never reset to them).
+    jump: bool,
     /// The next velocity fix resets the velocity (after a position reset).
     reset_velocity: bool,
     /// After a reset: the time from which fixes have been fused again.
@@ -109,6 +119,8 @@ impl<T: Real> Default for GnssTrack<T> {
             frozen: false,
             rejected: 0,
             rejected_since: None,
+            last_fused: None,
+            jump: false,
             reset_velocity: false,
             unconfirmed: false,
             fused_since: None,
@@ -121,6 +133,8 @@ impl<T: Real> Default for GnssTrack<T> {
 struct StuckTrack<T: Real> {
     last: Vector3<T>,
     since: [Option<u64>; 3],
+    accel_repeats: faults::Repeats<T>,
+    gyro_peak: Vector3<T>,
 }
 
 /// The INS navigator (module docs), with an IMU ring of `H` intervals (64: a 0.3 s horizon at
@@ -268,6 +282,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             stuck: StuckTrack {
                 last: Vector3::zeros(),
                 since: [None; 3],
+                accel_repeats: faults::Repeats::new(),
+                gyro_peak: Vector3::zeros(),
             },
             report: InsReport {
                 t_ns: 0,

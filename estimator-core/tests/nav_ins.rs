@@ -75,12 +75,15 @@ fn give(nav: &mut InsNavigator<f64>, t: u64, aid: &Aid) -> Result<(), NavError> 
     }
 }
 
+/// Time (ns), position and velocity of the estimate at one IMU sample.
+type Track = Vec<(u64, Vector3<f64>, Vector3<f64>)>;
+
 /// Runs the stream with every measurement delivered at `arrival(validity time, index)`; returns
 /// the estimate's position at every IMU sample once the INS runs, and the navigator.
 fn run(
     duration_s: f64,
     deliveries: &[(u64, u64, Aid)], // (arrival, validity, aid), sorted by arrival
-) -> (Vec<(u64, Vector3<f64>, Vector3<f64>)>, InsNavigator<f64>) {
+) -> (Track, InsNavigator<f64>) {
     let mut nav = InsNavigator::<f64>::new(config()).unwrap();
     let mut out = Vec::new();
     let mut next = 0;

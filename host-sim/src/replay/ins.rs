@@ -10,7 +10,8 @@ use crate::baseline::{Madgwick, Mahony};
 use crate::dataset::read::{Dataset, Event, TruthStream};
 use crate::metrics::{Estimate, Outcome, Scorer};
 use estimator_core::nav::{
-    Aiding, GnssFix, InsConfig, InsNavigator, InsReport, MagneticFusion, NavError,
+    AidStatus, Aiding, GnssFix, InsConfig, InsEvent, InsNavigator, InsReport, MagneticFusion,
+    NavError, Reason, Validity,
 };
 use estimator_core::Real;
 use nalgebra::Matrix3;
@@ -51,6 +52,65 @@ fn estimate<T: Real, const H: usize, const Q: usize>(
         accel_bias: up3(&e.state.accel_bias),
         cov: [block(0), block(1), block(2), block(3), block(4)],
     })
+}
+
+/// The header of `validity.csv`: one row per IMU sample, what the navigator's report said.
+const VALIDITY_HEADER: &str =
+    "t_ns,tilt,heading,velocity,position,gyro_bias,accel_bias,gnss,magnetometer,barometer,imu_fault,event";
+
+fn validity_word(v: Validity) -> &'static str {
+    match v {
+        Validity::Valid => "valid",
+        Validity::Invalid(Reason::Starting) => "starting",
+        Validity::Invalid(Reason::Uncertain) => "uncertain",
+        Validity::Invalid(Reason::NoMagnetometer) => "no_magnetometer",
+        Validity::Invalid(Reason::NoFix) => "no_fix",
+        Validity::Invalid(Reason::FixesDisagree) => "fixes_disagree",
+        Validity::Invalid(Reason::Reset) => "reset",
+        Validity::Invalid(Reason::ImuFault) => "imu_fault",
+    }
+}
+
+fn status_word(s: AidStatus) -> &'static str {
+    match s {
+        AidStatus::Absent => "absent",
+        AidStatus::Waiting => "waiting",
+        AidStatus::Fused => "fused",
+        AidStatus::Stale => "stale",
+        AidStatus::Rejected => "rejected",
+        AidStatus::Faulty => "faulty",
+    }
+}
+
+fn event_word(e: Option<InsEvent>) -> &'static str {
+    match e {
+        None => "",
+        Some(InsEvent::Started) => "started",
+        Some(InsEvent::Realigned) => "realigned",
+        Some(InsEvent::PositionReset) => "position_reset",
+        Some(InsEvent::ImuFault) => "imu_fault",
+    }
+}
+
+/// One row of `validity.csv`.
+fn write_validity<T: Real>(f: &mut impl Write, r: &InsReport<T>) -> std::io::Result<()> {
+    let v = &r.validity;
+    writeln!(
+        f,
+        "{},{},{},{},{},{},{},{},{},{},{},{}",
+        r.t_ns,
+        validity_word(v.tilt),
+        validity_word(v.heading),
+        validity_word(v.velocity),
+        validity_word(v.position),
+        validity_word(v.gyro_bias),
+        validity_word(v.accel_bias),
+        status_word(r.gnss),
+        status_word(r.magnetometer),
+        status_word(r.barometer),
+        u8::from(r.imu_fault),
+        event_word(r.event),
+    )
 }
 
 /// Scores the update a call made, or a refused sample.
@@ -126,6 +186,8 @@ pub(super) fn replay_ins<T: Real>(
     let (mut tum, tum_path) = open("estimate.tum")?;
     let (mut csv, csv_path) = open("estimate.csv")?;
     super::write_csv_header(&mut csv).map_err(out_err(&csv_path))?;
+    let (mut validity, validity_path) = open("validity.csv")?;
+    writeln!(validity, "{VALIDITY_HEADER}").map_err(out_err(&validity_path))?;
     let mut truth = if ds.has_groundtruth {
         let (gt_tum, gt_path) = open("groundtruth.tum")?;
         Some(TruthCursor {
@@ -150,6 +212,9 @@ pub(super) fn replay_ins<T: Real>(
                 last_imu = Some(t_ns);
                 let r = nav.imu(t_ns, &lit3(&gyro), &lit3(&accel));
                 score(&mut scorer, &r, "imu", t_ns);
+                if let Ok(report) = &r {
+                    write_validity(&mut validity, report).map_err(out_err(&validity_path))?;
+                }
                 scorer.filter_ns += started.elapsed().as_nanos();
                 scorer.imu_samples += 1;
                 let Some(e) = estimate(&nav) else {
@@ -216,6 +281,7 @@ pub(super) fn replay_ins<T: Real>(
     }
     tum.flush().map_err(out_err(&tum_path))?;
     csv.flush().map_err(out_err(&csv_path))?;
+    validity.flush().map_err(out_err(&validity_path))?;
     if let Some(tr) = truth.as_mut() {
         tr.finish()?;
     }

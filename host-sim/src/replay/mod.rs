@@ -6,6 +6,7 @@
 //! | `estimate.csv` | the full state and the 1-σ of each error-state component, with a header |
 //! | `groundtruth.tum` | the truth in TUM format, where the dataset has it |
 //! | `metrics.json` | where the truth exists: RMSEs, NEES, NIS and update counts per sensor, time per IMU sample |
+//! | `validity.csv` | GNSS datasets: after every IMU sample, the INS navigator's validity of each quantity (or why not), each aid's status, IMU faults and events |
 //! | `*.png` | trajectory, per-axis errors inside their ±3σ bands, biases, NIS |
 //!
 //! The navigator configures itself from the dataset's `sensor.yaml` files and starts itself from

@@ -84,11 +84,12 @@ pub(super) fn write_tum(
 /// The file outputs (the plots aside). They are written as `NAME.partial` and renamed together at the
 /// end; on any error (the guard drops uncommitted) the partial files are removed, so a failed
 /// run never leaves outputs that look complete.
-pub(super) const OUTPUTS: [&str; 4] = [
+pub(super) const OUTPUTS: [&str; 5] = [
     "estimate.tum",
     "estimate.csv",
     "groundtruth.tum",
     "metrics.json",
+    "validity.csv",
 ];
 
 pub(super) struct Partials<'a> {

@@ -83,6 +83,9 @@ use buffer::{Aid, AidQueue, ImuRing, QueueError, Queued};
 use nalgebra::{Matrix3, Vector3};
 use window::{Increment, Interval};
 
+/// An aiding sensor with nothing due for this long is [`AidStatus::Stale`], ns (1 s).
+pub const AID_STALE_NS: u64 = 1_000_000_000;
+
 /// Before the first fix, the attitude navigator; then the INS.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[allow(clippy::large_enum_variant)] // one of the two is always there; they share the space
@@ -190,6 +193,8 @@ pub struct InsNavigator<T: Real, const H: usize = 64, const Q: usize = 24> {
     filter_rate: Vector3<T>,
     filter_accel: Vector3<T>,
     gnss: GnssTrack<T>,
+    /// When a measurement of each aid (GNSS, magnetometer, barometer) last came due, ns.
+    last_due: [Option<u64>; 3],
     /// The magnetometer's world reference: configured, or learned by the alignment.
     magnetic_reference: Option<Vector3<T>>,
     stuck: StuckTrack<T>,
@@ -279,6 +284,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             filter_accel: Vector3::zeros(),
             gnss: GnssTrack::default(),
             magnetic_reference: config.attitude.magnetometer.and_then(|m| m.reference),
+            last_due: [None; 3],
             stuck: StuckTrack {
                 last: Vector3::zeros(),
                 since: [None; 3],
@@ -668,6 +674,14 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         let Some(item) = self.queue.take_due(t_f) else {
             return;
         };
+        let kind = match item.aid {
+            Aid::Gnss { .. } | Aid::GnssVelocity(..) => 0,
+            Aid::Magnetometer(_) => 1,
+            Aid::Barometer(_) => 2,
+        };
+        if let Some(due) = self.last_due.get_mut(kind) {
+            *due = Some(t_f);
+        }
         // The measurement is carried over the `dt ≥ 0` between its time and the filter's.
         let dt = seconds::<T>(t_f.saturating_sub(item.t_ns));
         match &mut self.mode {

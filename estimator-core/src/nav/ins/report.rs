@@ -15,6 +15,9 @@ pub enum AidStatus {
     Waiting,
     /// The last measurement was fused.
     Fused,
+    /// No measurement has come due for [`AID_STALE_NS`](crate::nav::AID_STALE_NS) (1 s) (an outage, or a
+    /// sensor that stopped).
+    Stale,
     /// The last measurement failed the gate (an outlier, or a fault if it lasts).
     Rejected,
     /// The last measurement was refused before the gate: a GNSS fix repeating the previous

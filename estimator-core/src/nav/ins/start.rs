@@ -54,6 +54,9 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         match Ins::from_attitude_filter(filter, &carry, v, p, sigma_v, sigma_position) {
             Ok(ins) => {
                 self.mode = Mode::Running(ins);
+                // Every aid starts counted as heard from now (the magnetometer fed the
+                // alignment until now).
+                self.last_due = [self.filter_t; 3];
                 self.magnetic_reference = reference;
                 self.gnss.last_position = Some(position);
                 self.report.gnss = AidStatus::Fused;

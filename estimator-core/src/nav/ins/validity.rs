@@ -3,7 +3,8 @@
 //! policy's state.
 
 use super::aid::DISAGREEING_FIXES;
-use super::{InsNavigator, Mode, INVALID_START};
+use super::report::AidStatus;
+use super::{InsNavigator, Mode, AID_STALE_NS, INVALID_START};
 use crate::kernels::block::block;
 use crate::kernels::mat3;
 use crate::nav::attitude::{Reason, Validity};
@@ -25,7 +26,27 @@ fn largest<T: Real>(m: &Matrix3<T>) -> T {
 }
 
 impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
+    /// Marks an aid whose last measurement came due more than [`AID_STALE_NS`] before the
+    /// filter's time as stale.
+    fn refresh_staleness(&mut self) {
+        let (Some(t_f), Mode::Running(_)) = (self.filter_t, &self.mode) else {
+            return;
+        };
+        let statuses = [
+            &mut self.report.gnss,
+            &mut self.report.magnetometer,
+            &mut self.report.barometer,
+        ];
+        for (status, due) in statuses.into_iter().zip(self.last_due) {
+            let quiet = due.is_none_or(|d| t_f.saturating_sub(d) > AID_STALE_NS);
+            if quiet && !matches!(status, AidStatus::Absent | AidStatus::Waiting) {
+                *status = AidStatus::Stale;
+            }
+        }
+    }
+
     pub(super) fn refresh_validity(&mut self) {
+        self.refresh_staleness();
         let c = &self.config;
         let v = &mut self.report.validity;
         match &self.mode {

@@ -12,7 +12,7 @@
 //! The filter runs `horizon_s` behind the newest IMU sample. IMU intervals wait in a ring of
 //! `H` entries, measurements in a queue of `Q`; each IMU call integrates the oldest interval
 //! into the filter (one prediction), then fuses at most one measurement whose time the filter
-//! has reached, in time order. An output predictor ([`window`]) carries the filter's state to
+//! has reached, in time order. An output predictor (`nav/ins/window.rs`) carries the filter's state to
 //! the newest sample in O(1) per sample, so the estimate is always the present one. A
 //! measurement stamped anywhere inside the horizon is fused at its own time (up to one IMU
 //! interval later, its value carried over that step by the estimated rate), and the order in
@@ -159,7 +159,7 @@ struct StuckTrack<T: Real> {
 ///     if k % 4 == 0 {
 ///         nav.magnetometer(t, &field).unwrap();
 ///     }
-///     if k % 40 == 0 && k >= 40 {
+///     if k % 40 == 0 && k >= 80 {
 ///         let fix = GnssFix::new(Vector3::new(10.0, 5.0, 2.0), Some(Vector3::zeros()), 1.0, 0.1);
 ///         nav.gnss(t - 200_000_000, &fix).unwrap();
 ///     }
@@ -180,7 +180,7 @@ pub struct InsNavigator<T: Real, const H: usize = 64, const Q: usize = 24> {
     ring: ImuRing<T, H>,
     queue: AidQueue<T, Q>,
     /// The output predictor's increments over `ring`, and over its last `ring.len() −
-    /// fresh_lag` intervals ([`window`]).
+    /// fresh_lag` intervals (the output predictor, `nav/ins/window.rs`).
     window: Increment<T>,
     fresh: Increment<T>,
     fresh_lag: usize,
@@ -352,7 +352,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
 
     /// The estimate at the newest IMU sample, once the INS runs: the filter's state carried by
     /// the output predictor (`R = R_f ΔR`, `v = v_f + g T + R_f Δv`,
-    /// `p = p_f + v_f T + ½ g T² + R_f Δp`, [`window`]) and its covariance carried to first
+    /// `p = p_f + v_f T + ½ g T² + R_f Δp`, `nav/ins/window.rs`) and its covariance carried to first
     /// order, `δθ = ΔRᵀ δθ_f`, `δv = δv_f − R_f[Δv]× δθ_f`,
     /// `δp = δp_f + T δv_f − R_f[Δp]× δθ_f`, plus the white noise over `T`
     /// (`σ_g² T`, `σ_a² T`, `σ_a² T³/3`); the bias blocks are the filter's.

@@ -56,6 +56,6 @@ pub use attitude::{
 pub use error::NavError;
 pub use ins::{
     AidStatus, Aiding, GnssFix, InsConfig, InsCounters, InsEstimate, InsEvent, InsFusion,
-    InsNavigator, InsReport, InsValidity, AID_STALE_NS,
+    InsNavigator, InsReport, InsValidity, AID_STALE_INTERVALS, AID_STALE_NS,
 };
 pub use mean::VectorMean;

@@ -83,8 +83,14 @@ use buffer::{Aid, AidQueue, ImuRing, QueueError, Queued};
 use nalgebra::{Matrix3, Vector3};
 use window::{Increment, Interval};
 
-/// An aiding sensor with nothing due for this long is [`AidStatus::Stale`], ns (1 s).
+/// An aiding sensor with nothing due for 2.5 of its own last intervals between measurements
+/// ([`AID_STALE_INTERVALS`]) is [`AidStatus::Stale`]; before an interval is known, for this
+/// long, ns (1 s).
 pub const AID_STALE_NS: u64 = 1_000_000_000;
+
+/// Twice the number of an aid's measurement intervals without a measurement that make it
+/// stale (5: 2.5 intervals, two missed measurements with room for jitter).
+pub const AID_STALE_INTERVALS: u64 = 5;
 
 /// Before the first fix, the attitude navigator; then the INS.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -195,6 +201,10 @@ pub struct InsNavigator<T: Real, const H: usize = 64, const Q: usize = 24> {
     gnss: GnssTrack<T>,
     /// When a measurement of each aid (GNSS, magnetometer, barometer) last came due, ns.
     last_due: [Option<u64>; 3],
+    /// The time of the last measurement of each, and the last nonzero interval between two
+    /// of them, ns.
+    last_measured: [Option<u64>; 3],
+    aid_interval: [Option<u64>; 3],
     /// The magnetometer's world reference: configured, or learned by the alignment.
     magnetic_reference: Option<Vector3<T>>,
     stuck: StuckTrack<T>,
@@ -285,6 +295,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             gnss: GnssTrack::default(),
             magnetic_reference: config.attitude.magnetometer.and_then(|m| m.reference),
             last_due: [None; 3],
+            last_measured: [None; 3],
+            aid_interval: [None; 3],
             stuck: StuckTrack {
                 last: Vector3::zeros(),
                 since: [None; 3],
@@ -679,7 +691,17 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             Aid::Magnetometer(_) => 1,
             Aid::Barometer(_) => 2,
         };
-        if let Some(due) = self.last_due.get_mut(kind) {
+        if let (Some(due), Some(last), Some(interval)) = (
+            self.last_due.get_mut(kind),
+            self.last_measured.get_mut(kind),
+            self.aid_interval.get_mut(kind),
+        ) {
+            // The interval between the measurements' own times (a GNSS velocity shares its
+            // position's time: an interval of zero is no interval).
+            if let Some(gap) = last.map(|l| item.t_ns.saturating_sub(l)).filter(|g| *g > 0) {
+                *interval = Some(gap);
+            }
+            *last = Some(item.t_ns);
             *due = Some(t_f);
         }
         // The measurement is carried over the `dt ≥ 0` between its time and the filter's.

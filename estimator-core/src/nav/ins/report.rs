@@ -15,8 +15,9 @@ pub enum AidStatus {
     Waiting,
     /// The last measurement was fused.
     Fused,
-    /// No measurement has come due for [`AID_STALE_NS`](crate::nav::AID_STALE_NS) (1 s) (an outage, or a
-    /// sensor that stopped).
+    /// No measurement has come due for 2.5 of the sensor's own measurement intervals (an
+    /// outage, or a sensor that stopped; [`AID_STALE_NS`](crate::nav::AID_STALE_NS) before an
+    /// interval is known).
     Stale,
     /// The last measurement failed the gate (an outlier, or a fault if it lasts).
     Rejected,

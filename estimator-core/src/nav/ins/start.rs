@@ -84,6 +84,9 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         self.last_sample = None;
         self.gnss = super::GnssTrack::default();
         self.stuck.since = [None; 3];
+        self.last_due = [None; 3];
+        self.last_measured = [None; 3];
+        self.aid_interval = [None; 3];
         self.report.validity = INVALID_START;
     }
 }

@@ -4,7 +4,7 @@
 
 use super::aid::DISAGREEING_FIXES;
 use super::report::AidStatus;
-use super::{InsNavigator, Mode, AID_STALE_NS, INVALID_START};
+use super::{InsNavigator, Mode, AID_STALE_INTERVALS, AID_STALE_NS, INVALID_START};
 use crate::kernels::block::block;
 use crate::kernels::mat3;
 use crate::nav::attitude::{Reason, Validity};
@@ -26,8 +26,8 @@ fn largest<T: Real>(m: &Matrix3<T>) -> T {
 }
 
 impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
-    /// Marks an aid whose last measurement came due more than [`AID_STALE_NS`] before the
-    /// filter's time as stale.
+    /// Marks an aid as stale when its last measurement came due more than 2.5 of its own
+    /// measurement intervals before the filter's time ([`AID_STALE_NS`] before one is known).
     fn refresh_staleness(&mut self) {
         let (Some(t_f), Mode::Running(_)) = (self.filter_t, &self.mode) else {
             return;
@@ -37,8 +37,14 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             &mut self.report.magnetometer,
             &mut self.report.barometer,
         ];
-        for (status, due) in statuses.into_iter().zip(self.last_due) {
-            let quiet = due.is_none_or(|d| t_f.saturating_sub(d) > AID_STALE_NS);
+        for ((status, due), interval) in statuses
+            .into_iter()
+            .zip(self.last_due)
+            .zip(self.aid_interval)
+        {
+            let limit =
+                interval.map_or(AID_STALE_NS, |i| i.saturating_mul(AID_STALE_INTERVALS) / 2);
+            let quiet = due.is_none_or(|d| t_f.saturating_sub(d) > limit);
             if quiet && !matches!(status, AidStatus::Absent | AidStatus::Waiting) {
                 *status = AidStatus::Stale;
             }

@@ -1,4 +1,4 @@
-//! A firmware-style main loop on the host: the attitude navigator and the 15-state filter fed
+//! A firmware-style main loop on the host: the attitude navigator and the INS navigator fed
 //! one timestamped sample at a time, every outcome handled, the estimate printed once a second.
 //!
 //! The sensors are a stand-in (a body turning slowly about the vertical at rest on a turntable,
@@ -9,25 +9,27 @@
 //! * [`AttitudeNavigator`]: attitude and gyro bias from gyro, accelerometer and magnetometer.
 //!   It starts itself (the first second of samples), chooses what to fuse, detects rest and
 //!   magnetic disturbances, and says after every call which parts of its estimate are valid.
-//! * [`Ins`]: the 15-state inertial filter (attitude, velocity, position, both IMU biases). It
-//!   is a filter, not a navigator: the loop predicts with every IMU sample and updates with
-//!   every GNSS fix, and handles the outcomes itself (the INS navigator will own this policy).
+//! * [`InsNavigator`]: position, velocity, attitude and both IMU biases from the IMU, GNSS and
+//!   the magnetometer. It aligns until the first fix, fuses every measurement at the time it
+//!   was valid (a fix delivered 0.2 s late is stamped with its own time), handles frozen,
+//!   jumping and drifting fixes, and reports each quantity's validity after every call. A
+//!   device with GNSS needs only this one; the attitude navigator is shown for one without.
 //!
 //! Tuning: the noise densities come from the sensor (`host-sim calibrate` measures them from a
 //! static recording); the navigator's other parameters are explained in the `nav` module docs.
 
-use estimator_core::eskf::{
-    Alignment, FilterConfig, GnssPosition, ImuNoise, ImuSample, InitialSigmas, Ins, UpdateOptions,
-    UpdateOutcome,
-};
+use estimator_core::eskf::{FilterConfig, ImuNoise};
 use estimator_core::lie::{LieGroup, So3};
-use estimator_core::nav::{AttitudeConfig, AttitudeNavigator, MagneticConfig, NavError};
+use estimator_core::nav::{
+    AttitudeConfig, AttitudeNavigator, GnssFix, InsConfig, InsNavigator, MagneticConfig, NavError,
+};
 use nalgebra::Vector3;
 
 const IMU_HZ: u64 = 200;
 const MAG_EVERY: u64 = 4; // 50 Hz
 const GNSS_EVERY: u64 = 40; // 5 Hz
 const FIELD: [f32; 3] = [0.0, 20.0, -45.0]; // µT, ENU: north and down
+const GNSS_LATENCY_NS: u64 = 200_000_000; // a fix arrives 0.2 s after the time it describes
 
 /// One reading of every sensor at sample `k` (the stand-in for the drivers).
 struct Sensors {
@@ -85,10 +87,12 @@ fn main() {
         Err(e) => return eprintln!("configuration refused: {e}"),
     };
 
-    // The 15-state filter, started once the navigator has an attitude and a GNSS fix exists.
-    let mut ins: Option<Ins<f32>> = None;
-    let options = UpdateOptions::default();
-    let mut last_t: Option<u64> = None;
+    // The INS navigator: the same attitude configuration (it aligns with it until the first
+    // fix), a 0.3 s horizon for late measurements.
+    let mut ins: InsNavigator<f32> = match InsNavigator::new(InsConfig::new(config)) {
+        Ok(n) => n,
+        Err(e) => return eprintln!("configuration refused: {e}"),
+    };
 
     for k in 0..20 * IMU_HZ {
         let s = read_sensors(k);
@@ -102,48 +106,31 @@ fn main() {
             Err(NavError::TimeNotIncreasing) => eprintln!("IMU sample out of order, dropped"),
             Err(e) => eprintln!("IMU sample refused: {e}"),
         }
+        match ins.imu(s.t_ns, &s.gyro, &s.accel) {
+            Ok(report) => {
+                if let Some(event) = report.event {
+                    println!("{:6.2} s  INS: {event:?}", k as f32 / IMU_HZ as f32);
+                }
+            }
+            Err(e) => eprintln!("INS: IMU sample refused: {e}"),
+        }
         if let Some(m) = s.mag {
             if let Err(e) = nav.magnetometer(s.t_ns, &m) {
                 eprintln!("magnetometer sample refused: {e}");
             }
-        }
-
-        // The INS: predict with every IMU interval, update with every fix.
-        if let (Some(f), Some(t0)) = (ins.as_mut(), last_t) {
-            let dt = (s.t_ns - t0) as f32 * 1e-9;
-            if let Err(e) = f.predict(&ImuSample {
-                gyro: s.gyro,
-                accel: s.accel,
-                dt,
-            }) {
-                eprintln!("INS prediction refused: {e}");
+            if let Err(e) = ins.magnetometer(s.t_ns, &m) {
+                eprintln!("INS: magnetometer sample refused: {e}");
             }
         }
-        last_t = Some(s.t_ns);
+        // A fix read now describes the time `GNSS_LATENCY_NS` ago: stamp it with that time.
         if let Some(p) = s.gnss {
-            match ins.as_mut() {
-                Some(f) => match f.update(&GnssPosition::new(p, Vector3::zeros(), 1.0), &options) {
-                    Ok(UpdateOutcome::Accepted { .. }) => {}
-                    Ok(UpdateOutcome::Rejected { nis, .. }) => {
-                        eprintln!("GNSS fix gated out (NIS {nis:.1})");
-                    }
-                    Err(e) => eprintln!("GNSS fix refused: {e}"),
-                },
-                // Start the INS from the navigator's attitude and bias and the first fix.
-                None => {
-                    if let (Some(e), true) = (nav.estimate(), nav.report().tilt.is_valid()) {
-                        let alignment = Alignment {
-                            attitude: e.attitude,
-                            gyro_bias: e.gyro_bias,
-                            heading_from_magnetometer: nav.report().heading.is_valid(),
-                        };
-                        match Ins::from_alignment(&alignment, p, &InitialSigmas::default(), filter)
-                        {
-                            Ok(f) => ins = Some(f),
-                            Err(e) => eprintln!("INS start refused: {e}"),
-                        }
-                    }
-                }
+            let fix = GnssFix::new(p, Some(Vector3::zeros()), 1.0, 0.1);
+            match ins.gnss(s.t_ns.saturating_sub(GNSS_LATENCY_NS), &fix) {
+                Ok(_) => {}
+                // Older than the horizon (the first fix, before the filter's start) or a
+                // duplicate: nothing to do but log it.
+                Err(NavError::TooOld) => eprintln!("GNSS fix older than the horizon, dropped"),
+                Err(e) => eprintln!("GNSS fix refused: {e}"),
             }
         }
 
@@ -163,18 +150,26 @@ fn main() {
                     r.at_rest
                 );
             }
-            if let Some(f) = &ins {
-                let x = f.state();
+            if let Some(e) = ins.estimate() {
+                let (x, v) = (e.state.position, ins.report().validity);
                 println!(
-                    "          INS position {:6.2} {:6.2} {:6.2} m, velocity {:5.2} m/s",
-                    x.position.x,
-                    x.position.y,
-                    x.position.z,
-                    x.velocity.norm()
+                    "          INS position {:6.2} {:6.2} {:6.2} m ({:?}), velocity {:5.2} m/s ({:?}), GNSS {:?}",
+                    x.x,
+                    x.y,
+                    x.z,
+                    v.position,
+                    e.state.velocity.norm(),
+                    v.velocity,
+                    ins.report().gnss
                 );
             }
         }
     }
+    let c = ins.counters();
+    println!(
+        "INS: {} IMU samples, {} GNSS positions fused, {} gated out, {} magnetometer updates, {} refused",
+        c.imu, c.gnss_position_fused, c.gnss_position_rejected, c.magnetometer_fused, c.refused
+    );
     let c = nav.counters();
     println!(
         "navigator: {} IMU and {} magnetometer samples, {} refused, {} zero-rate updates, {} accelerometer and {} heading blocks fused",

@@ -63,6 +63,9 @@ pub struct Estimate {
     pub accel_bias: Vector3<f64>,
     /// Covariance blocks in [`BLOCKS`] order; `None` for blocks the filter does not estimate.
     pub cov: [Option<Matrix3<f64>>; 5],
+    /// Whether the navigator reported each block valid (attitude: tilt and heading), in
+    /// [`BLOCKS`] order; `None` when it reports no such thing.
+    pub valid: Option<[bool; 5]>,
 }
 
 impl Estimate {
@@ -110,6 +113,8 @@ pub struct HistoryPoint {
     pub est_bias: [f64; 6],
     /// True gyro then accelerometer bias.
     pub true_bias: [f64; 6],
+    /// The navigator's validity of each block, when it reports one.
+    pub valid: Option<[bool; 5]>,
 }
 
 /// A bounded history: when full, every other point is dropped and the stride doubles, so memory
@@ -239,6 +244,8 @@ pub struct Scorer {
     pairs: Vec<PosePair>,
     /// Whether a scored estimate had a position (a position covariance block).
     positions: bool,
+    /// The dataset's fault intervals (`faults.csv`), for the plots.
+    pub faults: Vec<crate::dataset::read::FaultInterval>,
     /// Whether the dataset has a heading reference; `None` until [`Scorer::note_run`].
     heading_reference: Option<bool>,
     /// Where the run comes from (copied to `metrics.json`).
@@ -377,6 +384,7 @@ impl Scorer {
         if self.truth_start_ns.is_none() {
             self.truth_start_ns = crate::dataset::read::first_truth_ns(dir)?;
         }
+        self.faults = crate::dataset::read::read_faults(dir)?;
         Ok(self)
     }
 
@@ -390,6 +398,12 @@ impl Scorer {
             self.provenance.dataset = Some(ds.dir.display().to_string());
         }
         self.provenance.precision = Some(precision.to_string());
+    }
+
+    /// The time all history points are counted from, ns.
+    #[must_use]
+    pub fn t0_ns(&self) -> Option<u64> {
+        self.t0_ns
     }
 
     /// The scored (estimate, truth) pose pairs, in time order.
@@ -452,6 +466,7 @@ impl Scorer {
             sigma: e.sigmas(),
             est_bias: six(eb),
             true_bias: six(tb),
+            valid: e.valid,
         });
     }
 
@@ -645,6 +660,7 @@ mod tests {
             gyro_bias: Vector3::zeros(),
             accel_bias: Vector3::zeros(),
             cov: [Some(Matrix3::identity()), None, None, None, None],
+            valid: None,
         }
     }
 

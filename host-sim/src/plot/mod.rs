@@ -89,7 +89,14 @@ pub fn write_all(
         written.push(f);
     }
     let f = dir.join("errors.png");
-    errors(&f, pts, title)?;
+    let t0 = scorer.t0_ns().unwrap_or(0);
+    let seconds = |ns: u64| (ns as f64 - t0 as f64) * 1e-9;
+    let faults: Vec<(f64, f64)> = scorer
+        .faults
+        .iter()
+        .map(|f| (seconds(f.start_ns), seconds(f.end_ns)))
+        .collect();
+    errors(&f, pts, &faults, title)?;
     written.push(f);
     let f = dir.join("biases.png");
     biases(&f, pts, title)?;
@@ -370,7 +377,30 @@ fn draw_tracks(chart: &mut Chart<'_, '_>, tracks: &[Vec<(f64, f64)>; 2]) -> Plot
     Ok(())
 }
 
-fn errors(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
+/// The spans `[t_a, t_b]` of consecutive points where block `b` was reported not valid.
+fn invalid_spans(pts: &[HistoryPoint], b: usize) -> Vec<(f64, f64)> {
+    let mut spans: Vec<(f64, f64)> = Vec::new();
+    let mut open: Option<f64> = None;
+    for p in pts {
+        let invalid = p.valid.is_some_and(|v| !v.get(b).copied().unwrap_or(true));
+        match (invalid, open) {
+            (true, None) => open = Some(p.t),
+            (false, Some(a)) => {
+                spans.push((a, p.t));
+                open = None;
+            }
+            _ => {}
+        }
+    }
+    if let (Some(a), Some(last)) = (open, pts.last()) {
+        spans.push((a, last.t));
+    }
+    spans
+}
+
+/// Per-axis errors inside their ±3σ bands; the dataset's fault intervals (`faults`, s) shaded,
+/// and the spans the navigator reported a block not valid marked along the bottom.
+fn errors(path: &Path, pts: &[HistoryPoint], faults: &[(f64, f64)], title: &str) -> PlotResult {
     let blocks: Vec<usize> = (0..5)
         .filter(|b| pts.iter().any(|p| p.sigma[3 * b].is_finite()))
         .collect();
@@ -384,13 +414,22 @@ fn errors(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
     )?;
     let (strip, body) = body.split_vertically(40);
     let band = BLACK.mix(0.15).filled();
-    legend_row(
-        &strip,
-        &[
-            Entry::new(Mark::Line(ESTIMATE.into()), "error"),
-            Entry::new(Mark::Band(band), "±3σ"),
-        ],
-    )?;
+    let fault_fill = RED.mix(0.12).filled();
+    let invalid_fill = RGBColor(230, 140, 0).mix(0.8).filled();
+    let mut entries = vec![
+        Entry::new(Mark::Line(ESTIMATE.into()), "error"),
+        Entry::new(Mark::Band(band), "±3σ"),
+    ];
+    if !faults.is_empty() {
+        entries.push(Entry::new(
+            Mark::Band(fault_fill),
+            "sensor fault (faults.csv)",
+        ));
+    }
+    if pts.iter().any(|p| p.valid.is_some()) {
+        entries.push(Entry::new(Mark::Band(invalid_fill), "reported not valid"));
+    }
+    legend_row(&strip, &entries)?;
     let cells = body.split_evenly((blocks.len(), 3));
     let units = ["deg", "m/s", "m", "deg/s", "m/s²"];
     let scale = [57.295_779_5, 1.0, 1.0, 57.295_779_5, 1.0];
@@ -433,6 +472,16 @@ fn errors(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
             let mut band_pts = upper.clone();
             band_pts.extend(upper.iter().rev().map(|(t, v)| (*t, -v)));
             chart.draw_series(std::iter::once(Polygon::new(band_pts, band)))?;
+            chart.draw_series(
+                faults
+                    .iter()
+                    .map(|(a, b)| Rectangle::new([(*a, -lim), (*b, lim)], fault_fill)),
+            )?;
+            chart.draw_series(
+                invalid_spans(pts, b)
+                    .into_iter()
+                    .map(|(a, z)| Rectangle::new([(a, -lim), (z, -0.9 * lim)], invalid_fill)),
+            )?;
             chart.draw_series(LineSeries::new(
                 pts.iter().map(|p| (p.t, (p.error[i] * k).clamp(-lim, lim))),
                 ESTIMATE,
@@ -696,6 +745,7 @@ mod tests {
                 } else {
                     [cov, None, None, cov, cov]
                 },
+                valid: None,
             };
             s.add(&est, &truth);
             let nis = match k % 40 {

@@ -66,6 +66,7 @@ fn estimate<T: Real>(nav: &AttitudeNavigator<T>, t_ns: u64) -> Option<Estimate> 
         gyro_bias: up3(&s.gyro_bias),
         accel_bias: up3(&s.accel_bias),
         cov: [Some(block(0)), None, None, Some(block(1)), Some(block(2))],
+        valid: None,
     })
 }
 

@@ -41,6 +41,7 @@ fn estimate<T: Real, const H: usize, const Q: usize>(
     nav: &InsNavigator<T, H, Q>,
 ) -> Option<Estimate> {
     let e = nav.estimate()?;
+    let v = nav.report().validity;
     let block =
         |b: usize| -> Option<Matrix3<f64>> { e.covariance.get(b).map(|m| m.map(|x| x.to_f64())) };
     Some(Estimate {
@@ -51,6 +52,13 @@ fn estimate<T: Real, const H: usize, const Q: usize>(
         gyro_bias: up3(&e.state.gyro_bias),
         accel_bias: up3(&e.state.accel_bias),
         cov: [block(0), block(1), block(2), block(3), block(4)],
+        valid: Some([
+            v.tilt.is_valid() && v.heading.is_valid(),
+            v.velocity.is_valid(),
+            v.position.is_valid(),
+            v.gyro_bias.is_valid(),
+            v.accel_bias.is_valid(),
+        ]),
     })
 }
 

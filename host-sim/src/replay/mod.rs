@@ -262,6 +262,7 @@ impl<T: Real> Filter<T> {
                 Some(block(p, 3)),
                 Some(block(p, 4)),
             ],
+            valid: None,
         }
     }
 

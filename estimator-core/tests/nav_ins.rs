@@ -4,7 +4,7 @@
 
 use estimator_core::eskf::FilterConfig;
 use estimator_core::nav::{
-    AidStatus, AttitudeConfig, GnssFix, InsConfig, InsEvent, InsNavigator, MagneticConfig,
+    AidStatus, Aiding, AttitudeConfig, GnssFix, InsConfig, InsEvent, InsNavigator, MagneticConfig,
     NavError, Reason, Validity,
 };
 use nalgebra::Vector3;
@@ -448,4 +448,135 @@ fn ins_navigator_refuses_a_frozen_receiver() {
     // Dead reckoning on a noise-free IMU: still on the truth.
     let truth_now = truth(seconds(nav.report().t_ns)).0;
     assert!((e.state.position - truth_now).norm() < 1.0);
+}
+
+/// At rest with a barometer; `mutate(k, t, gyro, accel, field, baro, gnss?)` alters the stream.
+/// Returns every report and the navigator.
+#[allow(clippy::type_complexity)]
+fn at_rest_stream(
+    duration_s: f64,
+    mutate: impl Fn(f64, &mut Vector3<f64>, &mut Vector3<f64>, &mut Vector3<f64>, &mut f64, &mut bool),
+) -> (
+    Vec<(f64, estimator_core::nav::InsReport<f64>)>,
+    InsNavigator<f64>,
+) {
+    let mut c = config();
+    c.barometer_sigma = Some(0.5);
+    let mut nav = InsNavigator::<f64>::new(c).unwrap();
+    let mut reports = Vec::new();
+    for k in 0..(duration_s * 200.0) as u64 {
+        let t = T0 + k * IMU_NS;
+        let s = seconds(t);
+        // A little deterministic noise: a real sensor never repeats its values exactly.
+        let wobble = |i: u64| ((k * 7 + i * 13) % 17) as f64 * 1e-4;
+        let mut gyro = Vector3::new(wobble(1), wobble(2), wobble(3));
+        let mut accel = Vector3::new(wobble(4), wobble(5), 9.81 + wobble(6));
+        let mut field = Vector3::from(FIELD);
+        let mut baro = 0.0;
+        let mut gnss = true;
+        mutate(s, &mut gyro, &mut accel, &mut field, &mut baro, &mut gnss);
+        if k % 4 == 0 {
+            nav.magnetometer(t, &field).unwrap();
+        }
+        if k % 8 == 0 {
+            nav.barometer(t, baro).unwrap();
+        }
+        if k % 40 == 20 && k > 200 && gnss {
+            nav.gnss(
+                t,
+                &GnssFix::new(Vector3::zeros(), Some(Vector3::zeros()), 0.5, 0.05),
+            )
+            .unwrap();
+        }
+        reports.push((s, nav.imu(t, &gyro, &accel).unwrap()));
+    }
+    (reports, nav)
+}
+
+#[test]
+fn ins_navigator_rejects_a_rotated_magnetometer_and_takes_it_back() {
+    // The field read rotated by 90° about the body's z for 20 s: rejected (never fused) while
+    // it lasts, fused again within 1 s after; the heading holds.
+    let (reports, nav) = at_rest_stream(40.0, |s, _, _, field, _, _| {
+        if (15.0..35.0).contains(&s) {
+            *field = Vector3::new(-field.y, field.x, field.z);
+        }
+    });
+    let detected = first(&reports, 15.0, |r| {
+        matches!(r.magnetometer, AidStatus::Rejected | AidStatus::Faulty)
+    });
+    assert!(detected < 16.0, "detected at {detected} s");
+    assert!(reports
+        .iter()
+        .filter(|(s, _)| (15.5..35.0).contains(s))
+        .all(|(_, r)| r
+            .fused
+            .is_none_or(|f| !(f.accepted && f.aid == Aiding::Magnetometer))));
+    let back = first(&reports, 35.0, |r| r.magnetometer == AidStatus::Fused);
+    assert!(back < 36.0, "fused again at {back} s");
+    let (_, _, yaw) = nav
+        .estimate()
+        .unwrap()
+        .state
+        .attitude
+        .quaternion()
+        .euler_angles();
+    assert!(yaw.abs().to_degrees() < 2.0, "yaw {} °", yaw.to_degrees());
+}
+
+#[test]
+fn ins_navigator_rejects_a_barometer_step() {
+    // The barometer reads 20 m high for 15 s: rejected, the height held by GNSS.
+    let (reports, nav) = at_rest_stream(40.0, |s, _, _, _, baro, _| {
+        if (15.0..30.0).contains(&s) {
+            *baro = 20.0;
+        }
+    });
+    let detected = first(&reports, 15.0, |r| r.barometer == AidStatus::Rejected);
+    assert!(detected < 16.0, "detected at {detected} s");
+    let back = first(&reports, 30.0, |r| r.barometer == AidStatus::Fused);
+    assert!(back < 31.0, "fused again at {back} s");
+    assert!(nav.estimate().unwrap().state.position.z.abs() < 1.0);
+}
+
+#[test]
+fn ins_navigator_sees_a_gnss_outage_and_takes_fixes_back() {
+    // No fixes for 60 s: GNSS stale within 1 s; the first fix after is fused and the position
+    // valid again.
+    let (reports, _) = at_rest_stream(100.0, |s, _, _, _, _, gnss| {
+        *gnss = !(20.0..80.0).contains(&s);
+    });
+    let stale = first(&reports, 20.0, |r| r.gnss == AidStatus::Stale);
+    assert!(stale < 21.0, "stale at {stale} s");
+    let back = first(&reports, 80.0, |r| r.gnss == AidStatus::Fused);
+    assert!(back < 81.0, "fused again at {back} s");
+    let valid = first(&reports, 80.0, |r| r.validity.position.is_valid());
+    assert!(valid < 81.0, "valid again at {valid} s");
+}
+
+#[test]
+fn ins_navigator_widens_for_a_clipped_accelerometer_and_a_stuck_gyro() {
+    // Vertical accelerometer clipped at 2.5 g under a 3 g vibration for 2 s, then the z gyro
+    // stuck for 2 s: each flagged as an IMU fault within 0.1 s, and the velocity (clip) and
+    // attitude (stuck) covariance widened.
+    let (reports, _) = at_rest_stream(40.0, |s, gyro, accel, _, _, _| {
+        if (15.0..17.0).contains(&s) {
+            let vib = 3.0 * 9.81 * (2.0 * std::f64::consts::PI * 25.0 * s).sin();
+            accel.z = (accel.z + vib).clamp(-2.5 * 9.81, 2.5 * 9.81);
+        }
+        if (25.0..27.0).contains(&s) {
+            gyro.z = 0.01;
+        }
+    });
+    let clip = first(&reports, 15.0, |r| r.imu_fault);
+    assert!(clip < 15.1, "clip seen at {clip} s");
+    let stuck = first(&reports, 25.0, |r| r.imu_fault);
+    assert!(stuck < 25.2, "stuck axis seen at {stuck} s");
+    assert!(reports
+        .iter()
+        .filter(|(s, _)| (18.0..25.0).contains(s))
+        .all(|(_, r)| !r.imu_fault));
+    assert!(reports
+        .iter()
+        .any(|(s, r)| (15.0..17.0).contains(s) && r.event == Some(InsEvent::ImuFault)));
 }

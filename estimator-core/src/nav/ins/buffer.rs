@@ -78,15 +78,10 @@ impl<T: Real, const H: usize> ImuRing<T, H> {
 /// A measurement waiting for the filter to reach its time.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Aid<T: Real> {
-    /// A GNSS fix: antenna position and (optionally) velocity, world frame, with 1σ.
-    Gnss {
-        position: Vector3<T>,
-        velocity: Option<Vector3<T>>,
-        sigma_position: T,
-        sigma_velocity: T,
-    },
-    /// A GNSS velocity, world frame, with its 1σ: the second half of a fix, fused in the call
-    /// after its position.
+    /// A GNSS antenna position, world frame, with its 1σ.
+    Gnss(Vector3<T>, T),
+    /// A GNSS antenna velocity, world frame, with its 1σ: the second half of a fix, stamped
+    /// like its position and fused after it (in the next call: one update per call).
     GnssVelocity(Vector3<T>, T),
     /// A magnetometer sample, body frame.
     Magnetometer(Vector3<T>),
@@ -99,7 +94,7 @@ impl<T: Real> Aid<T> {
     /// whatever the order of arrival).
     fn rank(&self) -> u8 {
         match self {
-            Self::Gnss { .. } => 0,
+            Self::Gnss(..) => 0,
             Self::GnssVelocity(..) => 1,
             Self::Magnetometer(_) => 2,
             Self::Barometer(_) => 3,
@@ -159,6 +154,22 @@ impl<T: Real, const Q: usize> AidQueue<T, Q> {
                 Ok(())
             }
             None => Err(QueueError::Full),
+        }
+    }
+
+    /// The number of free places.
+    pub(crate) fn free(&self) -> usize {
+        self.items.iter().filter(|q| q.is_none()).count()
+    }
+
+    /// Removes and returns the GNSS velocity stamped `t_ns`, if one is waiting.
+    pub(crate) fn take_velocity_at(&mut self, t_ns: u64) -> Option<(Vector3<T>, T)> {
+        let slot = self.items.iter_mut().find(|q| {
+            q.is_some_and(|q| q.t_ns == t_ns && matches!(q.aid, Aid::GnssVelocity(..)))
+        })?;
+        match slot.take()?.aid {
+            Aid::GnssVelocity(v, sigma) => Some((v, sigma)),
+            _ => None,
         }
     }
 

@@ -147,7 +147,8 @@ struct StuckTrack<T: Real> {
 }
 
 /// The INS navigator (module docs), with an IMU ring of `H` intervals (64: a 0.3 s horizon at
-/// 200 Hz with room) and a measurement queue of `Q` (24).
+/// 200 Hz with room) and a measurement queue of `Q` (40: over a 0.3 s horizon, a magnetometer
+/// at 50 Hz, a barometer at 25 Hz and GNSS position and velocity at 5 Hz keep 26 waiting).
 ///
 /// ```
 /// use estimator_core::eskf::FilterConfig;
@@ -176,7 +177,7 @@ struct StuckTrack<T: Real> {
 /// assert!((estimate.state.position - Vector3::new(10.0, 5.0, 2.0)).norm() < 1.0);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct InsNavigator<T: Real, const H: usize = 64, const Q: usize = 24> {
+pub struct InsNavigator<T: Real, const H: usize = 64, const Q: usize = 40> {
     config: InsConfig<T>,
     horizon_ns: u64,
     reset_ns: u64,
@@ -529,13 +530,11 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         } else {
             Ok(())
         };
-        let aid = Aid::Gnss {
-            position: fix.position,
-            velocity: fix.velocity,
-            sigma_position: fix.sigma_position,
-            sigma_velocity: fix.sigma_velocity,
-        };
-        self.enqueue(t_ns, aid, checked)?;
+        let position = Aid::Gnss(fix.position, fix.sigma_position);
+        let velocity = fix
+            .velocity
+            .map(|v| Aid::GnssVelocity(v, fix.sigma_velocity));
+        self.enqueue(t_ns, position, velocity, checked)?;
         if self.report.gnss == AidStatus::Absent {
             self.report.gnss = AidStatus::Waiting;
         }
@@ -564,7 +563,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             }
             return Ok(self.report);
         }
-        self.enqueue(t_ns, Aid::Magnetometer(*field), checked)?;
+        self.enqueue(t_ns, Aid::Magnetometer(*field), None, checked)?;
         Ok(self.report)
     }
 
@@ -583,7 +582,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         if checked.is_ok() && self.config.barometer_sigma.is_none() {
             return Ok(self.report);
         }
-        self.enqueue(t_ns, Aid::Barometer(altitude), checked)?;
+        self.enqueue(t_ns, Aid::Barometer(altitude), None, checked)?;
         Ok(self.report)
     }
 
@@ -593,11 +592,11 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         &mut self,
         t_ns: u64,
         aid: Aid<T>,
+        second: Option<Aid<T>>,
         checked: Result<(), NavError>,
     ) -> Result<(), NavError> {
-        let item = Queued { t_ns, aid };
-        self.report.event = None;
-        self.report.fused = None;
+        let first = Queued { t_ns, aid };
+        let second = second.map(|aid| Queued { t_ns, aid });
         let result = checked.and_then(|()| {
             if self.filter_t.is_some_and(|t| t_ns <= t) {
                 return Err(NavError::TooOld);
@@ -608,15 +607,38 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             {
                 return Err(NavError::InFuture);
             }
-            self.queue.insert(item).map_err(|e| match e {
+            // Both halves of a fix or neither: the checks come before the first insertion.
+            let room = if second.is_some() { 2 } else { 1 };
+            let fits = self.queue.check(&first).and_then(|()| match &second {
+                Some(v) => self.queue.check(v),
+                None => Ok(()),
+            });
+            let fits = fits.and_then(|()| {
+                if self.queue.free() >= room {
+                    Ok(())
+                } else {
+                    Err(QueueError::Full)
+                }
+            });
+            fits.map_err(|e| match e {
                 QueueError::Full => NavError::QueueFull,
                 QueueError::Duplicate => NavError::TimeNotIncreasing,
             })
         });
-        if result.is_err() {
+        if let Err(e) = result {
             self.counters.refused = self.counters.refused.saturating_add(1);
+            return Err(e);
         }
-        result
+        for item in core::iter::once(first).chain(second) {
+            if self.queue.insert(item).is_err() {
+                // Unreachable after the checks above; counted rather than trusted.
+                self.counters.numerical_failures =
+                    self.counters.numerical_failures.saturating_add(1);
+            }
+        }
+        self.report.event = None;
+        self.report.fused = None;
+        Ok(())
     }
 
     /// The time the ring spans: from the filter's time to the newest sample, ns.
@@ -687,7 +709,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             return;
         };
         let kind = match item.aid {
-            Aid::Gnss { .. } | Aid::GnssVelocity(..) => 0,
+            Aid::Gnss(..) | Aid::GnssVelocity(..) => 0,
             Aid::Magnetometer(_) => 1,
             Aid::Barometer(_) => 2,
         };
@@ -708,30 +730,16 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         let dt = seconds::<T>(t_f.saturating_sub(item.t_ns));
         match &mut self.mode {
             Mode::Aligning(_) => match item.aid {
-                Aid::Gnss {
-                    position,
-                    velocity,
-                    sigma_position,
-                    sigma_velocity,
-                } => self.start(dt, position, velocity, sigma_position, sigma_velocity),
+                Aid::Gnss(position, sigma) => {
+                    // The fix's velocity, stamped alike, is the next item: the start takes it.
+                    let velocity = self.queue.take_velocity_at(item.t_ns);
+                    self.start(dt, position, sigma, velocity);
+                }
                 _ => self.counters.unused = self.counters.unused.saturating_add(1),
             },
             Mode::Running(_) => match item.aid {
-                Aid::Gnss {
-                    position,
-                    velocity,
-                    sigma_position,
-                    sigma_velocity,
-                } => {
-                    self.fuse_gnss(t_f, item.t_ns, dt, position, sigma_position);
-                    // The velocity waits for the next call (one update per call); it is
-                    // stamped like the position and comes out of the queue next.
-                    if let Some(v) = velocity {
-                        let _ = self.queue.insert(Queued {
-                            t_ns: item.t_ns,
-                            aid: Aid::GnssVelocity(v, sigma_velocity),
-                        });
-                    }
+                Aid::Gnss(position, sigma) => {
+                    self.fuse_gnss(t_f, item.t_ns, dt, position, sigma);
                 }
                 Aid::GnssVelocity(v, sigma) => self.fuse_gnss_velocity(item.t_ns, dt, v, sigma),
                 Aid::Magnetometer(field) => self.fuse_magnetometer(item.t_ns, dt, field),

@@ -28,9 +28,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         &mut self,
         dt: T,
         position: Vector3<T>,
-        velocity: Option<Vector3<T>>,
         sigma_position: T,
-        sigma_velocity: T,
+        velocity: Option<(Vector3<T>, T)>,
     ) {
         let Mode::Aligning(att) = &self.mode else {
             return;
@@ -44,10 +43,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         };
         let carry = self.window.rotation.inverse();
         let attitude = filter.state().attitude.compose(&carry);
-        let (v, sigma_v) = match velocity {
-            Some(v) => (v, sigma_velocity),
-            None => (Vector3::zeros(), T::lit(UNKNOWN_VELOCITY_SIGMA)),
-        };
+        let (v, sigma_v) = velocity.unwrap_or((Vector3::zeros(), T::lit(UNKNOWN_VELOCITY_SIGMA)));
         let antenna = position + v * dt;
         let p = antenna - attitude.act(&self.config.gnss_lever_arm);
         let reference = att.magnetic_reference();

@@ -375,16 +375,35 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
     /// [`EskfError::NonFinite`] for a negative or non-finite sigma, or one whose square
     /// overflows `P`; the filter is then unchanged.
     pub fn widen_velocity(&mut self, sigma: T) -> Result<(), EskfError> {
-        let v = sigma * sigma;
-        let fits = (0..3).all(|k| {
-            self.covariance
-                .get((3 + k, 3 + k))
-                .is_some_and(|d| (*d + v).is_finite())
-        });
-        if !(non_negative_finite(sigma) && v.is_finite() && fits) {
-            return Err(EskfError::NonFinite);
+        self.widen_blocks(&[(1, sigma)])
+    }
+
+    /// Adds `σ_g² I` to the gyro-bias block and `σ_a² I` to the accelerometer-bias block of
+    /// `P`: biases known less well than `P` says (an estimate carried over from a model that
+    /// did not hold). `P` stays positive definite.
+    ///
+    /// # Errors
+    /// As [`Filter::widen_velocity`].
+    pub fn widen_biases(&mut self, gyro: T, accel: T) -> Result<(), EskfError> {
+        self.widen_blocks(&[(3, gyro), (4, accel)])
+    }
+
+    /// Adds `σ² I` to each listed diagonal block; checks every sum before the first change.
+    fn widen_blocks(&mut self, blocks: &[(usize, T)]) -> Result<(), EskfError> {
+        for (b, sigma) in blocks {
+            let v = *sigma * *sigma;
+            let fits = (0..3).all(|k| {
+                self.covariance
+                    .get((3 * b + k, 3 * b + k))
+                    .is_some_and(|d| (*d + v).is_finite())
+            });
+            if !(non_negative_finite(*sigma) && v.is_finite() && fits) {
+                return Err(EskfError::NonFinite);
+            }
         }
-        add_scaled_identity(&mut self.covariance, 1, 1, v);
+        for (b, sigma) in blocks {
+            add_scaled_identity(&mut self.covariance, *b, *b, *sigma * *sigma);
+        }
         Ok(())
     }
 

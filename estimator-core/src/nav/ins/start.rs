@@ -14,6 +14,11 @@ use nalgebra::Vector3;
 /// moves slower than this.
 const UNKNOWN_VELOCITY_SIGMA: f64 = 30.0;
 
+/// The tilt and heading the alignment may be off by beyond its covariance when it ran while
+/// moving, rad (3° and 5°).
+const MOVING_TILT_SIGMA: f64 = 0.052_359_88;
+const MOVING_YAW_SIGMA: f64 = 0.087_266_46;
+
 impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// Starts the INS at the filter's time `t_f` from the alignment and a fix valid `dt`
     /// earlier, if the alignment is ready (tilt valid; heading valid with a magnetometer);
@@ -22,7 +27,9 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// The attitude navigator's estimate is at the newest sample; the output predictor's
     /// rotation `ΔR` over the horizon carries it back, `R_f = R ΔRᵀ`
     /// ([`Ins::from_attitude_filter`]). The antenna position is carried to `t_f` by the fix's
-    /// velocity (`p + v dt`), and the lever arm removed with that attitude (`p − R_f ℓ`).
+    /// velocity (`p + v dt`), and the lever arm removed with that attitude (`p − R_f ℓ`). When
+    /// the body was not at rest, the attitude (3° tilt, 5° heading) and the biases (their
+    /// priors, `gyro_bias_sigma` and `accelerometer_bias_sigma`) are widened.
     #[inline(never)] // once per start: its matrices stay out of the caller's frame
     pub(super) fn start(
         &mut self,
@@ -47,7 +54,20 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         let antenna = position + v * dt;
         let p = antenna - attitude.act(&self.config.gnss_lever_arm);
         let reference = att.magnetic_reference();
-        match Ins::from_attitude_filter(filter, &carry, v, p, sigma_v, sigma_position) {
+        let moving = !report.at_rest;
+        let c = &self.config.attitude;
+        let started = Ins::from_attitude_filter(filter, &carry, v, p, sigma_v, sigma_position)
+            .and_then(|mut ins| {
+                if moving {
+                    // Aligned while moving, the attitude navigator's covariance holds only as
+                    // far as its motion model did (a vehicle's sustained accelerations break
+                    // it): its tilt, heading and biases are widened by their priors.
+                    ins.widen_attitude(T::lit(MOVING_TILT_SIGMA), T::lit(MOVING_YAW_SIGMA))?;
+                    ins.widen_biases(c.gyro_bias_sigma, c.accelerometer_bias_sigma)?;
+                }
+                Ok(ins)
+            });
+        match started {
             Ok(ins) => {
                 self.mode = Mode::Running(ins);
                 // Every aid starts counted as heard from now (the magnetometer fed the

@@ -9,6 +9,8 @@
 //! * [`metrics`]: streaming scores against ground truth; [`stats`]: chi-square quantiles.
 //! * [`plot`]: the PNG plots.
 //! * [`montecarlo`]: consistency over seeds against chi-square bands.
+//! * [`faults`]: the fault bench: detection and recovery times, false-valid epochs and ATE of
+//!   the INS navigator over the fault scenarios.
 //! * [`replay`]: the filter over a dataset folder, with its outputs (trajectories, metrics, plots).
 //! * [`bench`](mod@bench): the filter over every dataset under a folder, against published references.
 //! * [`output`]: output folders written beside their target and moved into place on success;
@@ -19,6 +21,7 @@ pub mod baseline;
 pub mod bench;
 pub mod calibrate;
 pub mod dataset;
+pub mod faults;
 pub mod metrics;
 pub mod montecarlo;
 pub mod output;

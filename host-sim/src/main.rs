@@ -175,6 +175,23 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             out!("  outputs in {}", out.display());
             Ok(())
         }
+        Command::Faults {
+            scenario,
+            runs,
+            seed,
+            out,
+            force,
+            json,
+            latency,
+        } => cli::faults::execute(cli::faults::Args {
+            scenario,
+            runs,
+            seed,
+            out,
+            force,
+            json,
+            latency,
+        }),
         Command::Montecarlo {
             scenario,
             runs,

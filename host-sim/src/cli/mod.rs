@@ -7,6 +7,7 @@
 //! | `host-sim replay DATASET [--out DIR] [--config FILE] [--force]` | run the filter over a dataset folder, with or without ground truth |
 //! | `host-sim bench DIR [--out OUT] [--config FILE] [--force]` | replay every dataset folder under `DIR` (one and two levels deep) and print its scores beside the `references.json` of its folder ([`host_sim::bench`]; default `OUT`: `out/bench`) |
 //! | `host-sim montecarlo --scenario NAME --runs N [--seed S] [--out DIR] [--json] [--force] [--check]` | consistency over the seeds `S`..`S+N-1`: NEES / NIS against chi-square bands; with `--out`, the runs and bands as CSV and JSON ([`host_sim::montecarlo`]) |
+//! | `host-sim faults [--scenario NAME ...] [--runs N] [--seed S] --out DIR [--force] [--json] [--latency]` | the fault bench over the `fault_*` scenarios: detection and recovery times, false-valid epochs, ATE, and the latency comparison ([`host_sim::faults`]) |
 //! | `host-sim calibrate DIR [--out DIR] [--from S] [--to S] [--force]` | IMU and magnetometer noise from a static recording (Allan deviation, `host_sim::calibrate`) |
 //! | `host-sim scenarios` | list the built-in scenarios |
 //!
@@ -19,6 +20,8 @@
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
+
+pub mod faults;
 
 /// Simulate, replay and score the estimator.
 #[derive(Debug, Parser)]
@@ -172,6 +175,49 @@ host-sim montecarlo --scenario matched_ahrs --runs 20 --seed 101 --out out/mc_ah
         /// Exit non-zero when a band is missed.
         #[arg(long)]
         check: bool,
+    },
+    /// The fault bench: detection and recovery times, false-valid epochs and ATE of the INS
+    /// navigator over the fault scenarios.
+    #[command(
+        after_help = "Simulates each scenario (default: every built-in fault_* scenario; a name or a TOML file, repeatable) \
+once per seed, --seed to --seed + --runs - 1, replays it with its replay configuration (no plots) and reads back validity.csv, \
+estimate.csv, the ground truth and faults.csv. Per scenario and fault it prints:\n\
+  detection: s from the fault's start to the first IMU epoch whose report shows it (GNSS step: position fixes_disagree or gnss rejected; \
+frozen: gnss faulty; outage: gnss stale; magnetometer: rejected or faulty; barometer step: rejected; IMU clip or stuck axis: imu_fault), median / max;\n\
+  recovery: s from the fault's end until, for 1 s without interruption, the sensor is fused and the quantity it affects valid with its error within 3σ, \
+median / max, against the target (7 s position, 5 s height);\n\
+  false-valid: epoch-axes reported valid with the error outside 3σ (beside the 0.27 % a consistent Gaussian filter shows, never 0) and outside 4σ;\n\
+  ATE: the SE(3)-aligned ATE RMSE, mean / max.\n\
+With fault_gnss_latency among the scenarios, or --latency: the mean ATE with fixes fused at their validity time, taken as valid on arrival, \
+and simulated without latency, their ratio (target ≤ 1.1), and the position ANEES against its 95 % band as `montecarlo` computes it.\n\
+The runs are simulated in a scratch folder beside --out, removed at the end.\n\
+Writes into --out: faults.csv (one row per run and fault) and faults.json (the summary; --json prints it instead of the tables).\n\n\
+Examples:\n  host-sim faults --out out/faults\n  host-sim faults --scenario fault_gnss_step --scenario fault_accel_clip --runs 5 --out out/faults_short"
+    )]
+    Faults {
+        /// A scenario (built-in name or TOML file); repeat for several (default: every
+        /// built-in `fault_*` scenario).
+        #[arg(long)]
+        scenario: Vec<String>,
+        /// Runs per scenario.
+        #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u64).range(1..))]
+        runs: u64,
+        /// Random seed of the first run; the runs use --seed to --seed + --runs - 1.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Output folder for faults.csv and faults.json.
+        #[arg(long)]
+        out: PathBuf,
+        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
+        /// files is never replaced).
+        #[arg(long)]
+        force: bool,
+        /// Print faults.json to stdout instead of the tables.
+        #[arg(long)]
+        json: bool,
+        /// Make the latency comparison even when fault_gnss_latency is not among the scenarios.
+        #[arg(long)]
+        latency: bool,
     },
     /// IMU and magnetometer noise from a static recording (Allan deviation).
     #[command(

@@ -7,11 +7,16 @@
 DEMO_OUT: the demo's semihosting output (`bench <i> <name> stack=<bytes>`, `size_of <T> <n>`,
 `bench_group <first> <windows> <name> imu_samples=<n> stack=<bytes>`: one window per call of a
 run over a stream, giving `icount.<name>_per_imu_sample` (the windows' sum over the IMU samples,
-rounded), `icount.<name>_max_call` and `stack.<name>`).
+rounded), `icount.<name>_max_call` and `stack.<name>`; `bench_classes <name> <code>:<class> ...`
+and `bench_tags <name> <first window> <codes>`: the class of each window of a group, one
+character each, giving `icount.<name>_<class>_max`, `icount.<name>_<class>_mean` and
+`calls.<name>_<class>`; `bench_stack <name> <bytes>`: a peak stack measured by the demo).
 ICOUNT_OUT: the plugin's output (`icount <i> <instructions>`); window 0 is the empty one, whose
 count (the marker overhead) is subtracted from the others.
 EXTRA: files of `name value` lines (flash sizes measured by the script).
 FIRMWARE_STRICT=1: enforce the targets, not the ceilings; no allowances.
+`stack.max` is the peak stack of every call but those whose own `stack.<name>` line is a guard
+(ceiling above target: the target is not met and that line holds the call).
 """
 import os
 import re
@@ -38,7 +43,18 @@ if sys.argv[2] == "--allowed":
     sys.exit(0 if (sys.argv[3] in allow and not strict) else 1)
 
 names, stack, icount, sizes, extra, groups = {}, {}, {}, {}, {}, []
+legends, tags = {}, {}
 for line in open(sys.argv[2]):
+    m = re.match(r"bench_classes (\S+) (.*)$", line.strip())
+    if m:
+        legends[m.group(1)] = dict(c.split(":", 1) for c in m.group(2).split())
+    m = re.match(r"bench_tags (\S+) (\d+) (\S+)$", line.strip())
+    if m:
+        for k, code in enumerate(m.group(3)):
+            tags[int(m.group(2)) + k] = (m.group(1), code)
+    m = re.match(r"bench_stack (\S+) (\d+)$", line.strip())
+    if m:
+        stack[m.group(1)] = int(m.group(2))
     m = re.match(r"bench (\d+) (\S+) stack=(\d+)", line)
     if m:
         names[int(m.group(1))] = m.group(2)
@@ -70,6 +86,15 @@ for first, windows, name, samples in groups:
         sys.exit(1)
     icount[name + "_per_imu_sample"] = (sum(calls) + samples // 2) // samples
     icount[name + "_max_call"] = max(calls)
+    classes = {}
+    for i in range(first, first + windows):
+        if tags.get(i, (None,))[0] == name:
+            classes.setdefault(tags[i][1], []).append(raw[i] - overhead)
+    for code, counts in classes.items():
+        cls = legends.get(name, {}).get(code, code)
+        icount[f"{name}_{cls}_max"] = max(counts)
+        icount[f"{name}_{cls}_mean"] = (sum(counts) + len(counts) // 2) // len(counts)
+        extra[f"calls.{name}_{cls}"] = len(counts)
 for path in sys.argv[4:]:
     for line in open(path):
         parts = line.split()
@@ -82,7 +107,10 @@ for k, v in icount.items():
 for k, v in stack.items():
     if k != "empty":
         figures["stack." + k] = v
-figures["stack.max"] = max(v for k, v in stack.items())
+# The peak of every call but those held by a guard of their own (a `stack.<name>` line whose
+# ceiling is above its target: the target is not met, that line holds the call).
+guarded = {k for k, (target, ceiling) in budgets.items() if ceiling > target}
+figures["stack.max"] = max((v for k, v in stack.items() if "stack." + k not in guarded), default=0)
 for k, v in sizes.items():
     figures["sizeof." + k] = v
 figures.update(extra)

@@ -9,8 +9,12 @@
 //!    instruction-count plugin `qemu-plugin/icount.c` counts between them) with the stack
 //!    painted below the caller, and prints the peak stack of each; the navigator's costliest
 //!    call, and every navigator call over the whole stream (one window each);
-//! 3. prints `size_of` of the filter, navigator and solver types;
-//! 4. exits through semihosting: status 0 when every check passed, 1 otherwise.
+//! 3. runs the INS navigator (`InsNavigator<f32>`) from switch-on over its synthesized stream
+//!    (`ins_stream.rs`: magnetometer and fixes delivered 0.2 s late), every call in its own
+//!    window, each window classed by what the call did (its report's `fused` and `event`), and
+//!    checks that the INS started, fused every fix and ends within a few metres of the truth;
+//! 4. prints `size_of` of the filter, navigator and solver types;
+//! 5. exits through semihosting: status 0 when every check passed, 1 otherwise.
 #![no_std]
 #![no_main]
 
@@ -18,6 +22,8 @@
 mod expected {
     include!(concat!(env!("OUT_DIR"), "/expected.rs"));
 }
+#[path = "../ins_stream.rs"]
+mod ins_stream;
 #[path = "../mem.rs"]
 mod mem;
 #[path = "../scenario.rs"]
@@ -35,7 +41,10 @@ use estimator_core::eskf::{
 };
 use estimator_core::gn::{self, solve_pnp, PnpSolution, SolveError};
 use estimator_core::lie::{LieGroup, Se3, So3};
-use estimator_core::nav::{AttitudeEstimate, AttitudeNavigator, AttitudeReport};
+use estimator_core::nav::{
+    Aiding, AttitudeEstimate, AttitudeNavigator, AttitudeReport, InsCounters, InsEstimate,
+    InsEvent, InsNavigator, InsReport,
+};
 use nalgebra::{Vector3, Vector6};
 
 // ---------------------------------------------------------------- benchmark markers
@@ -149,6 +158,20 @@ impl Checker {
             what,
             got,
             bound,
+            if ok { "ok" } else { "FAIL" }
+        );
+    }
+
+    fn at_least(&mut self, what: &str, got: u32, min: u32) {
+        let ok = got >= min;
+        if !ok {
+            self.failures += 1;
+        }
+        hprintln!(
+            "check {:<28} {} >= {} {}",
+            what,
+            got,
+            min,
             if ok { "ok" } else { "FAIL" }
         );
     }
@@ -439,6 +462,262 @@ fn bench_nav_stream(index: &mut u32) -> Option<(AttitudeEstimate<f32>, u32)> {
     Some((nav.estimate()?, nav.counters().refused))
 }
 
+/// The classes of the INS navigator's calls, by what each did: its code in the `bench_tags`
+/// lines, and its name (`tools/check_budgets.py` gives each class `icount.ins_nav_<name>_max`,
+/// `_mean`, and the demo prints its peak stack, `stack.ins_nav_<name>`).
+const INS_CLASSES: [(u8, &str); 10] = [
+    (b's', "step"),
+    (b'p', "gnss_position"),
+    (b'v', "gnss_velocity"),
+    (b'm', "magnetometer"),
+    (b'b', "barometer"),
+    (b'S', "start"),
+    (b'a', "aligning"),
+    (b'G', "gnss_call"),
+    (b'M', "magnetometer_call"),
+    (b'x', "refused"),
+];
+
+/// At most this many windows in the INS navigator's run (its stream has 2,031 calls).
+const INS_WINDOWS: usize = 2_100;
+
+/// What the INS navigator's measured run found.
+struct InsNavRun {
+    /// The report and estimate after the last call.
+    report: InsReport<f32>,
+    estimate: Option<InsEstimate<f32>>,
+    counters: InsCounters,
+    /// IMU calls that started the INS; that raised any other event (realigned, reset, IMU
+    /// fault); whose update the gate rejected.
+    started: u32,
+    other_events: u32,
+    rejected: u32,
+    /// Windows beyond the tag buffer (0 when every call was classed).
+    unclassed: u32,
+    /// When the INS started, ms after switch-on.
+    start_ms: u32,
+    /// The call after an IMU gap went back to aligning.
+    realigned: bool,
+}
+
+/// The class of an INS navigator's `imu` call that was not refused, from its report.
+fn ins_imu_class(nav: &InsNavigator<f32>) -> u8 {
+    let r = nav.report();
+    if r.event == Some(InsEvent::Started) {
+        return b'S';
+    }
+    if nav.filter().is_none() {
+        return b'a';
+    }
+    match r.fused.map(|f| f.aid) {
+        Some(Aiding::GnssPosition) => b'p',
+        Some(Aiding::GnssVelocity) => b'v',
+        Some(Aiding::Magnetometer) => b'm',
+        Some(Aiding::Barometer) => b'b',
+        None => b's',
+    }
+}
+
+/// Runs a new `InsNavigator<f32>` (its default ring of IMU intervals and queue, 0.3 s horizon)
+/// from switch-on over `ins_stream`, each call in its own measured window, and prints
+/// `bench_group <first> <windows> ins_nav imu_samples=<n> stack=<peak>`, the class of every
+/// window (`bench_tags ins_nav <first window> <codes>`, legend in `bench_classes`) and each
+/// class's peak stack; then measures `estimate()` once, and an `imu` call after an IMU gap on
+/// a copy.
+fn bench_ins_nav(index: &mut u32) -> Option<InsNavRun> {
+    let mut nav: InsNavigator<f32> = InsNavigator::new(ins_stream::config::<f32>()).ok()?;
+    let first = *index;
+    let mut tags = [0u8; INS_WINDOWS];
+    let mut class_stack = [0usize; INS_CLASSES.len()];
+    let (mut windows, mut imu, mut peak) = (0usize, 0u32, 0usize);
+    let (mut started, mut other_events, mut rejected) = (0u32, 0u32, 0u32);
+    let mut start_ms = 0u32;
+    let mut last_imu = None;
+    ins_stream::samples::<f32>(|sample| {
+        let refused_before = nav.counters().refused;
+        let (stack, tag) = match sample {
+            ins_stream::InsSample::Imu { t_ns, gyro, accel } => {
+                imu += 1;
+                let stack = measure(&mut || {
+                    let _ = black_box(black_box(&mut nav).imu(
+                        black_box(t_ns),
+                        black_box(&gyro),
+                        black_box(&accel),
+                    ));
+                });
+                let tag = ins_imu_class(&nav);
+                last_imu = Some((t_ns, gyro, accel));
+                let r = nav.report();
+                match r.event {
+                    Some(InsEvent::Started) => {
+                        started += 1;
+                        let ms = (t_ns - ins_stream::T0_NS) / 1_000_000;
+                        start_ms = u32::try_from(ms).unwrap_or(u32::MAX);
+                    }
+                    Some(_) => other_events += 1,
+                    None => {}
+                }
+                if r.fused.is_some_and(|f| !f.accepted) {
+                    rejected += 1;
+                }
+                (stack, tag)
+            }
+            ins_stream::InsSample::Mag { t_ns, field } => {
+                let stack = measure(&mut || {
+                    let _ = black_box(
+                        black_box(&mut nav).magnetometer(black_box(t_ns), black_box(&field)),
+                    );
+                });
+                (stack, b'M')
+            }
+            ins_stream::InsSample::Gnss { t_ns, fix } => {
+                let stack = measure(&mut || {
+                    let _ = black_box(black_box(&mut nav).gnss(black_box(t_ns), black_box(&fix)));
+                });
+                (stack, b'G')
+            }
+        };
+        // A refused call returns an error and leaves the report as it was.
+        let tag = if nav.counters().refused != refused_before {
+            b'x'
+        } else {
+            tag
+        };
+        if let Some(slot) = tags.get_mut(windows) {
+            *slot = tag;
+        }
+        if let Some(k) = INS_CLASSES.iter().position(|(c, _)| *c == tag) {
+            if let Some(s) = class_stack.get_mut(k) {
+                *s = (*s).max(stack);
+            }
+        }
+        peak = peak.max(stack);
+        windows += 1;
+    });
+    *index += windows as u32;
+    hprintln!(
+        "bench_group {} {} ins_nav imu_samples={} stack={}",
+        first,
+        windows,
+        imu,
+        peak
+    );
+    let mut legend = [0u8; 160];
+    let mut n = 0;
+    for (code, name) in INS_CLASSES {
+        for b in [code, b':'].iter().chain(name.as_bytes()).chain(b" ") {
+            if let Some(slot) = legend.get_mut(n) {
+                *slot = *b;
+                n += 1;
+            }
+        }
+    }
+    hprintln!(
+        "bench_classes ins_nav {}",
+        core::str::from_utf8(legend.get(..n).unwrap_or(&[])).unwrap_or("")
+    );
+    let classed = windows.min(INS_WINDOWS);
+    let mut at = 0;
+    while at < classed {
+        let end = (at + 100).min(classed);
+        let line = tags.get(at..end).unwrap_or(&[]);
+        hprintln!(
+            "bench_tags ins_nav {} {}",
+            first as usize + at,
+            core::str::from_utf8(line).unwrap_or("")
+        );
+        at = end;
+    }
+    for ((code, name), stack) in INS_CLASSES.iter().zip(class_stack) {
+        if tags.get(..classed).is_some_and(|t| t.contains(code)) {
+            hprintln!("bench_stack ins_nav_{} {}", name, stack);
+        }
+    }
+    bench(index, "ins_nav_estimate", || {
+        black_box(black_box(&nav).estimate());
+    });
+    // An IMU sample 0.2 s after the last (a gap over `max_dt`, 0.1 s): the call goes back to
+    // aligning (`Realigned`), building a new attitude navigator in place of the INS. Measured
+    // on a copy; another copy checks the event.
+    let mut realigned = false;
+    if let Some((t_ns, gyro, accel)) = last_imu {
+        let t_gap = t_ns + 200_000_000;
+        let mut copy = nav;
+        bench(index, "ins_nav_imu_after_gap", || {
+            let _ = black_box(black_box(&mut copy).imu(
+                black_box(t_gap),
+                black_box(&gyro),
+                black_box(&accel),
+            ));
+        });
+        let mut other = nav;
+        realigned = other
+            .imu(t_gap, &gyro, &accel)
+            .is_ok_and(|r| r.event == Some(InsEvent::Realigned));
+    }
+    Some(InsNavRun {
+        report: *nav.report(),
+        estimate: nav.estimate(),
+        counters: *nav.counters(),
+        started,
+        other_events,
+        rejected,
+        unclassed: u32::try_from(windows - classed).unwrap_or(u32::MAX),
+        start_ms,
+        realigned,
+    })
+}
+
+/// Checks the INS navigator's run: every sample taken, the INS started once from the
+/// alignment, every fix and magnetometer sample fused, and the end estimate near the truth.
+fn check_ins_nav(c: &mut Checker, run: &Option<InsNavRun>) {
+    let Some(r) = run else {
+        c.equal("ins nav constructed", 0, 1);
+        return;
+    };
+    let n = &r.counters;
+    c.equal("ins nav windows classed", r.unclassed, 0);
+    c.equal("ins nav samples refused", n.refused, 0);
+    c.equal("ins nav started", r.started, 1);
+    hprintln!("info ins_nav started {} ms after switch-on", r.start_ms);
+    c.equal("ins nav gap call realigned", u32::from(r.realigned), 1);
+    c.equal("ins nav other events", r.other_events, 0);
+    c.equal("ins nav updates rejected", r.rejected, 0);
+    c.equal("ins nav numerical failures", n.numerical_failures, 0);
+    hprintln!(
+        "info ins_nav measurements unused while aligning {}",
+        n.unused
+    );
+    c.at_least("ins nav gnss position fused", n.gnss_position_fused, 25);
+    c.at_least("ins nav gnss velocity fused", n.gnss_velocity_fused, 25);
+    c.at_least("ins nav magnetometer fused", n.magnetometer_fused, 250);
+    let v = &r.report.validity;
+    let valid = [v.tilt, v.heading, v.velocity, v.position]
+        .iter()
+        .filter(|x| x.is_valid())
+        .count();
+    c.equal("ins nav tilt/heading/v/p valid", valid as u32, 4);
+    let Some(e) = &r.estimate else {
+        c.equal("ins nav estimate", 0, 1);
+        return;
+    };
+    let p = ins_stream::truth_position::<f32>(e.t_ns);
+    c.below(
+        "ins nav position error (m)",
+        (e.state.position - p).norm(),
+        1.5,
+    );
+    let v = ins_stream::truth_velocity::<f32>();
+    c.below(
+        "ins nav velocity error (m/s)",
+        (e.state.velocity - v).norm(),
+        0.15,
+    );
+    let a = ins_stream::truth_attitude::<f32>();
+    let err = e.state.attitude.between(&a).log().norm();
+    c.below("ins nav attitude error (rad)", err, 0.03);
+}
+
 /// What the benchmarks found besides the figures.
 struct Benchmarks {
     updates: Updates,
@@ -446,6 +725,8 @@ struct Benchmarks {
     nav_step: bool,
     /// The navigator's measured run over the stream: final estimate, samples refused.
     nav_stream: Option<(AttitudeEstimate<f32>, u32)>,
+    /// The INS navigator's measured run over its stream.
+    ins_nav: Option<InsNavRun>,
 }
 
 fn run_benchmarks(w: &scenario::Workload<f32>) -> Benchmarks {
@@ -578,10 +859,12 @@ fn run_benchmarks(w: &scenario::Workload<f32>) -> Benchmarks {
         updates.bench(&mut i, "nav_filter_update_heading", f, &p.heading, opts);
     }
     let nav_stream = bench_nav_stream(&mut i);
+    let ins_nav = bench_ins_nav(&mut i);
     Benchmarks {
         updates,
         nav_step,
         nav_stream,
+        ins_nav,
     }
 }
 
@@ -615,6 +898,7 @@ fn main() -> ! {
                 }
                 None => c.equal("nav stream run", 0, 1),
             }
+            check_ins_nav(&mut c, &b.ins_nav);
         }
         None => c.equal("benchmark workload built", 0, 1),
     }
@@ -625,6 +909,12 @@ fn main() -> ! {
         "size_of AttitudeNavigator<f32> {}",
         size_of::<AttitudeNavigator<f32>>()
     );
+    hprintln!(
+        "size_of InsNavigator<f32> {}",
+        size_of::<InsNavigator<f32>>()
+    );
+    hprintln!("size_of InsReport<f32> {}", size_of::<InsReport<f32>>());
+    hprintln!("size_of InsEstimate<f32> {}", size_of::<InsEstimate<f32>>());
     hprintln!(
         "size_of AttitudeReport<f32> {}",
         size_of::<AttitudeReport<f32>>()

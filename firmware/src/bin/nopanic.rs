@@ -40,7 +40,8 @@ use estimator_core::gn::{
 };
 use estimator_core::lie::{skew, LieGroup, Se2, Se3, So2, So3};
 use estimator_core::nav::{
-    AttitudeConfig, AttitudeNavigator, MagneticConfig, Validity, VectorMean,
+    AttitudeConfig, AttitudeNavigator, GnssFix, InsConfig, InsNavigator, MagneticConfig, Validity,
+    VectorMean,
 };
 use estimator_core::Real;
 use nalgebra::{
@@ -181,6 +182,7 @@ fn eskf<T: Real>(x: &Seed<T>) {
     ahrs(x, &config, &opts);
     ahrs_accel_bias(x, &config, &opts);
     nav(x, &config);
+    ins_nav(x, &config);
     keep(&UpdateOptions::<T>::default());
     keep(&bb(Gate::<T>::Probability(GateProbability::P95)).threshold(bb(3)));
     keep(&GateProbability::P999.quantile::<T>(bb(9)));
@@ -261,6 +263,11 @@ fn eskf<T: Real>(x: &Seed<T>) {
     if let Ok(outcome) = ins_update!(cam) {
         keep(&(outcome.nis(), outcome.is_accepted()));
     }
+    // What a navigator does to the filter besides updates: widen, reset.
+    keep(&ins.widen_velocity(d));
+    keep(&ins.widen_biases(g, h));
+    keep(&ins.reset_position(w, e));
+    keep(&ins.reset_velocity(v, f));
     keep(&ins);
 }
 
@@ -340,6 +347,15 @@ fn ahrs_accel_bias<T: Real>(x: &Seed<T>, config: &FilterConfig<T>, opts: &Update
     keep(&filter.update(&GravityDirection::new(w, g), opts));
     keep(&filter.update(&Magnetometer::new(v, w, d), opts));
     keep(&filter);
+    // The INS started from this filter (the INS navigator's start-up).
+    keep(&Ins::from_attitude_filter(
+        &filter,
+        &So3::exp(&w),
+        v,
+        w,
+        a,
+        b,
+    ));
 }
 
 /// The attitude navigator on an opaque state (`black_box` after construction: every phase and
@@ -377,6 +393,45 @@ fn nav<T: Real>(x: &Seed<T>, config: &FilterConfig<T>) {
     mean.add(&bb(w));
     keep(&(mean.count(), mean.mean(), mean.scatter_sq()));
     keep(&(T::from_count(bb(7)), h.to_count()));
+}
+
+/// The INS navigator on an opaque state (`black_box` after construction, as the attitude
+/// navigator: every phase, aligning or running, and every branch of its calls is reachable),
+/// with a magnetometer and a barometer configured, and opaque samples.
+#[inline(never)]
+fn ins_nav<T: Real>(x: &Seed<T>, config: &FilterConfig<T>) {
+    let [a, b, c, d, e, f, g, h] = *x;
+    let (v, w) = (Vector3::new(a, b, c), Vector3::new(d, e, f));
+    let mut attitude = AttitudeConfig::new(*config);
+    attitude.magnetometer = bb(Some(MagneticConfig::new(g, bb(Some(w)))));
+    let mut cfg = InsConfig::new(attitude);
+    cfg.barometer_sigma = bb(Some(h));
+    cfg.gnss_lever_arm = v;
+    cfg.gyro_stuck_s = a;
+    let cfg = bb(cfg);
+    keep(&cfg.validate());
+    let nav = match InsNavigator::<T>::new(cfg) {
+        Ok(n) => n,
+        Err(e) => {
+            keep(&e);
+            return;
+        }
+    };
+    let mut nav = bb(nav);
+    let t = bb(1_000_000_000u64);
+    keep(&nav.imu(t, &v, &w));
+    let fix = GnssFix::new(w, bb(Some(v)), a, b);
+    keep(&nav.gnss(t, &fix));
+    keep(&nav.magnetometer(t, &w));
+    keep(&nav.barometer(t, h));
+    keep(&nav.estimate());
+    keep(&(
+        nav.config(),
+        nav.report(),
+        nav.counters(),
+        nav.filter(),
+        nav.aligning(),
+    ));
 }
 
 #[inline(never)]

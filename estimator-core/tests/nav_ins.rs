@@ -580,3 +580,21 @@ fn ins_navigator_widens_for_a_clipped_accelerometer_and_a_stuck_gyro() {
         .iter()
         .any(|(s, r)| (15.0..17.0).contains(s) && r.event == Some(InsEvent::ImuFault)));
 }
+
+#[test]
+fn ins_navigator_does_not_start_from_an_outlier() {
+    // The first fix is 50 m off: the INS starts only on two fixes that agree, so from the
+    // next good pair, and never reports a valid position 50 m wrong.
+    let outlier = |s: f64| {
+        if s < 1.2 {
+            Vector3::new(50.0, 0.0, 0.0)
+        } else {
+            Vector3::zeros()
+        }
+    };
+    let (reports, nav) = at_rest_with_fixes(10.0, outlier, |_| Vector3::zeros());
+    let started = first(&reports, 0.0, |r| r.event == Some(InsEvent::Started));
+    assert!(started > 1.2 && started < 2.0, "started at {started} s");
+    assert!(nav.estimate().unwrap().state.position.norm() < 1.0);
+    assert!(nav.counters().unused >= 2, "{:?}", nav.counters());
+}

@@ -306,6 +306,44 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
         sigma_velocity: T,
         sigma_position: T,
     ) -> Result<Self, EskfError> {
+        let mut ins = Self::unstarted(*attitude.config());
+        ins.restart_from_attitude_filter(
+            attitude,
+            carry,
+            velocity,
+            position,
+            sigma_velocity,
+            sigma_position,
+        )?;
+        Ok(ins)
+    }
+
+    /// A filter whose `P` is zero: not a filter until [`Filter::restart_from_attitude_filter`]
+    /// has run on it (a navigator builds the INS in the place of its attitude filter).
+    pub(crate) fn unstarted(config: FilterConfig<T>) -> Self {
+        Self {
+            state: InsState::identity(),
+            covariance: SMatrix::zeros(),
+            config,
+        }
+    }
+
+    /// Starts this filter again as [`Filter::from_attitude_filter`] builds one, in place (a
+    /// navigator switching from its attitude filter to the INS holds one `P`, not two), with
+    /// the attitude filter's configuration.
+    ///
+    /// # Errors
+    /// As [`Filter::from_attitude_filter`]; the filter is then unchanged.
+    #[inline(never)] // once at start-up: its matrices stay out of the caller's frame
+    pub fn restart_from_attitude_filter(
+        &mut self,
+        attitude: &AhrsAccelBias<T>,
+        carry: &So3<T>,
+        velocity: Vector3<T>,
+        position: Vector3<T>,
+        sigma_velocity: T,
+        sigma_position: T,
+    ) -> Result<(), EskfError> {
         let a = attitude.state();
         let state = InsState {
             attitude: a.attitude.compose(carry).renormalize(),
@@ -322,7 +360,10 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
         {
             return Err(EskfError::CovarianceNotPositiveDefinite);
         }
-        let mut p = SMatrix::<T, 15, 15>::zeros();
+        self.state = state;
+        self.config = *attitude.config();
+        let p = &mut self.covariance;
+        *p = SMatrix::zeros();
         // Block k of the attitude filter (δθ, δb_g, δb_a) is block `to[k]` of the INS.
         let to = [0, 3, 4];
         let m = carry.rotation_matrix().transpose();
@@ -335,16 +376,12 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
                 if j == 0 {
                     b = mat3::mul(&b, &m.transpose());
                 }
-                set_block(&mut p, *bi, *bj, &b);
+                set_block(p, *bi, *bj, &b);
             }
         }
-        add_scaled_identity(&mut p, 1, 1, sigma_velocity * sigma_velocity);
-        add_scaled_identity(&mut p, 2, 2, sigma_position * sigma_position);
-        Ok(Self {
-            state,
-            covariance: p,
-            config: *attitude.config(),
-        })
+        add_scaled_identity(p, 1, 1, sigma_velocity * sigma_velocity);
+        add_scaled_identity(p, 2, 2, sigma_position * sigma_position);
+        Ok(())
     }
 
     /// Resets the position to `position` with 1σ `sigma` per axis, forgetting what the filter

@@ -17,7 +17,7 @@ pub enum NavError {
     InvalidConfig,
     /// A measurement's sigma is not positive (or its square not finite).
     InvalidSigma,
-    /// A measurement stamped at or before the time the filter has reached (older than the
+    /// A measurement stamped before the time the filter has reached (older than the
     /// delayed-fusion horizon).
     TooOld,
     /// A measurement stamped after the newest IMU sample by more than `max_dt`.

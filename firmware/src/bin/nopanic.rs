@@ -348,14 +348,11 @@ fn ahrs_accel_bias<T: Real>(x: &Seed<T>, config: &FilterConfig<T>, opts: &Update
     keep(&filter.update(&Magnetometer::new(v, w, d), opts));
     keep(&filter);
     // The INS started from this filter (the INS navigator's start-up).
-    keep(&Ins::from_attitude_filter(
-        &filter,
-        &So3::exp(&w),
-        v,
-        w,
-        a,
-        b,
-    ));
+    let mut ins = Ins::from_attitude_filter(&filter, &So3::exp(&w), v, w, a, b);
+    if let Ok(ins) = ins.as_mut() {
+        keep(&ins.restart_from_attitude_filter(&filter, &So3::exp(&v), w, v, b, a));
+    }
+    keep(&ins);
 }
 
 /// The attitude navigator on an opaque state (`black_box` after construction: every phase and

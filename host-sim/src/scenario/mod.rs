@@ -446,9 +446,11 @@ fn fault_scenarios(base: &Scenario) -> Vec<Scenario> {
             ..Signal::default()
         };
     });
-    // A 25 Hz vertical vibration of 1.6 mm (motors on a stiff mount): ±39.5 m/s², so the vertical
-    // specific force peaks near 5 g and a ±4 g range clips it, on one side only.
-    let vibrating = figure8(|t| t.position[2].sines.push(sine(0.0016, 25.0, 0.0)));
+    // A 23.3 Hz vertical vibration of 1.84 mm (motors on a stiff mount): ±39.5 m/s², so the
+    // vertical specific force peaks near 5 g and a ±4 g range clips it, on one side only. Not a
+    // divisor of the 200 Hz IMU rate: a motor is not phase-locked to the IMU's clock, and a
+    // locked one would repeat its quantized samples exactly, as only a clipped axis does.
+    let vibrating = figure8(|t| t.position[2].sines.push(sine(0.001_843, 23.3, 0.0)));
     // The heading swing phased so that its rate crosses zero, rising, at 40 s (τ = 34 s): a turn
     // begins, and by 42 s the heading has moved 0.19 rad that a stuck z gyro does not see.
     let turning = figure8(|t| {
@@ -506,7 +508,7 @@ fn fault_scenarios(base: &Scenario) -> Vec<Scenario> {
         },
         Scenario {
             name: "fault_accel_clip".into(),
-            description: "accelerometer clipped at ±4 g from 40 s to 42 s under a 25 Hz vibration peaking near 5 g; figure-eight, IMU, magnetometer, GNSS 5 Hz, barometer, 120 s".into(),
+            description: "accelerometer clipped at ±4 g from 40 s to 42 s under a 23.3 Hz vibration peaking near 5 g; figure-eight, IMU, magnetometer, GNSS 5 Hz, barometer, 120 s".into(),
             trajectory: vibrating,
             imu: ImuConfig { accel_clip: vec![[40.0, 42.0, 4.0 * 9.81]], ..ImuConfig::default() },
             ..all_sensors.clone()

@@ -119,6 +119,9 @@ impl<T: Real> Queued<T> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct AidQueue<T: Real, const Q: usize> {
     items: [Option<Queued<T>>; Q],
+    /// The earliest time among `items` (so that the common call, nothing due, reads one
+    /// number instead of scanning the queue).
+    earliest: Option<u64>,
 }
 
 /// Why a measurement could not be queued.
@@ -131,7 +134,10 @@ pub(crate) enum QueueError {
 
 impl<T: Real, const Q: usize> AidQueue<T, Q> {
     pub(crate) fn new() -> Self {
-        Self { items: [None; Q] }
+        Self {
+            items: [None; Q],
+            earliest: None,
+        }
     }
 
     /// Checks that `item` can be queued (nothing is changed).
@@ -151,6 +157,7 @@ impl<T: Real, const Q: usize> AidQueue<T, Q> {
         match self.items.iter_mut().find(|q| q.is_none()) {
             Some(slot) => {
                 *slot = Some(item);
+                self.earliest = Some(self.earliest.map_or(item.t_ns, |e| e.min(item.t_ns)));
                 Ok(())
             }
             None => Err(QueueError::Full),
@@ -167,7 +174,9 @@ impl<T: Real, const Q: usize> AidQueue<T, Q> {
         let slot = self.items.iter_mut().find(|q| {
             q.is_some_and(|q| q.t_ns == t_ns && matches!(q.aid, Aid::GnssVelocity(..)))
         })?;
-        match slot.take()?.aid {
+        let taken = slot.take();
+        self.earliest = self.items.iter().flatten().map(|q| q.t_ns).min();
+        match taken?.aid {
             Aid::GnssVelocity(v, sigma) => Some((v, sigma)),
             _ => None,
         }
@@ -175,15 +184,21 @@ impl<T: Real, const Q: usize> AidQueue<T, Q> {
 
     /// Removes and returns the earliest measurement stamped at or before `t_ns`.
     pub(crate) fn take_due(&mut self, t_ns: u64) -> Option<Queued<T>> {
-        let slot = self
+        if self.earliest.is_none_or(|e| e > t_ns) {
+            return None;
+        }
+        let taken = self
             .items
             .iter_mut()
             .filter(|q| q.is_some_and(|q| q.t_ns <= t_ns))
-            .min_by_key(|q| q.map(|q| q.key()))?;
-        slot.take()
+            .min_by_key(|q| q.map(|q| q.key()))
+            .and_then(Option::take);
+        self.earliest = self.items.iter().flatten().map(|q| q.t_ns).min();
+        taken
     }
 
     pub(crate) fn clear(&mut self) {
         self.items = [None; Q];
+        self.earliest = None;
     }
 }

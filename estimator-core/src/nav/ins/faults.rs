@@ -11,8 +11,12 @@ use nalgebra::Vector3;
 /// The smallest rate error a stuck gyro axis is taken to hide, rad/s.
 const STUCK_RATE_FLOOR: f64 = 1.0;
 
+/// After a faulty IMU sample, the velocity and position are reported invalid for this long,
+/// ns (1 s): the samples between two detected ones may be faulty too.
+const FAULT_HOLD_NS: u64 = 1_000_000_000;
+
 /// Samples of each accelerometer axis remembered for the saturation check.
-const HISTORY: usize = 8;
+const HISTORY: usize = 16;
 
 /// Per accelerometer axis, the magnitudes of the last [`HISTORY`] samples: a magnitude above
 /// 2 g met again exactly is a saturation level (noise and motion never repeat a large value
@@ -99,6 +103,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             return;
         }
         self.report.imu_fault = true;
+        self.stuck.invalid_until = Some(t_ns.saturating_add(FAULT_HOLD_NS));
         self.counters.imu_faults = self.counters.imu_faults.saturating_add(1);
         let accel_range = accel_level.unwrap_or(c.accelerometer_range);
         let peak = self

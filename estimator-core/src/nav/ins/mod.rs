@@ -49,7 +49,7 @@
 //!   is then held by the GNSS velocity and the gyro.
 //! * **Barometer.** Gated.
 //! * **IMU.** A sample with an axis at the sensor's range (configured, or for the
-//!   accelerometer learned: a magnitude above 2 g met again exactly within 8 samples, which
+//!   accelerometer learned: a magnitude above 2 g met again exactly within 16 samples, which
 //!   noise and motion never do) is saturated; a
 //!   gyro axis repeating its value exactly for `gyro_stuck_s` while another changes is stuck.
 //!   Such a sample is still integrated (nothing else measures the motion), and the velocity
@@ -107,6 +107,10 @@ struct GnssTrack<T: Real> {
     last_position: Option<Vector3<T>>,
     /// The last fix was frozen (its velocity is not fused either).
     frozen: bool,
+    /// While aligning, the last fix (time, position, 1σ, velocity): the next one starts the
+    /// INS if the two agree.
+    #[allow(clippy::type_complexity)]
+    start_candidate: Option<(u64, Vector3<T>, T, Option<(Vector3<T>, T)>)>,
     /// Consecutive rejected position fixes, and the time of the first.
     rejected: u16,
     rejected_since: Option<u64>,
@@ -126,6 +130,7 @@ impl<T: Real> Default for GnssTrack<T> {
         Self {
             last_position: None,
             frozen: false,
+            start_candidate: None,
             rejected: 0,
             rejected_since: None,
             last_fused: None,
@@ -144,6 +149,9 @@ struct StuckTrack<T: Real> {
     since: [Option<u64>; 3],
     accel_repeats: faults::Repeats<T>,
     gyro_peak: Vector3<T>,
+    /// The velocity and position stay invalid until this time after a faulty sample, ns (the
+    /// samples between two detected ones may be faulty too).
+    invalid_until: Option<u64>,
 }
 
 /// The INS navigator (module docs), with an IMU ring of `H` intervals (64: a 0.3 s horizon at
@@ -303,6 +311,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
                 since: [None; 3],
                 accel_repeats: faults::Repeats::new(),
                 gyro_peak: Vector3::zeros(),
+                invalid_until: None,
             },
             report: InsReport {
                 t_ns: 0,
@@ -598,7 +607,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         let first = Queued { t_ns, aid };
         let second = second.map(|aid| Queued { t_ns, aid });
         let result = checked.and_then(|()| {
-            if self.filter_t.is_some_and(|t| t_ns <= t) {
+            if self.filter_t.is_some_and(|t| t_ns < t) {
                 return Err(NavError::TooOld);
             }
             let newest = self.imu_clock.last().unwrap_or(0);
@@ -672,7 +681,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         // The fresh window starts where this one ends; when the filter reaches its start, it
         // replaces the window (its rounding is that of fewer steps).
         if self.fresh_lag == 0 {
-            self.fresh = Increment::empty(self.bias().0, self.bias().1);
+            let (gyro_bias, accel_bias) = self.bias();
+            self.fresh = Increment::empty(gyro_bias, accel_bias);
             self.fresh_lag = self.ring.len();
             // Everything in the ring is older than the new fresh window.
             if self.fresh_lag == 0 {
@@ -682,7 +692,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             self.fresh_lag -= 1;
             if self.fresh_lag == 0 {
                 self.window = self.fresh;
-                self.fresh = Increment::empty(self.bias().0, self.bias().1);
+                let (gyro_bias, accel_bias) = self.bias();
+                self.fresh = Increment::empty(gyro_bias, accel_bias);
                 self.fresh_lag = self.ring.len();
             }
         }
@@ -733,7 +744,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
                 Aid::Gnss(position, sigma) => {
                     // The fix's velocity, stamped alike, is the next item: the start takes it.
                     let velocity = self.queue.take_velocity_at(item.t_ns);
-                    self.start(dt, position, sigma, velocity);
+                    self.start(item.t_ns, dt, position, sigma, velocity);
                 }
                 _ => self.counters.unused = self.counters.unused.saturating_add(1),
             },

@@ -5,6 +5,7 @@ use super::report::{AidStatus, InsEvent};
 use super::window::Increment;
 use super::{InsNavigator, Mode, INVALID_START};
 use crate::eskf::Ins;
+use crate::kernels::{all_finite, mat3, positive_finite};
 use crate::lie::LieGroup;
 use crate::nav::attitude::AttitudeNavigator;
 use crate::Real;
@@ -13,6 +14,9 @@ use nalgebra::Vector3;
 /// The velocity's 1σ at start when the first fix has none, m/s: a road vehicle or a drone
 /// moves slower than this.
 const UNKNOWN_VELOCITY_SIGMA: f64 = 30.0;
+
+/// The two fixes that start the INS are at most this far apart, ns (2 s).
+const START_PAIR_NS: u64 = 2_000_000_000;
 
 /// The tilt and heading the alignment may be off by beyond its covariance when it ran while
 /// moving, rad (3° and 5°).
@@ -30,9 +34,15 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// velocity (`p + v dt`), and the lever arm removed with that attitude (`p − R_f ℓ`). When
     /// the body was not at rest, the attitude (3° tilt, 5° heading) and the biases (their
     /// priors, `gyro_bias_sigma` and `accelerometer_bias_sigma`) are widened.
+    ///
+    /// A fix starts the INS only when it agrees with the one before it (a gross outlier must
+    /// not become the start): `|p₂ − p₁ − v̄ Δt| ≤ 3 √(σ₁² + σ₂²) + 3 σ_v̄ Δt`, with `v̄` the two
+    /// fixes' mean velocity (without velocities, `σ_v̄` is the 30 m/s of an unknown velocity),
+    /// fixes at most 2 s apart.
     #[inline(never)] // once per start: its matrices stay out of the caller's frame
     pub(super) fn start(
         &mut self,
+        t_m: u64,
         dt: T,
         position: Vector3<T>,
         sigma_position: T,
@@ -41,6 +51,29 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         let Mode::Aligning(att) = &self.mode else {
             return;
         };
+        let previous = self
+            .gnss
+            .start_candidate
+            .replace((t_m, position, sigma_position, velocity));
+        let agrees = previous.is_some_and(|(t_p, p_p, s_p, v_p)| {
+            let gap_ns = t_m.saturating_sub(t_p);
+            if gap_ns == 0 || gap_ns > START_PAIR_NS {
+                return false;
+            }
+            let gap: T = super::seconds(gap_ns);
+            let (v, sigma_v) = match (v_p, velocity) {
+                (Some((a, sa)), Some((b, sb))) => ((a + b) * T::lit(0.5), sa.max(sb)),
+                _ => (Vector3::zeros(), T::lit(UNKNOWN_VELOCITY_SIGMA)),
+            };
+            let miss = mat3::norm(&(position - p_p - v * gap));
+            let tolerance = T::lit(3.0)
+                * ((s_p * s_p + sigma_position * sigma_position).sqrt_rn() + sigma_v * gap);
+            miss <= tolerance
+        });
+        if !agrees {
+            self.counters.unused = self.counters.unused.saturating_add(1);
+            return;
+        }
         let report = att.report();
         let heading_ready =
             self.config.attitude.magnetometer.is_none() || report.heading.is_valid();
@@ -55,21 +88,47 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         let p = antenna - attitude.act(&self.config.gnss_lever_arm);
         let reference = att.magnetic_reference();
         let moving = !report.at_rest;
-        let c = &self.config.attitude;
-        let started = Ins::from_attitude_filter(filter, &carry, v, p, sigma_v, sigma_position)
-            .and_then(|mut ins| {
-                if moving {
-                    // Aligned while moving, the attitude navigator's covariance holds only as
-                    // far as its motion model did (a vehicle's sustained accelerations break
-                    // it): its tilt, heading and biases are widened by their priors.
-                    ins.widen_attitude(T::lit(MOVING_TILT_SIGMA), T::lit(MOVING_YAW_SIGMA))?;
-                    ins.widen_biases(c.gyro_bias_sigma, c.accelerometer_bias_sigma)?;
-                }
-                Ok(ins)
-            });
+        let (gyro_bias_sigma, accel_bias_sigma) = (
+            self.config.attitude.gyro_bias_sigma,
+            self.config.attitude.accelerometer_bias_sigma,
+        );
+        // The attitude filter lives where the INS will: copied out first (a 9-state filter),
+        // so that the INS is built in place rather than beside it. What the in-place start
+        // checks is checked here, before the alignment is given up (the attitude filter's own
+        // state is finite, an invariant of the filter).
+        let aligned = *filter;
+        let square = |s: T| s * s;
+        let ok = all_finite(v.as_slice())
+            && all_finite(p.as_slice())
+            && carry.is_finite()
+            && positive_finite(square(sigma_v))
+            && positive_finite(square(sigma_position));
+        let started = if ok {
+            self.mode = Mode::Running(Ins::unstarted(*aligned.config()));
+            match &mut self.mode {
+                Mode::Running(ins) => ins
+                    .restart_from_attitude_filter(&aligned, &carry, v, p, sigma_v, sigma_position)
+                    .and_then(|()| {
+                        if moving {
+                            // Aligned while moving, the attitude navigator's covariance holds
+                            // only as far as its motion model did (a vehicle's sustained
+                            // accelerations break it): its tilt, heading and biases are
+                            // widened by their priors.
+                            ins.widen_attitude(
+                                T::lit(MOVING_TILT_SIGMA),
+                                T::lit(MOVING_YAW_SIGMA),
+                            )?;
+                            ins.widen_biases(gyro_bias_sigma, accel_bias_sigma)?;
+                        }
+                        Ok(())
+                    }),
+                Mode::Aligning(_) => Ok(()),
+            }
+        } else {
+            Err(crate::eskf::EskfError::NonFinite)
+        };
         match started {
-            Ok(ins) => {
-                self.mode = Mode::Running(ins);
+            Ok(()) => {
                 // Every aid starts counted as heard from now (the magnetometer fed the
                 // alignment until now).
                 self.last_due = [self.filter_t; 3];
@@ -87,6 +146,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
 
     /// Back to aligning after an IMU gap: the buffers are emptied (their samples and
     /// measurements belong to the time before the gap) and the report says nothing is valid.
+    #[cold]
+    #[inline(never)] // rare: its new attitude navigator stays out of every IMU call's frame
     pub(super) fn restart(&mut self) {
         if let Ok(att) = AttitudeNavigator::new(self.config.attitude) {
             self.mode = Mode::Aligning(att);
@@ -100,6 +161,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         self.last_sample = None;
         self.gnss = super::GnssTrack::default();
         self.stuck.since = [None; 3];
+        self.stuck.invalid_until = None;
         self.last_due = [None; 3];
         self.last_measured = [None; 3];
         self.aid_interval = [None; 3];

@@ -9,7 +9,7 @@ use crate::kernels::block::block;
 use crate::kernels::mat3;
 use crate::nav::attitude::{Reason, Validity};
 use crate::Real;
-use nalgebra::Matrix3;
+use nalgebra::SMatrix;
 
 /// Valid when `variance ≤ limit²`.
 fn within<T: Real>(variance: T, limit: T) -> Validity {
@@ -20,9 +20,11 @@ fn within<T: Real>(variance: T, limit: T) -> Validity {
     }
 }
 
-/// The largest diagonal entry.
-fn largest<T: Real>(m: &Matrix3<T>) -> T {
-    m.m11.max(m.m22).max(m.m33)
+/// The largest variance of block `b` of the 15-state `P` (its diagonal only, read in place).
+fn largest<T: Real>(p: &SMatrix<T, 15, 15>, b: usize) -> T {
+    (0..3).fold(T::zero(), |m, k| {
+        p.get((3 * b + k, 3 * b + k)).map_or(m, |d| m.max(*d))
+    })
 }
 
 impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
@@ -64,21 +66,31 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             Mode::Running(ins) => {
                 let p = ins.covariance();
                 let r = ins.state().attitude.rotation_matrix();
-                // World-frame attitude covariance R P_θθ Rᵀ: tilt on x, y; heading on z (up).
-                let w = mat3::mul(&mat3::mul(&r, &block(p, 0, 0)), &r.transpose());
-                v.tilt = within(w.m11.max(w.m22), c.tilt_valid_sigma);
-                v.heading = within(w.m33, c.heading_valid_sigma);
-                v.velocity = within(largest(&block(p, 1, 1)), c.velocity_valid_sigma);
+                // The world-frame attitude variances, `W_kk = r_kᵀ P_θθ r_k` with `r_k` row k
+                // of R (the diagonal of R P_θθ Rᵀ, without the whole product): tilt on x, y;
+                // heading on z (up).
+                let ptt = block(p, 0, 0);
+                let world = |k: usize| {
+                    let row = r.row(k).transpose();
+                    row.dot(&mat3::mul_vec(&ptt, &row))
+                };
+                v.tilt = within(world(0).max(world(1)), c.tilt_valid_sigma);
+                v.heading = within(world(2), c.heading_valid_sigma);
+                v.velocity = within(largest(p, 1), c.velocity_valid_sigma);
                 v.position = if self.gnss.rejected >= DISAGREEING_FIXES {
                     Validity::Invalid(Reason::FixesDisagree)
                 } else if self.gnss.unconfirmed {
                     Validity::Invalid(Reason::Reset)
                 } else {
-                    within(largest(&block(p, 2, 2)), c.position_valid_sigma)
+                    within(largest(p, 2), c.position_valid_sigma)
                 };
-                v.gyro_bias = within(largest(&block(p, 3, 3)), c.gyro_bias_valid_sigma);
-                v.accel_bias = within(largest(&block(p, 4, 4)), c.accel_bias_valid_sigma);
-                if self.report.imu_fault {
+                v.gyro_bias = within(largest(p, 3), c.gyro_bias_valid_sigma);
+                v.accel_bias = within(largest(p, 4), c.accel_bias_valid_sigma);
+                let held = self
+                    .stuck
+                    .invalid_until
+                    .is_some_and(|until| self.report.t_ns < until);
+                if self.report.imu_fault || held {
                     v.velocity = Validity::Invalid(Reason::ImuFault);
                     v.position = Validity::Invalid(Reason::ImuFault);
                 }

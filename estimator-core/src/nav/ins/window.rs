@@ -28,7 +28,10 @@
 //!
 //! Removal rounds a little every step; so a second window (`fresh`) integrates only new
 //! samples, and replaces the first when the filter reaches its start (every horizon), which
-//! bounds the rounding to that of one horizon's steps. Each window integrates with one fixed
+//! bounds the rounding to that of one horizon's steps. For the same reason the rotation is not
+//! renormalized per step: a product of at most two horizons' unit quaternions (128 at 200 Hz)
+//! departs from unit norm by about 128 ε (2·10⁻⁵ in `f32`), and the estimate renormalizes the
+//! attitude it reports. Each window integrates with one fixed
 //! bias, the filter's when it began, so that removal undoes exactly what was added.
 
 use crate::kernels::mat3;
@@ -90,7 +93,7 @@ impl<T: Real> Increment<T> {
         let r = self.rotation.rotation_matrix();
         self.position += self.velocity * s.dt + mat3::mul_vec(&r, &dp);
         self.velocity += mat3::mul_vec(&r, &dv);
-        self.rotation = self.rotation.compose(&dr).renormalize();
+        self.rotation = self.rotation.compose(&dr);
         self.duration += s.dt;
     }
 
@@ -101,7 +104,7 @@ impl<T: Real> Increment<T> {
         let rest = self.duration - s.dt;
         self.position = back.act(&(self.position - dp - dv * rest));
         self.velocity = back.act(&(self.velocity - dv));
-        self.rotation = back.compose(&self.rotation).renormalize();
+        self.rotation = back.compose(&self.rotation);
         self.duration = if rest > T::zero() { rest } else { T::zero() };
     }
 }

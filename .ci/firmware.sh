@@ -153,7 +153,7 @@ else
     || { cat "$OUT/nopanic-selftest.log"; fail "no-panic self-test failed for another reason"; }
 fi
 
-# The starter (src/bin/starter.rs): the navigator and the 15-state filter in a main loop, the file
+# The starter (src/bin/starter.rs): the attitude and INS navigators in a main loop, the file
 # a user copies. It must build and pass its own check under QEMU.
 step "starter firmware: builds, runs under QEMU, passes its check"
 if cargo build-m4 --release --bin starter 2> "$OUT/starter.log" \

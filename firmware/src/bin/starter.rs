@@ -1,4 +1,4 @@
-//! A starting point for firmware: the attitude navigator and the 15-state filter in a main loop,
+//! A starting point for firmware: the attitude navigator and the INS navigator in a main loop,
 //! fed one timestamped sample at a time, every outcome handled, the estimate printed once a
 //! second over semihosting. Copy this file, replace [`Board`] by your drivers and the prints by
 //! your telemetry.
@@ -7,14 +7,17 @@
 //! `cargo build-m4 --release --bin starter` in `firmware/`, then
 //! `qemu-system-arm -machine mps2-an386 -cpu cortex-m4 -nographic -monitor none -serial none
 //! -semihosting-config enable=on,target=native -kernel target/thumbv7em-none-eabihf/release/starter`).
-//! It exits with status 0 when, after 10 s, the navigator reports a valid tilt and heading
-//! within 2° of the stand-in's truth and the 15-state filter has started.
+//! It exits with status 0 when, after 10 s, the attitude navigator reports a valid tilt and
+//! heading within 2° of the stand-in's truth and the INS navigator a valid position within 2 m
+//! of it.
 //!
 //! * `AttitudeNavigator` owns its `AhrsAccelBias` filter, its start-up, what it fuses and when,
 //!   rest detection and magnetic disturbances; the loop only passes samples and reads reports.
-//! * `Ins` is a filter: the loop predicts with every IMU interval, updates with every GNSS fix
-//!   and decides what to do with each outcome (gated out: log; refused: log, the filter is
-//!   unchanged).
+//! * `InsNavigator` owns the 15-state filter: it aligns until the first fix, fuses every
+//!   measurement at the time it was valid (a fix read now describes the time the receiver's
+//!   latency ago: stamp it with that time), handles frozen, jumping and drifting fixes and IMU
+//!   faults, and reports each quantity's validity after every call. A device with GNSS needs only
+//!   this one; the attitude navigator is for a device without.
 //! * The noise values come from the sensor (`host-sim calibrate` measures them from a static
 //!   recording); the navigator's other parameters are explained in the `nav` module docs of
 //!   `estimator-core` (its tuning guide).
@@ -26,18 +29,19 @@ mod vectors;
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
-use estimator_core::eskf::{
-    Alignment, FilterConfig, GnssPosition, ImuNoise, ImuSample, InitialSigmas, Ins, UpdateOptions,
-    UpdateOutcome,
-};
+use estimator_core::eskf::{FilterConfig, ImuNoise};
 use estimator_core::lie::{LieGroup, So3};
-use estimator_core::nav::{AttitudeConfig, AttitudeNavigator, MagneticConfig};
+use estimator_core::nav::{
+    AttitudeConfig, AttitudeNavigator, GnssFix, InsConfig, InsNavigator, MagneticConfig, NavError,
+};
 use nalgebra::Vector3;
 
 const IMU_HZ: u64 = 200;
 const STEP_NS: u64 = 1_000_000_000 / IMU_HZ;
 /// The world magnetic field, µT, ENU (north along `y`, pointing down).
 const FIELD: [f32; 3] = [0.0, 20.0, -45.0];
+/// The stand-in receiver's latency: a fix arrives this long after the time it describes, ns.
+const GNSS_LATENCY_NS: u64 = 200_000_000;
 
 /// The stand-in for the drivers: a level body at rest for 2 s, then turning about the vertical
 /// at 10 °/s, read by an IMU at 200 Hz, a magnetometer at 50 Hz and GNSS at 5 Hz, with a small
@@ -122,10 +126,11 @@ fn main() -> ! {
     let Ok(mut nav) = AttitudeNavigator::new(config) else {
         finish(false, "navigator configuration refused");
     };
-    let mut ins: Option<Ins<f32>> = None;
-    let options = UpdateOptions::default();
+    // The INS navigator: the same attitude configuration (it aligns with it until the first fix).
+    let Ok(mut ins) = InsNavigator::<f32>::new(InsConfig::new(config)) else {
+        finish(false, "INS navigator configuration refused");
+    };
     let mut board = Board { k: 0 };
-    let mut last_t: Option<u64> = None;
 
     while board.k < 10 * IMU_HZ {
         let (t_ns, gyro, accel) = board.imu();
@@ -143,36 +148,27 @@ fn main() -> ! {
                 hprintln!("magnetometer sample refused: {}", e);
             }
         }
-        if let (Some(f), Some(t0)) = (ins.as_mut(), last_t) {
-            let dt = (t_ns - t0) as f32 * 1e-9;
-            if let Err(e) = f.predict(&ImuSample { gyro, accel, dt }) {
-                hprintln!("INS prediction refused: {}", e);
+        match ins.imu(t_ns, &gyro, &accel) {
+            Ok(report) => {
+                if let Some(event) = report.event {
+                    hprintln!("{} ms INS: {:?}", t_ns / 1_000_000, event);
+                }
+            }
+            Err(e) => hprintln!("INS: IMU sample refused: {}", e),
+        }
+        if let Some(field) = board.magnetometer() {
+            if let Err(e) = ins.magnetometer(t_ns, &field) {
+                hprintln!("INS: magnetometer sample refused: {}", e);
             }
         }
-        last_t = Some(t_ns);
-        if let Some(fix) = board.gnss() {
-            match ins.as_mut() {
-                Some(f) => match f.update(&GnssPosition::new(fix, Vector3::zeros(), 1.0), &options)
-                {
-                    Ok(UpdateOutcome::Accepted { .. }) => {}
-                    Ok(UpdateOutcome::Rejected { .. }) => hprintln!("GNSS fix gated out"),
-                    Err(e) => hprintln!("GNSS fix refused: {}", e),
-                },
-                // The INS starts from the navigator's attitude once its tilt is valid.
-                None => {
-                    if let (Some(e), true) = (nav.estimate(), nav.report().tilt.is_valid()) {
-                        let alignment = Alignment {
-                            attitude: e.attitude,
-                            gyro_bias: e.gyro_bias,
-                            heading_from_magnetometer: nav.report().heading.is_valid(),
-                        };
-                        let sigmas = InitialSigmas::default();
-                        match Ins::from_alignment(&alignment, fix, &sigmas, filter) {
-                            Ok(f) => ins = Some(f),
-                            Err(e) => hprintln!("INS start refused: {}", e),
-                        }
-                    }
-                }
+        if let Some(position) = board.gnss() {
+            // The stand-in's receiver delivers its fix 0.2 s after the time it describes.
+            let fix = GnssFix::new(position, Some(Vector3::zeros()), 1.0, 0.1);
+            match ins.gnss(t_ns.saturating_sub(GNSS_LATENCY_NS), &fix) {
+                Ok(_) => {}
+                // Older than the horizon (a fix before the filter's start): dropped.
+                Err(NavError::TooOld) => hprintln!("GNSS fix older than the horizon"),
+                Err(e) => hprintln!("GNSS fix refused: {}", e),
             }
         }
         if board.k.is_multiple_of(IMU_HZ) {
@@ -197,13 +193,17 @@ fn main() -> ! {
         Some(e) => {
             let truth = So3::exp(&Vector3::new(0.0, 0.0, Board::yaw(board.k)));
             let error = e.attitude.inverse().compose(&truth).log().norm();
-            report.tilt.is_valid() && report.heading.is_valid() && error < 0.035 && ins.is_some()
+            let position_ok = ins
+                .estimate()
+                .is_some_and(|e| e.state.position.norm() < 2.0)
+                && ins.report().validity.position.is_valid();
+            report.tilt.is_valid() && report.heading.is_valid() && error < 0.035 && position_ok
         }
         None => false,
     };
     finish(
         ok,
-        "after 10 s: attitude within 2°, tilt and heading valid, INS started",
+        "after 10 s: attitude within 2°, tilt and heading valid; INS position valid within 2 m",
     )
 }
 

@@ -47,7 +47,8 @@ pub enum Command {
     /// Simulate, filter, score and plot; prints a summary table.
     #[command(
         after_help = "Writes into --out: estimate.tum, estimate.csv, groundtruth.tum (TUM: t x y z qx qy qz qw), \
-metrics.json, trajectory.png, errors.png, biases.png, nis.png, and dataset/ (the simulated EuRoC-layout dataset).\n\n\
+metrics.json, validity.csv (with GNSS: the INS navigator's report after every IMU sample), trajectory.png, errors.png, \
+biases.png, nis.png, and dataset/ (the simulated EuRoC-layout dataset).\n\n\
 Example: host-sim run --scenario handheld_ahrs --seed 2 --out out/ahrs"
     )]
     Run {

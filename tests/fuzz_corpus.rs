@@ -97,6 +97,11 @@ fn corpus_navigator() {
 }
 
 #[test]
+fn corpus_ins() {
+    corpus("ins");
+}
+
+#[test]
 fn corpus_lie() {
     corpus("lie");
 }

@@ -29,6 +29,7 @@
 mod dataset;
 mod filters;
 pub mod input;
+mod ins;
 mod lie;
 mod navigator;
 mod solver;
@@ -182,6 +183,14 @@ pub fn run_navigator(data: &[u8]) -> Outcome {
     navigator::run(data)
 }
 
+/// The INS target: `InsNavigator<f32/f64>` with the default ring and queue or a ring of 8 and
+/// a queue of 4, an arbitrary configuration, and a simulated vehicle's IMU, GNSS, magnetometer
+/// and barometer streams (delayed, out of order, with faults) interleaved with arbitrary
+/// samples at arbitrary times.
+pub fn run_ins(data: &[u8]) -> Outcome {
+    ins::run(data)
+}
+
 /// The Lie-group target: every operation of SO(2), SE(2), SO(3), SE(3) in `f32` and `f64`.
 pub fn run_lie(data: &[u8]) -> Outcome {
     lie::run(data)
@@ -199,9 +208,10 @@ pub fn run_dataset(data: &[u8]) -> Outcome {
 }
 
 /// The targets by name, for the replay.
-pub const TARGETS: [(&str, Run); 5] = [
+pub const TARGETS: [(&str, Run); 6] = [
     ("filters", run_filters),
     ("navigator", run_navigator),
+    ("ins", run_ins),
     ("lie", run_lie),
     ("solver", run_solver),
     ("dataset", run_dataset),

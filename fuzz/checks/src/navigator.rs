@@ -29,7 +29,9 @@ pub(crate) fn run(data: &[u8]) -> Outcome {
     log.finish()
 }
 
-fn config<T: Scalar>(input: &mut Input<'_>) -> AttitudeConfig<T> {
+/// An attitude configuration: a mask of fields drawn, the rest default (the INS target draws
+/// its alignment's with it too).
+pub(crate) fn config<T: Scalar>(input: &mut Input<'_>) -> AttitudeConfig<T> {
     let mut c = AttitudeConfig::new(FilterConfig::default());
     let mask = input.u32();
     let draw = |input: &mut Input<'_>, bit: u32| -> Option<T> {

@@ -192,7 +192,7 @@ fn ins_navigator_refusals_leave_it_unchanged() {
     );
     let nan = Vector3::new(f64::NAN, 0.0, 0.0);
     let before = nav;
-    let cases: [(&str, Result<(), NavError>, NavError); 8] = [
+    let cases: [(&str, Result<(), NavError>, NavError); 11] = [
         (
             "too old",
             nav.gnss(t_new - 400_000_000, &fix).map(|_| ()),
@@ -250,6 +250,34 @@ fn ins_navigator_refusals_leave_it_unchanged() {
             NavError::TimeNotIncreasing,
         ),
         (
+            "1 µm position sigma",
+            nav.gnss(
+                t_new,
+                &GnssFix {
+                    sigma_position: 1e-6,
+                    ..fix
+                },
+            )
+            .map(|_| ()),
+            NavError::InvalidSigma,
+        ),
+        (
+            "a gyro at 1e4 rad/s",
+            nav.imu(t_new + IMU_NS, &Vector3::new(0.0, 0.0, 1e4), &Vector3::z())
+                .map(|_| ()),
+            NavError::OutOfRange,
+        ),
+        (
+            "an accelerometer at 1e28 m/s²",
+            nav.imu(
+                t_new + IMU_NS,
+                &Vector3::zeros(),
+                &Vector3::new(0.0, 0.0, 1e28),
+            )
+            .map(|_| ()),
+            NavError::OutOfRange,
+        ),
+        (
             "non-finite IMU",
             nav.imu(t_new + IMU_NS, &nan, &Vector3::z()).map(|_| ()),
             NavError::NonFinite,
@@ -259,7 +287,7 @@ fn ins_navigator_refusals_leave_it_unchanged() {
         assert_eq!(got, Err(want), "{what}");
     }
     // Bit for bit what it was, but for the refusal counter.
-    assert_eq!(nav.counters().refused, before.counters().refused + 8);
+    assert_eq!(nav.counters().refused, before.counters().refused + 11);
     let without_count = |n: &InsNavigator<f64>| {
         format!("{n:?}").replace(&format!("refused: {}", n.counters().refused), "")
     };

@@ -8,6 +8,9 @@ use crate::eskf::EskfError;
 pub enum NavError {
     /// A NaN or infinite value in the sample.
     NonFinite,
+    /// An IMU sample beyond any sensor's range ([`IMU_RATE_LIMIT`](crate::nav::IMU_RATE_LIMIT),
+    /// [`IMU_ACCEL_LIMIT`](crate::nav::IMU_ACCEL_LIMIT)): a fault, not a measurement.
+    OutOfRange,
     /// An all-zero accelerometer or magnetometer sample: no sensor reads exactly zero on
     /// every axis, so the sample is taken for a fault.
     ZeroVector,
@@ -34,6 +37,7 @@ impl core::fmt::Display for NavError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             Self::NonFinite => f.write_str("non-finite value in the sample"),
+            Self::OutOfRange => f.write_str("IMU sample beyond any sensor's range"),
             Self::ZeroVector => f.write_str("all-zero sample"),
             Self::TimeNotIncreasing => f.write_str("timestamp is not after the previous one"),
             Self::InvalidConfig => f.write_str("configuration value out of its domain"),

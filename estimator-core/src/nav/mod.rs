@@ -43,11 +43,34 @@
 //! ANEES (3 for a consistent filter: much above, the noise values are too small; much below,
 //! too large), and `host-sim bench` runs every dataset under a folder.
 
+/// The largest IMU rate a navigator takes, rad/s (about 11,500 °/s, above every MEMS gyro's
+/// range): a larger finite sample is a fault, refused with [`NavError::OutOfRange`].
+pub const IMU_RATE_LIMIT: f64 = 200.0;
+
+/// The largest specific force a navigator takes, m/s² (about 510 g, above every MEMS
+/// accelerometer's range), refused beyond like [`IMU_RATE_LIMIT`].
+pub const IMU_ACCEL_LIMIT: f64 = 5_000.0;
+
+/// The range of gravity's norm a navigator's configuration may give, m/s² (the Moon's 1.6 to
+/// Jupiter's 25 fit; a gravity of 10²⁹ is a mistake).
+pub const GRAVITY_MIN: f64 = 0.5;
+/// See [`GRAVITY_MIN`].
+pub const GRAVITY_MAX: f64 = 50.0;
+
+/// A GNSS fix's position 1σ a navigator takes, m: from 1 mm (better than RTK) to 10 km.
+/// Outside it the 15-state covariance mixes scales `f32` cannot hold (a 1 µm position beside a
+/// 1 km/s velocity), and the fix is refused with [`NavError::InvalidSigma`].
+pub const FIX_POSITION_SIGMA: [f64; 2] = [1e-3, 1e4];
+/// A GNSS fix's velocity 1σ a navigator takes, m/s (1 mm/s to 100 m/s), as
+/// [`FIX_POSITION_SIGMA`].
+pub const FIX_VELOCITY_SIGMA: [f64; 2] = [1e-3, 100.0];
+
 mod attitude;
 mod clock;
 mod error;
 mod ins;
 mod mean;
+mod sample;
 
 pub use attitude::{
     AttitudeConfig, AttitudeEstimate, AttitudeNavigator, AttitudeReport, Counters, Event, Fusion,

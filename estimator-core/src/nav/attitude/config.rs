@@ -177,7 +177,9 @@ impl<T: Real> AttitudeConfig<T> {
 
     /// `Ok` when every value is in its domain: the filter configuration valid, every time and
     /// sigma positive (the gyro bias, scale and heading sigmas may be 0), `max_rejected_blocks ≥ 1`, and the block and
-    /// start-up shorter than 4 s (their length in nanoseconds fits 32 bits).
+    /// start-up shorter than 4 s (their length in nanoseconds fits 32 bits); a gravity whose
+    /// norm is between [`GRAVITY_MIN`](crate::nav::GRAVITY_MIN) and
+    /// [`GRAVITY_MAX`](crate::nav::GRAVITY_MAX).
     ///
     /// # Errors
     /// [`NavError::InvalidConfig`], or the filter's own error.
@@ -200,7 +202,12 @@ impl<T: Real> AttitudeConfig<T> {
             && self.max_rejected_blocks >= 1
             && positive_finite(self.tilt_valid_sigma)
             && positive_finite(self.heading_valid_sigma)
-            && self.filter.max_dt < four_seconds;
+            && self.filter.max_dt < four_seconds
+            && crate::nav::sample::within_limits(
+                crate::kernels::mat3::norm(&self.filter.gravity),
+                crate::nav::GRAVITY_MIN,
+                crate::nav::GRAVITY_MAX,
+            );
         if !ok {
             return Err(NavError::InvalidConfig);
         }

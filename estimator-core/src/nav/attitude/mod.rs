@@ -41,10 +41,11 @@ pub use report::{
 };
 
 use crate::eskf::{AhrsAccelBias, AhrsAccelBiasState, ImuSample};
-use crate::kernels::{all_finite, mat3};
+use crate::kernels::mat3;
 use crate::lie::{LieGroup, So3};
 use crate::nav::clock::{Clock, Tick};
 use crate::nav::error::NavError;
+use crate::nav::sample::{check_imu, check_vector};
 use crate::Real;
 use block::Block;
 use magnetic::Magnetic;
@@ -319,10 +320,7 @@ impl<T: Real> AttitudeNavigator<T> {
         gyro: &Vector3<T>,
         accel: &Vector3<T>,
     ) -> Result<(), NavError> {
-        if !all_finite(gyro.as_slice()) {
-            return Err(NavError::NonFinite);
-        }
-        check_vector(accel)?;
+        check_imu(gyro, accel)?;
         let tick = self.imu_clock.tick(t_ns, self.durations.max_step)?;
         let mut event = None;
         let dt_ns = match tick {
@@ -622,16 +620,5 @@ impl<T: Real> AttitudeNavigator<T> {
         } else {
             Validity::Invalid(Reason::Uncertain)
         };
-    }
-}
-
-/// `Ok` for a finite vector that is not all zero.
-fn check_vector<T: Real>(v: &Vector3<T>) -> Result<(), NavError> {
-    if !all_finite(v.as_slice()) {
-        Err(NavError::NonFinite)
-    } else if v.x == T::zero() && v.y == T::zero() && v.z == T::zero() {
-        Err(NavError::ZeroVector)
-    } else {
-        Ok(())
     }
 }

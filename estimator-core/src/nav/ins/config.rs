@@ -76,15 +76,18 @@ impl<T: Real> InsConfig<T> {
     }
 
     /// `Ok` when every value is in its domain: the attitude configuration valid; `horizon_s`
-    /// in `[0, 10]` s; the lever arm finite; a barometer sigma positive; ranges, stuck time and
-    /// thresholds not negative; `gnss_reset_s` positive.
+    /// in `[0, 10]` s; the lever arm finite; ranges, stuck time and
+    /// thresholds not negative; `gnss_reset_s` positive; a barometer sigma between 1 mm and
+    /// 1 km.
     ///
     /// # Errors
     /// [`NavError::InvalidConfig`] (or the attitude configuration's error).
     pub fn validate(&self) -> Result<(), NavError> {
         self.attitude.validate()?;
         let horizon = non_negative_finite(self.horizon_s) && self.horizon_s <= T::lit(10.0);
-        let baro = self.barometer_sigma.is_none_or(positive_finite);
+        let baro = self
+            .barometer_sigma
+            .is_none_or(|s| crate::nav::sample::within_limits(s, 1e-3, 1e3));
         let non_negative = [
             self.accelerometer_range,
             self.gyro_range,

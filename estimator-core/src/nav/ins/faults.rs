@@ -63,7 +63,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// another axis changes). A faulty sample widens the filter by what it may hide: the
     /// velocity by `σ = a_max dt` for a saturated accelerometer (`a_max` the saturation
     /// level), the attitude by `σ = 2 ω_max dt` (tilt and heading; `ω_max` the largest rate
-    /// seen, at least 1 rad/s) for a saturated or stuck gyro.
+    /// seen, at least 1 rad/s; never past a variance of π² per axis) for a saturated or stuck gyro.
     pub(super) fn check_imu_faults(
         &mut self,
         t_ns: u64,
@@ -125,7 +125,22 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             failed |= ins.widen_velocity(accel_range * dt).is_err();
         }
         if gyro_clipped || stuck {
-            failed |= ins.widen_attitude(rate * dt, rate * dt).is_err();
+            // Widened by `rate · dt`, but never beyond a variance of π² per axis: past it the
+            // attitude is unknown, and a larger number only costs precision.
+            let p = ins.covariance();
+            let largest = (0..3).fold(T::zero(), |m, k| p.get((k, k)).map_or(m, |d| m.max(*d)));
+            let room = T::pi() * T::pi() - largest;
+            let step = rate * dt;
+            let sigma = if step * step <= room {
+                step
+            } else if room > T::zero() {
+                room.sqrt_rn()
+            } else {
+                T::zero()
+            };
+            if sigma > T::zero() {
+                failed |= ins.widen_attitude(sigma, sigma).is_err();
+            }
         }
         if failed {
             self.counters.numerical_failures = self.counters.numerical_failures.saturating_add(1);

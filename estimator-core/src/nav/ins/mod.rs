@@ -73,11 +73,13 @@ pub use report::{
 
 use crate::eskf::{ImuSample, Ins};
 use crate::kernels::block::block;
-use crate::kernels::{all_finite, mat3, positive_finite};
+use crate::kernels::{all_finite, mat3};
 use crate::lie::{skew, LieGroup};
 use crate::nav::attitude::{AttitudeNavigator, Reason, Validity};
 use crate::nav::clock::{Clock, Tick};
 use crate::nav::error::NavError;
+use crate::nav::sample::{check_imu, check_vector, within_limits};
+use crate::nav::{FIX_POSITION_SIGMA, FIX_VELOCITY_SIGMA};
 use crate::Real;
 use buffer::{Aid, AidQueue, ImuRing, QueueError, Queued};
 use nalgebra::{Matrix3, Vector3};
@@ -436,7 +438,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     ///
     /// # Errors
     /// [`NavError::NonFinite`], [`NavError::ZeroVector`] (an all-zero accelerometer),
-    /// [`NavError::TimeNotIncreasing`]; the navigator is then unchanged. A numerical failure of
+    /// [`NavError::OutOfRange`], [`NavError::TimeNotIncreasing`]; the navigator is then
+    /// unchanged. A numerical failure of
     /// the filter is counted, not returned: the step is skipped.
     pub fn imu(
         &mut self,
@@ -444,11 +447,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         gyro: &Vector3<T>,
         accel: &Vector3<T>,
     ) -> Result<InsReport<T>, NavError> {
-        let checked = if all_finite(gyro.as_slice()) {
-            check_vector(accel).and_then(|()| self.imu_clock.tick(t_ns, self.max_step_ns))
-        } else {
-            Err(NavError::NonFinite)
-        };
+        let checked =
+            check_imu(gyro, accel).and_then(|()| self.imu_clock.tick(t_ns, self.max_step_ns));
         let tick = match checked {
             Ok(tick) => tick,
             Err(e) => {
@@ -522,16 +522,18 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// Takes one GNSS fix, valid at `t_ns` (the time of the fix, not of its arrival).
     ///
     /// # Errors
-    /// [`NavError::NonFinite`]; [`NavError::InvalidSigma`] for a sigma that is not positive;
+    /// [`NavError::NonFinite`]; [`NavError::InvalidSigma`] for a sigma outside
+    /// [`FIX_POSITION_SIGMA`](crate::nav::FIX_POSITION_SIGMA) or
+    /// [`FIX_VELOCITY_SIGMA`](crate::nav::FIX_VELOCITY_SIGMA);
     /// [`NavError::TooOld`] for a fix the filter has passed (older than the horizon);
     /// [`NavError::InFuture`] for one stamped after the newest IMU sample by more than
     /// `max_dt`; [`NavError::QueueFull`], or [`NavError::TimeNotIncreasing`] for a second fix
     /// with the same time; the navigator is then unchanged.
     pub fn gnss(&mut self, t_ns: u64, fix: &GnssFix<T>) -> Result<InsReport<T>, NavError> {
         let velocity_ok = fix.velocity.is_none_or(|v| all_finite(v.as_slice()));
-        let positive = |s: T| positive_finite(s) && positive_finite(s * s);
-        let sigmas_ok = positive(fix.sigma_position)
-            && (fix.velocity.is_none() || positive(fix.sigma_velocity));
+        let in_range = |s: T, [min, max]: [f64; 2]| within_limits(s, min, max);
+        let sigmas_ok = in_range(fix.sigma_position, FIX_POSITION_SIGMA)
+            && (fix.velocity.is_none() || in_range(fix.sigma_velocity, FIX_VELOCITY_SIGMA));
         let checked = if !(all_finite(fix.position.as_slice()) && velocity_ok) {
             Err(NavError::NonFinite)
         } else if !sigmas_ok {
@@ -757,16 +759,5 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
                 Aid::Barometer(altitude) => self.fuse_barometer(item.t_ns, dt, altitude),
             },
         }
-    }
-}
-
-/// `Ok` for a finite vector that is not all zero.
-fn check_vector<T: Real>(v: &Vector3<T>) -> Result<(), NavError> {
-    if !all_finite(v.as_slice()) {
-        Err(NavError::NonFinite)
-    } else if v.x == T::zero() && v.y == T::zero() && v.z == T::zero() {
-        Err(NavError::ZeroVector)
-    } else {
-        Ok(())
     }
 }

@@ -2,10 +2,10 @@
 //! or camera): every sample goes to [`AttitudeNavigator`], exactly as a firmware main loop
 //! would call it; this file only reads, writes and scores.
 
-use super::output::{write_estimate_csv, write_tum, Partials, TruthCursor};
-use super::{lit3, out_err, up3, ReplayConfig, ReplayError};
+use super::output::{EstimateFiles, Partials};
+use super::{lit3, up3, ReplayConfig, ReplayError};
 use crate::baseline::{Madgwick, Mahony};
-use crate::dataset::read::{Dataset, Event, TruthStream};
+use crate::dataset::read::{Dataset, Event};
 use crate::metrics::{Estimate, Outcome, Scorer};
 use estimator_core::eskf::{FilterConfig, ImuNoise};
 use estimator_core::nav::{
@@ -14,9 +14,7 @@ use estimator_core::nav::{
 };
 use estimator_core::Real;
 use nalgebra::{Matrix3, Vector3};
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 /// The navigator's configuration from the dataset's sensor files and the replay options.
@@ -119,30 +117,7 @@ pub(super) fn replay_attitude<T: Real>(
         .map_err(|e| ReplayError::Config(format!("navigator: {e}")))?;
     let mut partials = Partials::new(out);
     partials.clear_previous();
-    let open = |name: &str| -> Result<(BufWriter<File>, PathBuf), ReplayError> {
-        let p = out.join(format!("{name}.partial"));
-        File::create(&p)
-            .map(|f| (BufWriter::new(f), p.clone()))
-            .map_err(|e| ReplayError::Output {
-                path: p,
-                message: e.to_string(),
-            })
-    };
-    let (mut tum, tum_path) = open("estimate.tum")?;
-    let (mut csv, csv_path) = open("estimate.csv")?;
-    super::write_csv_header(&mut csv).map_err(out_err(&csv_path))?;
-    let mut truth = if ds.has_groundtruth {
-        let (gt_tum, gt_path) = open("groundtruth.tum")?;
-        Some(TruthCursor {
-            stream: TruthStream::open(dir)?,
-            prev: None,
-            next: None,
-            tum: gt_tum,
-            tum_path: gt_path,
-        })
-    } else {
-        None
-    };
+    let mut files = EstimateFiles::open(out, dir, ds.has_groundtruth)?;
     let mut baselines: Option<(Madgwick, Mahony)> = None;
     // The heading is one number; the whole field three.
     let mag_dof = if cfg.magnetometer_vector { 3 } else { 1 };
@@ -176,17 +151,7 @@ pub(super) fn replay_attitude<T: Real>(
                     }
                     (None, None) => {}
                 }
-                write_tum(&mut tum, t_ns, &e.position, &e.attitude).map_err(out_err(&tum_path))?;
-                write_estimate_csv(&mut csv, &e).map_err(out_err(&csv_path))?;
-                if let Some(tr) = truth.as_mut() {
-                    if let Some(t) = tr.at(t_ns)? {
-                        scorer.add(&e, &t);
-                        if let Some((mw, mh)) = &baselines {
-                            scorer.add_baseline("madgwick", &mw.attitude, &t);
-                            scorer.add_baseline("mahony", &mh.attitude, &t);
-                        }
-                    }
-                }
+                files.add(&mut scorer, &e, baselines.as_ref())?;
             }
             Event::Mag { t_ns, field } => {
                 if let Some((mw, mh)) = baselines.as_mut() {
@@ -201,11 +166,7 @@ pub(super) fn replay_attitude<T: Real>(
             _ => {}
         }
     }
-    tum.flush().map_err(out_err(&tum_path))?;
-    csv.flush().map_err(out_err(&csv_path))?;
-    if let Some(tr) = truth.as_mut() {
-        tr.finish()?;
-    }
+    files.finish()?;
     super::finish(out, cfg, title, ds, &scorer)?;
     partials.commit()?;
     Ok(scorer)

@@ -4,10 +4,10 @@
 //! receiver's `latency_s`); this file only reads, writes and scores.
 
 use super::attitude::navigator_config;
-use super::output::{write_estimate_csv, write_tum, Partials, TruthCursor};
+use super::output::{open_partial, EstimateFiles, Partials};
 use super::{lit3, out_err, up3, ReplayConfig, ReplayError};
 use crate::baseline::{Madgwick, Mahony};
-use crate::dataset::read::{Dataset, Event, TruthStream};
+use crate::dataset::read::{Dataset, Event};
 use crate::metrics::{Estimate, Outcome, Scorer};
 use estimator_core::nav::{
     AidStatus, Aiding, GnssFix, InsConfig, InsEvent, InsNavigator, InsReport, MagneticFusion,
@@ -15,9 +15,8 @@ use estimator_core::nav::{
 };
 use estimator_core::Real;
 use nalgebra::Matrix3;
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::io::Write;
+use std::path::Path;
 use std::time::Instant;
 
 /// The navigator's configuration from the dataset's sensor files and the replay options.
@@ -182,32 +181,9 @@ pub(super) fn replay_ins<T: Real>(
     };
     let mut partials = Partials::new(out);
     partials.clear_previous();
-    let open = |name: &str| -> Result<(BufWriter<File>, PathBuf), ReplayError> {
-        let p = out.join(format!("{name}.partial"));
-        File::create(&p)
-            .map(|f| (BufWriter::new(f), p.clone()))
-            .map_err(|e| ReplayError::Output {
-                path: p,
-                message: e.to_string(),
-            })
-    };
-    let (mut tum, tum_path) = open("estimate.tum")?;
-    let (mut csv, csv_path) = open("estimate.csv")?;
-    super::write_csv_header(&mut csv).map_err(out_err(&csv_path))?;
-    let (mut validity, validity_path) = open("validity.csv")?;
+    let mut files = EstimateFiles::open(out, dir, ds.has_groundtruth)?;
+    let (mut validity, validity_path) = open_partial(out, "validity.csv")?;
     writeln!(validity, "{VALIDITY_HEADER}").map_err(out_err(&validity_path))?;
-    let mut truth = if ds.has_groundtruth {
-        let (gt_tum, gt_path) = open("groundtruth.tum")?;
-        Some(TruthCursor {
-            stream: TruthStream::open(dir)?,
-            prev: None,
-            next: None,
-            tum: gt_tum,
-            tum_path: gt_path,
-        })
-    } else {
-        None
-    };
     let mut baselines: Option<(Madgwick, Mahony)> = None;
     let mut last_imu: Option<u64> = None;
     for ev in ds.events()? {
@@ -241,17 +217,7 @@ pub(super) fn replay_ins<T: Real>(
                     }
                     (None, None) => {}
                 }
-                write_tum(&mut tum, t_ns, &e.position, &e.attitude).map_err(out_err(&tum_path))?;
-                write_estimate_csv(&mut csv, &e).map_err(out_err(&csv_path))?;
-                if let Some(tr) = truth.as_mut() {
-                    if let Some(t) = tr.at(t_ns)? {
-                        scorer.add(&e, &t);
-                        if let Some((mw, mh)) = &baselines {
-                            scorer.add_baseline("madgwick", &mw.attitude, &t);
-                            scorer.add_baseline("mahony", &mh.attitude, &t);
-                        }
-                    }
-                }
+                files.add(&mut scorer, &e, baselines.as_ref())?;
                 continue;
             }
             Event::Mag { t_ns, field } => {
@@ -287,12 +253,8 @@ pub(super) fn replay_ins<T: Real>(
         }
         scorer.filter_ns += started.elapsed().as_nanos();
     }
-    tum.flush().map_err(out_err(&tum_path))?;
-    csv.flush().map_err(out_err(&csv_path))?;
+    files.finish()?;
     validity.flush().map_err(out_err(&validity_path))?;
-    if let Some(tr) = truth.as_mut() {
-        tr.finish()?;
-    }
     if nav.estimate().is_none() {
         return Err(ReplayError::Start(format!(
             "the INS never started: no GNSS fix came due with the alignment ready ({} fixes unused)",

@@ -17,7 +17,7 @@
 //! 15-state filter here, started from a window at rest and a PnP pose of the first frame.
 
 use crate::baseline::{Madgwick, Mahony};
-use crate::dataset::read::{CameraParams, Dataset, Event, TruthStream};
+use crate::dataset::read::{CameraParams, Dataset, Event};
 use crate::dataset::DatasetError;
 use crate::metrics::trajectory::Delta;
 use crate::metrics::{Estimate, Metrics, Outcome, Scorer};
@@ -31,8 +31,7 @@ use estimator_core::lie::{LieGroup, Se3, So3};
 use estimator_core::Real;
 use nalgebra::{Matrix3, SMatrix, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -40,7 +39,7 @@ mod attitude;
 mod ins;
 mod output;
 
-use output::{write_estimate_csv, write_tum, Partials, TruthCursor};
+use output::{EstimateFiles, Partials};
 
 /// Replay options (a TOML file given with `--config`; every field optional).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -464,30 +463,7 @@ fn replay_in<T: Real>(
     // --- Outputs: written as `*.partial`, renamed only when the whole run succeeded. ---
     let mut partials = Partials::new(out);
     partials.clear_previous();
-    let open = |name: &str| -> Result<(BufWriter<File>, PathBuf), ReplayError> {
-        let p = out.join(format!("{name}.partial"));
-        File::create(&p)
-            .map(|f| (BufWriter::new(f), p.clone()))
-            .map_err(|e| ReplayError::Output {
-                path: p,
-                message: e.to_string(),
-            })
-    };
-    let (mut tum, tum_path) = open("estimate.tum")?;
-    let (mut csv, csv_path) = open("estimate.csv")?;
-    write_csv_header(&mut csv).map_err(out_err(&csv_path))?;
-    let mut truth = if ds.has_groundtruth {
-        let (gt_tum, gt_path) = open("groundtruth.tum")?;
-        Some(TruthCursor {
-            stream: TruthStream::open(dir)?,
-            prev: None,
-            next: None,
-            tum: gt_tum,
-            tum_path: gt_path,
-        })
-    } else {
-        None
-    };
+    let mut files = EstimateFiles::open(out, dir, ds.has_groundtruth)?;
 
     // --- The run. ---
     let ekf = UpdateOptions::<T>::default();
@@ -521,17 +497,7 @@ fn replay_in<T: Real>(
                 scorer.filter_ns += started.elapsed().as_nanos();
                 scorer.imu_samples += 1;
                 let e = filter.estimate(t_ns);
-                write_tum(&mut tum, t_ns, &e.position, &e.attitude).map_err(out_err(&tum_path))?;
-                write_estimate_csv(&mut csv, &e).map_err(out_err(&csv_path))?;
-                if let Some(tr) = truth.as_mut() {
-                    if let Some(t) = tr.at(t_ns)? {
-                        scorer.add(&e, &t);
-                        if let Some((mw, mh)) = &baselines {
-                            scorer.add_baseline("madgwick", &mw.attitude, &t);
-                            scorer.add_baseline("mahony", &mh.attitude, &t);
-                        }
-                    }
-                }
+                files.add(&mut scorer, &e, baselines.as_ref())?;
                 continue;
             }
             Event::Mag { t_ns, field } => {
@@ -584,11 +550,7 @@ fn replay_in<T: Real>(
         }
         scorer.filter_ns += started.elapsed().as_nanos();
     }
-    tum.flush().map_err(out_err(&tum_path))?;
-    csv.flush().map_err(out_err(&csv_path))?;
-    if let Some(tr) = truth.as_mut() {
-        tr.finish()?;
-    }
+    files.finish()?;
     finish(out, cfg, title, &ds, &scorer)?;
     partials.commit()?;
     Ok(scorer)

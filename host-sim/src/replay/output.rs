@@ -2,8 +2,9 @@
 //! guard that renames them into place only when the whole run succeeded.
 
 use super::{out_err, ReplayError};
+use crate::baseline::{Madgwick, Mahony};
 use crate::dataset::read::{Truth, TruthStream};
-use crate::metrics::{interpolate_truth, Estimate};
+use crate::metrics::{interpolate_truth, Estimate, Scorer};
 use estimator_core::lie::So3;
 use nalgebra::Vector3;
 use std::fs::File;
@@ -150,4 +151,93 @@ pub(super) fn write_estimate_csv(f: &mut impl Write, e: &Estimate) -> std::io::R
         }
     }
     writeln!(f)
+}
+
+/// Creates `out/NAME.partial` (renamed to `NAME` by [`Partials::commit`]).
+pub(super) fn open_partial(
+    out: &Path,
+    name: &str,
+) -> Result<(BufWriter<File>, PathBuf), ReplayError> {
+    let p = out.join(format!("{name}.partial"));
+    File::create(&p)
+        .map(|f| (BufWriter::new(f), p.clone()))
+        .map_err(|e| ReplayError::Output {
+            path: p,
+            message: e.to_string(),
+        })
+}
+
+/// The reference filters run beside a navigator on the same samples (where a magnetometer
+/// exists), scored with it.
+pub(super) type Baselines = (Madgwick, Mahony);
+
+/// What every replay writes as it goes: the estimate (TUM and CSV) at each IMU sample, and the
+/// truth it is scored against (copied to `groundtruth.tum`).
+pub(super) struct EstimateFiles {
+    tum: BufWriter<File>,
+    tum_path: PathBuf,
+    csv: BufWriter<File>,
+    csv_path: PathBuf,
+    truth: Option<TruthCursor>,
+}
+
+impl EstimateFiles {
+    /// Opens the partial files in `out` (the truth's when `has_truth`, read from `dir`).
+    pub(super) fn open(out: &Path, dir: &Path, has_truth: bool) -> Result<Self, ReplayError> {
+        let (tum, tum_path) = open_partial(out, "estimate.tum")?;
+        let (mut csv, csv_path) = open_partial(out, "estimate.csv")?;
+        super::write_csv_header(&mut csv).map_err(out_err(&csv_path))?;
+        let truth = if has_truth {
+            let (gt_tum, gt_path) = open_partial(out, "groundtruth.tum")?;
+            Some(TruthCursor {
+                stream: TruthStream::open(dir)?,
+                prev: None,
+                next: None,
+                tum: gt_tum,
+                tum_path: gt_path,
+            })
+        } else {
+            None
+        };
+        Ok(Self {
+            tum,
+            tum_path,
+            csv,
+            csv_path,
+            truth,
+        })
+    }
+
+    /// Writes one estimate and scores it (and the reference filters) against the truth at its
+    /// time, where there is one.
+    pub(super) fn add(
+        &mut self,
+        scorer: &mut Scorer,
+        e: &Estimate,
+        baselines: Option<&Baselines>,
+    ) -> Result<(), ReplayError> {
+        write_tum(&mut self.tum, e.t_ns, &e.position, &e.attitude)
+            .map_err(out_err(&self.tum_path))?;
+        write_estimate_csv(&mut self.csv, e).map_err(out_err(&self.csv_path))?;
+        if let Some(tr) = self.truth.as_mut() {
+            if let Some(t) = tr.at(e.t_ns)? {
+                scorer.add(e, &t);
+                if let Some((mw, mh)) = baselines {
+                    scorer.add_baseline("madgwick", &mw.attitude, &t);
+                    scorer.add_baseline("mahony", &mh.attitude, &t);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Flushes the files and copies the rest of the truth.
+    pub(super) fn finish(mut self) -> Result<(), ReplayError> {
+        self.tum.flush().map_err(out_err(&self.tum_path))?;
+        self.csv.flush().map_err(out_err(&self.csv_path))?;
+        if let Some(tr) = self.truth.as_mut() {
+            tr.finish()?;
+        }
+        Ok(())
+    }
 }

@@ -5,6 +5,7 @@
 use crate::dataset::read::{Truth, TruthStream};
 use crate::metrics::{errors, interpolate_truth, Estimate};
 use estimator_core::lie::So3;
+use estimator_core::nav::{self, Reason};
 use nalgebra::Vector3;
 use std::path::Path;
 
@@ -29,21 +30,65 @@ pub enum Validity {
     ImuFault,
 }
 
+/// `validity.csv`'s validity words, written by the replay and read here: the file's format,
+/// defined once.
+const VALIDITY_WORDS: [(Validity, &str); 8] = [
+    (Validity::Valid, "valid"),
+    (Validity::Starting, "starting"),
+    (Validity::Uncertain, "uncertain"),
+    (Validity::NoMagnetometer, "no_magnetometer"),
+    (Validity::NoFix, "no_fix"),
+    (Validity::FixesDisagree, "fixes_disagree"),
+    (Validity::Reset, "reset"),
+    (Validity::ImuFault, "imu_fault"),
+];
+
+/// `validity.csv`'s status words, as [`VALIDITY_WORDS`].
+const STATUS_WORDS: [(AidStatus, &str); 6] = [
+    (AidStatus::Absent, "absent"),
+    (AidStatus::Waiting, "waiting"),
+    (AidStatus::Fused, "fused"),
+    (AidStatus::Stale, "stale"),
+    (AidStatus::Rejected, "rejected"),
+    (AidStatus::Faulty, "faulty"),
+];
+
+/// The word of `key` in `table` (every key is in its table).
+fn word_of<K: PartialEq + Copy>(table: &[(K, &'static str)], key: K) -> &'static str {
+    table.iter().find(|(k, _)| *k == key).map_or("", |(_, w)| w)
+}
+
+/// The key of `word` in `table`.
+fn key_of<K: Copy>(table: &[(K, &str)], word: &str) -> Option<K> {
+    table.iter().find(|(_, w)| *w == word).map(|(k, _)| *k)
+}
+
+impl From<nav::Validity> for Validity {
+    fn from(v: nav::Validity) -> Self {
+        match v {
+            nav::Validity::Valid => Self::Valid,
+            nav::Validity::Invalid(Reason::Starting) => Self::Starting,
+            nav::Validity::Invalid(Reason::Uncertain) => Self::Uncertain,
+            nav::Validity::Invalid(Reason::NoMagnetometer) => Self::NoMagnetometer,
+            nav::Validity::Invalid(Reason::NoFix) => Self::NoFix,
+            nav::Validity::Invalid(Reason::FixesDisagree) => Self::FixesDisagree,
+            nav::Validity::Invalid(Reason::Reset) => Self::Reset,
+            nav::Validity::Invalid(Reason::ImuFault) => Self::ImuFault,
+        }
+    }
+}
+
 impl Validity {
     /// The word as `validity.csv` writes it; `None` for any other word.
     #[must_use]
     pub fn parse(word: &str) -> Option<Self> {
-        Some(match word {
-            "valid" => Self::Valid,
-            "starting" => Self::Starting,
-            "uncertain" => Self::Uncertain,
-            "no_magnetometer" => Self::NoMagnetometer,
-            "no_fix" => Self::NoFix,
-            "fixes_disagree" => Self::FixesDisagree,
-            "reset" => Self::Reset,
-            "imu_fault" => Self::ImuFault,
-            _ => return None,
-        })
+        key_of(&VALIDITY_WORDS, word)
+    }
+
+    /// The word `validity.csv` writes for it.
+    #[must_use]
+    pub fn word(self) -> &'static str {
+        word_of(&VALIDITY_WORDS, self)
     }
 
     /// `true` for [`Validity::Valid`].
@@ -70,19 +115,30 @@ pub enum AidStatus {
     Faulty,
 }
 
+impl From<nav::AidStatus> for AidStatus {
+    fn from(s: nav::AidStatus) -> Self {
+        match s {
+            nav::AidStatus::Absent => Self::Absent,
+            nav::AidStatus::Waiting => Self::Waiting,
+            nav::AidStatus::Fused => Self::Fused,
+            nav::AidStatus::Stale => Self::Stale,
+            nav::AidStatus::Rejected => Self::Rejected,
+            nav::AidStatus::Faulty => Self::Faulty,
+        }
+    }
+}
+
 impl AidStatus {
     /// The word as `validity.csv` writes it; `None` for any other word.
     #[must_use]
     pub fn parse(word: &str) -> Option<Self> {
-        Some(match word {
-            "absent" => Self::Absent,
-            "waiting" => Self::Waiting,
-            "fused" => Self::Fused,
-            "stale" => Self::Stale,
-            "rejected" => Self::Rejected,
-            "faulty" => Self::Faulty,
-            _ => return None,
-        })
+        key_of(&STATUS_WORDS, word)
+    }
+
+    /// The word `validity.csv` writes for it.
+    #[must_use]
+    pub fn word(self) -> &'static str {
+        word_of(&STATUS_WORDS, self)
     }
 }
 

@@ -8,10 +8,11 @@ use super::output::{open_partial, EstimateFiles, Partials};
 use super::{lit3, out_err, up3, ReplayConfig, ReplayError};
 use crate::baseline::{Madgwick, Mahony};
 use crate::dataset::read::{Dataset, Event};
+use crate::faults::epochs;
 use crate::metrics::{Estimate, Outcome, Scorer};
 use estimator_core::nav::{
     AidStatus, Aiding, GnssFix, InsConfig, InsEvent, InsNavigator, InsReport, MagneticFusion,
-    NavError, Reason, Validity,
+    NavError, Validity,
 };
 use estimator_core::Real;
 use nalgebra::Matrix3;
@@ -65,30 +66,6 @@ fn estimate<T: Real, const H: usize, const Q: usize>(
 const VALIDITY_HEADER: &str =
     "t_ns,tilt,heading,velocity,position,gyro_bias,accel_bias,gnss,magnetometer,barometer,imu_fault,event";
 
-fn validity_word(v: Validity) -> &'static str {
-    match v {
-        Validity::Valid => "valid",
-        Validity::Invalid(Reason::Starting) => "starting",
-        Validity::Invalid(Reason::Uncertain) => "uncertain",
-        Validity::Invalid(Reason::NoMagnetometer) => "no_magnetometer",
-        Validity::Invalid(Reason::NoFix) => "no_fix",
-        Validity::Invalid(Reason::FixesDisagree) => "fixes_disagree",
-        Validity::Invalid(Reason::Reset) => "reset",
-        Validity::Invalid(Reason::ImuFault) => "imu_fault",
-    }
-}
-
-fn status_word(s: AidStatus) -> &'static str {
-    match s {
-        AidStatus::Absent => "absent",
-        AidStatus::Waiting => "waiting",
-        AidStatus::Fused => "fused",
-        AidStatus::Stale => "stale",
-        AidStatus::Rejected => "rejected",
-        AidStatus::Faulty => "faulty",
-    }
-}
-
 fn event_word(e: Option<InsEvent>) -> &'static str {
     match e {
         None => "",
@@ -99,22 +76,24 @@ fn event_word(e: Option<InsEvent>) -> &'static str {
     }
 }
 
-/// One row of `validity.csv`.
+/// One row of `validity.csv` (its words are the fault bench's reader's, `faults::epochs`).
 fn write_validity<T: Real>(f: &mut impl Write, r: &InsReport<T>) -> std::io::Result<()> {
     let v = &r.validity;
+    let word = |v: Validity| epochs::Validity::from(v).word();
+    let status = |s: AidStatus| epochs::AidStatus::from(s).word();
     writeln!(
         f,
         "{},{},{},{},{},{},{},{},{},{},{},{}",
         r.t_ns,
-        validity_word(v.tilt),
-        validity_word(v.heading),
-        validity_word(v.velocity),
-        validity_word(v.position),
-        validity_word(v.gyro_bias),
-        validity_word(v.accel_bias),
-        status_word(r.gnss),
-        status_word(r.magnetometer),
-        status_word(r.barometer),
+        word(v.tilt),
+        word(v.heading),
+        word(v.velocity),
+        word(v.position),
+        word(v.gyro_bias),
+        word(v.accel_bias),
+        status(r.gnss),
+        status(r.magnetometer),
+        status(r.barometer),
         u8::from(r.imu_fault),
         event_word(r.event),
     )

@@ -89,6 +89,21 @@ pub type Ahrs<T> = Filter<T, AhrsState<T>, 6>;
 /// ```
 pub type AhrsAccelBias<T> = Filter<T, AhrsAccelBiasState<T>, 9>;
 
+impl<T: Real> AhrsAccelBias<T> {
+    /// The identity state with `P = I` and a configuration its caller has validated
+    /// ([`FilterConfig::validate`]): the placeholder the attitude navigator holds until it
+    /// starts the filter ([`restart_from_alignment`](Self::restart_from_alignment)), built
+    /// without [`new`](Self::new)'s checks of values that are valid by construction (no
+    /// factorization, no `Result` on the stack of a restart).
+    pub(crate) fn placeholder(config: FilterConfig<T>) -> Self {
+        Self {
+            state: AhrsAccelBiasState::identity(),
+            covariance: SMatrix::identity(),
+            config,
+        }
+    }
+}
+
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
     /// From a given state and covariance.
     ///

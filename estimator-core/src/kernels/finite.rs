@@ -24,6 +24,19 @@ pub(crate) fn positive_finite<T: Real>(x: T) -> bool {
     x > T::zero() && x * T::zero() == T::zero()
 }
 
+/// The larger of `a` and `b`, `a` when `b` is NaN: a comparison and a select. `f32::max` is
+/// a call of `libm`'s `fmaxf` on a Cortex-M4F (no `vmaxnm` before ARMv8). Folded from a
+/// number over a sequence, NaN elements are passed over, as with `fmax`.
+#[inline(always)]
+#[must_use]
+pub(crate) fn larger<T: Real>(a: T, b: T) -> T {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
 /// `0 ≤ x < ∞` (false for NaN), as [`positive_finite`].
 #[inline(always)]
 #[must_use]
@@ -58,6 +71,22 @@ mod tests {
             }
         }
         assert!(all_finite::<f64>(&[]));
+    }
+
+    #[test]
+    fn larger_is_max_and_passes_over_nan() {
+        for (a, b, want) in [
+            (1.0, 2.0, 2.0),
+            (2.0, 1.0, 2.0),
+            (-0.5, -3.0, -0.5),
+            (1.0, f64::NAN, 1.0),
+        ] {
+            assert_eq!(larger(a, b), want, "{a} {b}");
+        }
+        let folded = [3.0, f64::NAN, 7.0, -1.0]
+            .iter()
+            .fold(0.0, |m, x| larger(m, *x));
+        assert_eq!(folded, 7.0);
     }
 
     #[test]

@@ -4,19 +4,21 @@
 use super::options::UpdateOptions;
 use super::work::Work;
 use crate::eskf::error::{EskfError, UpdateOutcome};
-use crate::kernels::cholesky::{factor_in_place, inverse_into};
+use crate::kernels::cholesky::{factor_in_place, inverse_into, spd_inverse_3};
 use crate::kernels::slice::{axpy, distance, dot, mat_vec};
 use crate::kernels::{all_finite, slice::symmetrize};
 use crate::Real;
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
-/// `U = P H̃ᵀ`, `S = H̃ U + R`, `S⁻¹`, `K = U S⁻¹` into `w`, for the `n × n` covariance `p`
-/// (column-major), over the `m` active columns of the working set only.
+/// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`, for the `n × n` covariance `p`
+/// (column-major) and the `m × m` noise `noise` (column-major), over the `m` active columns of
+/// the working set only. Returns the NIS `rᵀ S⁻¹ r` of the residual in `w`.
 #[inline(never)]
 fn gain_into<T: Real, const N: usize, const C: usize>(
     p: &[T],
+    noise: &[T],
     w: &mut Work<T, N, C>,
-) -> Result<(), EskfError> {
+) -> Result<T, EskfError> {
     let n = N.max(1);
     let (m, ht) = (w.m, w.ht.as_slice());
     let (u, s, k) = (w.g.u.as_mut_slice(), &mut w.g.s, w.g.k.as_mut_slice());
@@ -31,7 +33,7 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
         }
     }
     // S_ij = R_ij + (row i of H)·(column j of U) for i, j < m; the identity padding stays.
-    s.copy_from(&w.noise);
+    *s = padded_noise(noise, m);
     for (j, uc) in u.chunks_exact(n).enumerate().take(m) {
         for (i, hc) in ht.chunks_exact(n).enumerate().take(m) {
             if let Some(e) = s.get_mut((i, j)) {
@@ -40,17 +42,27 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
         }
     }
     symmetrize(s.as_mut_slice(), C);
-    // S⁻¹ from the Cholesky factor (C × C); the columns of K past m stay zero.
-    let mut l = *s;
-    if !(factor_in_place(l.as_mut_slice(), C, T::zero())
-        && inverse_into(l.as_slice(), C, w.s_inv.as_mut_slice()))
-    {
+    // S⁻¹ from the Cholesky factor (C × C; the 3 × 3 of every model up to three rows through
+    // the unrolled kernel); the columns of K past m stay zero.
+    let mut s_inv = SMatrix::<T, C, C>::zeros();
+    let inverted = match (
+        s.as_slice().first_chunk::<9>(),
+        s_inv.as_mut_slice().first_chunk_mut::<9>(),
+    ) {
+        (Some(s3), Some(x3)) if C == 3 => spd_inverse_3(s3, x3),
+        _ => {
+            let mut l = *s;
+            factor_in_place(l.as_mut_slice(), C, T::zero())
+                && inverse_into(l.as_slice(), C, s_inv.as_mut_slice())
+        }
+    };
+    if !inverted {
         return Err(EskfError::SingularInnovation);
     }
     k.fill(T::zero());
     for (kc, sc) in k
         .chunks_exact_mut(n)
-        .zip(w.s_inv.as_slice().chunks_exact(C.max(1)))
+        .zip(s_inv.as_slice().chunks_exact(C.max(1)))
         .take(m)
     {
         for (uc, s) in u.chunks_exact(n).zip(sc).take(m) {
@@ -60,25 +72,26 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
     if !all_finite(k) {
         return Err(EskfError::SingularInnovation);
     }
-    Ok(())
+    // NIS = rᵀ S⁻¹ r.
+    let mut y = SVector::<T, C>::zeros();
+    mat_vec(s_inv.as_slice(), w.r.as_slice(), y.as_mut_slice());
+    let nis = dot(w.r.as_slice(), y.as_slice());
+    if !nis.is_finite() {
+        return Err(EskfError::SingularInnovation);
+    }
+    Ok(nis)
 }
 
 /// The gain at the prior, the NIS and the gate, then `δx₁ = K₀ r₀` into `w.dx`. Returns
 /// `Rejected`, or `Accepted` with the NIS (its iteration count is set by the caller).
 pub(super) fn gate_step<T: Real, const N: usize, const C: usize>(
     p: &[T],
+    noise: &[T],
     m: usize,
     opts: &UpdateOptions<T>,
     w: &mut Work<T, N, C>,
 ) -> Result<UpdateOutcome<T>, EskfError> {
-    gain_into(p, w)?;
-    // NIS = rᵀ S⁻¹ r.
-    let mut y = SVector::<T, C>::zeros();
-    mat_vec(w.s_inv.as_slice(), w.r.as_slice(), y.as_mut_slice());
-    let nis = dot(w.r.as_slice(), y.as_slice());
-    if !nis.is_finite() {
-        return Err(EskfError::SingularInnovation);
-    }
+    let nis = gain_into(p, noise, w)?;
     let threshold = opts.gate.threshold(m);
     if nis > threshold {
         return Ok(UpdateOutcome::Rejected { nis, threshold });
@@ -93,11 +106,12 @@ pub(super) fn gate_step<T: Real, const N: usize, const C: usize>(
 #[inline(never)]
 pub(super) fn step<T: Real, const N: usize, const C: usize>(
     p: &[T],
+    noise: &[T],
     opts: &UpdateOptions<T>,
     w: &mut Work<T, N, C>,
 ) -> Option<bool> {
     let saved = w.g;
-    let ok = gain_into(p, w).is_ok();
+    let ok = gain_into(p, noise, w).is_ok();
     // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
     let n = N.max(1);
     let mut y = w.r;
@@ -115,4 +129,19 @@ pub(super) fn step<T: Real, const N: usize, const C: usize>(
     let converged = distance(next.as_slice(), w.dx.as_slice()) < opts.step_tolerance;
     w.dx = next;
     Some(converged)
+}
+
+/// `R` (`m × m`, column-major in `noise`) in the top-left of the `C × C` identity: the padded
+/// noise of the [module docs](super) (`S_pad = [[S, 0], [0, I]]`). Entries missing from `noise`
+/// stay those of the identity.
+pub(super) fn padded_noise<T: Real, const C: usize>(noise: &[T], m: usize) -> SMatrix<T, C, C> {
+    let mut r = SMatrix::<T, C, C>::identity();
+    for j in 0..m {
+        for i in 0..m {
+            if let (Some(e), Some(v)) = (r.get_mut((i, j)), noise.get(j * m + i)) {
+                *e = *v;
+            }
+        }
+    }
+    r
 }

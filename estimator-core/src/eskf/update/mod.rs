@@ -41,7 +41,7 @@ use crate::kernels::{all_finite, mat3};
 use crate::lie::{LieGroup, So3};
 use crate::Real;
 use commit::commit;
-use gain::{gate_step, step};
+use gain::{gate_step, padded_noise, step};
 pub use model::{Linearization, Measurement};
 use nalgebra::{SMatrix, SVector};
 pub use options::UpdateOptions;
@@ -132,30 +132,27 @@ where
             s: SMatrix::zeros(),
             k: SMatrix::zeros(),
         },
-        s_inv: SMatrix::zeros(),
         dx: SVector::zeros(),
-        noise: SMatrix::identity(),
         m,
     };
-    // R into the top-left m × m of the identity.
-    for (j, col) in noise.chunks_exact(m.max(1)).enumerate() {
-        for (i, v) in col.iter().enumerate() {
-            if let Some(e) = w.noise.get_mut((i, j)) {
-                *e = *v;
-            }
-        }
-    }
-    if !is_spd(&w.noise) {
+    if !noise_is_spd::<T, C>(noise, m) {
         return Err(EskfError::NoiseNotPositiveDefinite);
     }
     linearize_into(model, x, &mut w, true)?;
-    let nis = match gate_step(p.as_slice(), m, opts, &mut w)? {
+    let nis = match gate_step(p.as_slice(), noise, m, opts, &mut w)? {
         UpdateOutcome::Accepted { nis, .. } => nis,
         rejected => return Ok(rejected),
     };
-    let iterations = iterate(x, p, model, opts, &mut w);
+    let iterations = iterate(x, p, model, noise, opts, &mut w);
     commit(x, p, &mut w)?;
     Ok(UpdateOutcome::Accepted { nis, iterations })
+}
+
+/// `R` (padded to `C × C`, [`padded_noise`]) is symmetric positive definite; out of line, so
+/// that the padded copy is not in the update's frame.
+#[inline(never)]
+fn noise_is_spd<T: Real, const C: usize>(noise: &[T], m: usize) -> bool {
+    is_spd(&padded_noise::<T, C>(noise, m))
 }
 
 /// Linearizes at `x̂ ⊕ δx` (`δx` = `w.dx`; at `x̂` when `first`) into `w.ht`, `w.r`, with the
@@ -201,6 +198,7 @@ fn iterate<T, S, const N: usize, const C: usize>(
     x: &S,
     p: &SMatrix<T, N, N>,
     model: &dyn Rows<T, S, N, C>,
+    noise: &[T],
     opts: &UpdateOptions<T>,
     w: &mut Work<T, N, C>,
 ) -> u8
@@ -213,7 +211,7 @@ where
         if linearize_into(model, x, w, false).is_err() {
             break;
         }
-        let Some(converged) = step(p.as_slice(), opts, w) else {
+        let Some(converged) = step(p.as_slice(), noise, opts, w) else {
             break;
         };
         iterations += 1;

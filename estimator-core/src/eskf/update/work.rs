@@ -12,12 +12,8 @@ pub(super) struct Work<T: Real, const N: usize, const C: usize> {
     pub(super) r: SVector<T, C>,
     /// `U`, `S` and `K` at the current iterate.
     pub(super) g: Gain<T, N, C>,
-    /// `S⁻¹` (for the NIS at the prior).
-    pub(super) s_inv: SMatrix<T, C, C>,
     /// The current correction `δx`.
     pub(super) dx: SVector<T, N>,
-    /// `R` padded to `C × C` with the identity.
-    pub(super) noise: SMatrix<T, C, C>,
     /// The number of active rows, `M`.
     pub(super) m: usize,
 }

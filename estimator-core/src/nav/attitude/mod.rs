@@ -40,7 +40,7 @@ pub use report::{
     Validity,
 };
 
-use crate::eskf::{AhrsAccelBias, AhrsAccelBiasState, ImuSample};
+use crate::eskf::{AhrsAccelBias, ImuSample};
 use crate::kernels::mat3;
 use crate::lie::{LieGroup, So3};
 use crate::nav::clock::{Clock, Tick};
@@ -49,7 +49,7 @@ use crate::nav::sample::{check_imu, check_vector};
 use crate::Real;
 use block::Block;
 use magnetic::Magnetic;
-use nalgebra::{SMatrix, Vector3};
+use nalgebra::Vector3;
 
 /// The update a pending block makes next.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -149,18 +149,22 @@ impl<T: Real> AttitudeNavigator<T> {
     /// out of its domain ([`AttitudeConfig::validate`]).
     pub fn new(config: AttitudeConfig<T>) -> Result<Self, NavError> {
         config.validate()?;
+        Ok(Self::waiting(config))
+    }
+
+    /// [`new`](Self::new) for a configuration its caller has validated
+    /// ([`AttitudeConfig::validate`]): a restart (the INS navigator's, after an IMU gap) needs
+    /// no `Result` on its stack.
+    #[inline(never)]
+    pub(crate) fn waiting(config: AttitudeConfig<T>) -> Self {
         let magnetic = config.magnetometer.as_ref().map(Magnetic::new);
-        Ok(Self {
+        Self {
             durations: Durations {
                 startup: nanoseconds(config.startup_s),
                 block: nanoseconds(config.block_s),
                 max_step: nanoseconds(config.filter.max_dt),
             },
-            filter: AhrsAccelBias::new(
-                AhrsAccelBiasState::identity(),
-                SMatrix::identity(),
-                config.filter,
-            )?,
+            filter: AhrsAccelBias::placeholder(config.filter),
             running: false,
             frame: So3::identity(),
             block: Block::default(),
@@ -190,7 +194,7 @@ impl<T: Real> AttitudeNavigator<T> {
             magnetic,
             counters: Counters::default(),
             config,
-        })
+        }
     }
 
     /// The configuration.

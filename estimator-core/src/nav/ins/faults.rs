@@ -4,7 +4,7 @@
 use super::report::InsEvent;
 use super::window::Interval;
 use super::{InsNavigator, Mode};
-use crate::kernels::mat3;
+use crate::kernels::larger;
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -36,15 +36,15 @@ impl<T: Real> Repeats<T> {
     }
 
     /// Takes a sample; returns the saturation level when an axis sits at one (its configured
-    /// `range`, or a repeated magnitude above `floor`).
-    fn clipped(&mut self, v: &Vector3<T>, range: T, floor: T) -> Option<T> {
+    /// `range`, or a repeated magnitude whose square is above `floor_sq`).
+    fn clipped(&mut self, v: &Vector3<T>, range: T, floor_sq: T) -> Option<T> {
         let mut level = None;
         let slot = self.next % HISTORY;
         for (x, past) in v.iter().zip(self.history.iter_mut()) {
             let a = x.abs();
             if range > T::zero() && a >= range * T::lit(0.999) {
                 level = Some(range);
-            } else if a > floor && past.contains(&a) {
+            } else if a * a > floor_sq && past.contains(&a) {
                 level = Some(a);
             }
             if let Some(p) = past.get_mut(slot) {
@@ -72,16 +72,17 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         interval: Option<&Interval<T>>,
     ) {
         let c = &self.config;
-        let two_g = mat3::norm(&c.attitude.filter.gravity) * T::lit(2.0);
+        // (2 g)², so that no square root is taken per sample.
+        let two_g_sq = c.attitude.filter.gravity.norm_squared() * T::lit(4.0);
         let accel_level = self
             .stuck
             .accel_repeats
-            .clipped(accel, c.accelerometer_range, two_g);
+            .clipped(accel, c.accelerometer_range, two_g_sq);
         let accel_clipped = accel_level.is_some();
         let gyro_clipped = c.gyro_range > T::zero()
             && gyro.iter().any(|w| w.abs() >= c.gyro_range * T::lit(0.999));
         for (w, peak) in gyro.iter().zip(self.stuck.gyro_peak.iter_mut()) {
-            *peak = peak.max(w.abs());
+            *peak = larger(*peak, w.abs());
         }
         let mut stuck = false;
         if c.gyro_stuck_s > T::zero() && self.last_sample.is_some() {

@@ -149,9 +149,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     #[cold]
     #[inline(never)] // rare: its new attitude navigator stays out of every IMU call's frame
     pub(super) fn restart(&mut self) {
-        if let Ok(att) = AttitudeNavigator::new(self.config.attitude) {
-            self.mode = Mode::Aligning(att);
-        }
+        // The configuration was validated by `new`.
+        self.mode = Mode::Aligning(AttitudeNavigator::waiting(self.config.attitude));
         self.ring.clear();
         self.queue.clear();
         self.window = Increment::empty(Vector3::zeros(), Vector3::zeros());

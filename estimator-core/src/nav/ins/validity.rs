@@ -6,7 +6,7 @@ use super::aid::DISAGREEING_FIXES;
 use super::report::AidStatus;
 use super::{InsNavigator, Mode, AID_STALE_INTERVALS, AID_STALE_NS, INVALID_START};
 use crate::kernels::block::block;
-use crate::kernels::mat3;
+use crate::kernels::{larger, mat3};
 use crate::nav::attitude::{Reason, Validity};
 use crate::Real;
 use nalgebra::SMatrix;
@@ -23,7 +23,7 @@ fn within<T: Real>(variance: T, limit: T) -> Validity {
 /// The largest variance of block `b` of the 15-state `P` (its diagonal only, read in place).
 fn largest<T: Real>(p: &SMatrix<T, 15, 15>, b: usize) -> T {
     (0..3).fold(T::zero(), |m, k| {
-        p.get((3 * b + k, 3 * b + k)).map_or(m, |d| m.max(*d))
+        p.get((3 * b + k, 3 * b + k)).map_or(m, |d| larger(m, *d))
     })
 }
 
@@ -74,7 +74,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
                     let row = r.row(k).transpose();
                     row.dot(&mat3::mul_vec(&ptt, &row))
                 };
-                v.tilt = within(world(0).max(world(1)), c.tilt_valid_sigma);
+                v.tilt = within(larger(world(0), world(1)), c.tilt_valid_sigma);
                 v.heading = within(world(2), c.heading_valid_sigma);
                 v.velocity = within(largest(p, 1), c.velocity_valid_sigma);
                 v.position = if self.gnss.rejected >= DISAGREEING_FIXES {

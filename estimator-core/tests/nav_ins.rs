@@ -610,6 +610,56 @@ fn ins_navigator_widens_for_a_clipped_accelerometer_and_a_stuck_gyro() {
 }
 
 #[test]
+fn ins_navigator_takes_a_large_value_met_three_times_as_a_rail_but_not_one_met_twice() {
+    // 25 m/s² (above 2 g) on the vertical axis at two samples 15 ms apart: noise, not a rail;
+    // at three samples within 16: saturated.
+    let at = |times: &'static [f64]| {
+        at_rest_stream(20.0, move |s, _, accel, _, _, _| {
+            if times.iter().any(|t| (s - t).abs() < 1e-6) {
+                accel.z = 25.0;
+            }
+        })
+        .0
+    };
+    let twice = at(&[15.0, 15.015]);
+    assert!(twice.iter().all(|(_, r)| !r.imu_fault));
+    let thrice = at(&[15.0, 15.015, 15.03]);
+    let flagged = first(&thrice, 14.0, |r| r.imu_fault);
+    assert!((flagged - 15.03).abs() < 1e-6, "flagged at {flagged} s");
+}
+
+#[test]
+fn ins_navigator_widens_the_velocity_for_a_vibration_its_samples_cannot_follow() {
+    // A vertical vibration of ±1 g at 23.3 Hz from 15 s to 20 s (0.07 m/s, 0.5 mm: at rest for
+    // the fixes): the trapezoid rule over 5 ms errs by dt |d₂| / 12 ≈ 2 mm/s per interval, and
+    // the velocity is widened for it. A smooth 0.5 Hz swing of ±0.01 g (the same 0.03 m/s order
+    // of motion) is followed by the samples and widens nothing. Neither is taken as saturated.
+    let run = |hz: f64, g: f64| {
+        let (reports, nav) = at_rest_stream(20.0, move |s, _, accel, _, _, _| {
+            if s >= 15.0 {
+                accel.z += g * 9.81 * (2.0 * std::f64::consts::PI * hz * (s - 15.0)).sin();
+            }
+        });
+        assert!(
+            reports.iter().all(|(_, r)| !r.imu_fault),
+            "{hz} Hz taken as a fault"
+        );
+        nav.estimate().unwrap().covariance[1][(2, 2)].sqrt()
+    };
+    let still = run(0.0, 0.0);
+    let smooth = run(0.5, 0.01);
+    let vibrating = run(23.3, 1.0);
+    assert!(
+        (smooth / still - 1.0).abs() < 0.01,
+        "smooth {smooth} against {still} m/s"
+    );
+    assert!(
+        vibrating > 1.5 * still,
+        "vibrating {vibrating} against {still} m/s"
+    );
+}
+
+#[test]
 fn ins_navigator_does_not_start_from_an_outlier() {
     // The first fix is 50 m off: the INS starts only on two fixes that agree, so from the
     // next good pair, and never reports a valid position 50 m wrong.

@@ -89,6 +89,15 @@ pub type Ahrs<T> = Filter<T, AhrsState<T>, 6>;
 /// ```
 pub type AhrsAccelBias<T> = Filter<T, AhrsAccelBiasState<T>, 9>;
 
+impl<T: Real> Ins<T> {
+    /// [`predict`](Self::predict) of a sample its caller has checked to be finite (the INS
+    /// navigator checks every sample before it is buffered): the same prediction without the
+    /// second look at the sample (about 70 Cortex-M4F instructions of the navigator's step).
+    pub(crate) fn predict_finite(&mut self, imu: &ImuSample<T>) -> Result<(), EskfError> {
+        super::predict::predict_ins_finite(&mut self.state, &mut self.covariance, imu, &self.config)
+    }
+}
+
 impl<T: Real> AhrsAccelBias<T> {
     /// The identity state with `P = I` and a configuration its caller has validated
     /// ([`FilterConfig::validate`]): the placeholder the attitude navigator holds until it

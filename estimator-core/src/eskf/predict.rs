@@ -47,11 +47,7 @@ impl<T: Real> FRows<T> {
     }
 }
 
-/// The 15-state prediction; writes only after every check passed.
-///
-/// Nominal: `ω = ω_m − b_g`, `f = f_m − b_a`, `a = R f + g`, `ΔR = exp(ω dt)`,
-/// `R⁺ = R ΔR`, `v⁺ = v + a dt`, `p⁺ = p + v dt + ½ a dt²`.
-/// Covariance: `P⁺ = F P Fᵀ + Q` with the nonzero blocks of `F` ([`FRows`]).
+/// The 15-state prediction: [`predict_ins_finite`] after the sample's finiteness check.
 fn predict_ins<T: Real>(
     x: &mut InsState<T>,
     p: &mut SMatrix<T, 15, 15>,
@@ -61,6 +57,23 @@ fn predict_ins<T: Real>(
     if !(all_finite(imu.gyro.as_slice()) && all_finite(imu.accel.as_slice())) {
         return Err(EskfError::NonFinite);
     }
+    predict_ins_finite(x, p, imu, cfg)
+}
+
+/// The 15-state prediction of a sample whose gyro and accelerometer are finite (checked by
+/// the caller: [`predict_ins`], or the INS navigator, which has checked every sample it
+/// integrates); writes only after every other check passed. Out of line: one copy for both.
+///
+/// Nominal: `ω = ω_m − b_g`, `f = f_m − b_a`, `a = R f + g`, `ΔR = exp(ω dt)`,
+/// `R⁺ = R ΔR`, `v⁺ = v + a dt`, `p⁺ = p + v dt + ½ a dt²`.
+/// Covariance: `P⁺ = F P Fᵀ + Q` with the nonzero blocks of `F` ([`FRows`]).
+#[inline(never)]
+pub(crate) fn predict_ins_finite<T: Real>(
+    x: &mut InsState<T>,
+    p: &mut SMatrix<T, 15, 15>,
+    imu: &ImuSample<T>,
+    cfg: &FilterConfig<T>,
+) -> Result<(), EskfError> {
     let dt = imu.dt;
     check_dt(dt, cfg.max_dt)?;
     let half = T::lit(0.5);

@@ -18,9 +18,17 @@ const FAULT_HOLD_NS: u64 = 1_000_000_000;
 /// Samples of each accelerometer axis remembered for the saturation check.
 const HISTORY: usize = 16;
 
+/// Earlier samples among the last [`HISTORY`] that must hold exactly the same magnitude above
+/// 2 g for a sample to be taken as saturated: the third sample at a rail is the first flagged.
+const RAIL_MATCHES: usize = 2;
+
 /// Per accelerometer axis, the magnitudes of the last [`HISTORY`] samples: a magnitude above
-/// 2 g met again exactly is a saturation level (noise and motion never repeat a large value
-/// exactly; a clipped axis does, sample after sample).
+/// 2 g met exactly [`RAIL_MATCHES`] times before is a saturation level. Noise and motion do
+/// not repeat a large value exactly; a clipped axis does, sample after sample, even when it
+/// touches its rail only at the peaks of a vibration (two or three samples a period). One
+/// exact repeat is not enough: a quantized vibration peaking above 2 g repeats a value by
+/// chance a few times a minute (about 9 samples in 120 s in the clipping scenario), two
+/// repeats almost never.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Repeats<T: Real> {
     history: [[T; HISTORY]; 3],
@@ -36,7 +44,8 @@ impl<T: Real> Repeats<T> {
     }
 
     /// Takes a sample; returns the saturation level when an axis sits at one (its configured
-    /// `range`, or a repeated magnitude whose square is above `floor_sq`).
+    /// `range`, or a magnitude whose square is above `floor_sq`, met [`RAIL_MATCHES`] times in
+    /// the history).
     fn clipped(&mut self, v: &Vector3<T>, range: T, floor_sq: T) -> Option<T> {
         let mut level = None;
         let slot = self.next % HISTORY;
@@ -44,7 +53,7 @@ impl<T: Real> Repeats<T> {
             let a = x.abs();
             if range > T::zero() && a >= range * T::lit(0.999) {
                 level = Some(range);
-            } else if a * a > floor_sq && past.contains(&a) {
+            } else if a * a > floor_sq && past.iter().filter(|p| **p == a).count() >= RAIL_MATCHES {
                 level = Some(a);
             }
             if let Some(p) = past.get_mut(slot) {
@@ -58,7 +67,8 @@ impl<T: Real> Repeats<T> {
 
 impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// Checks one IMU sample for saturation (an accelerometer axis at its configured range, or
-    /// at a magnitude above 2 g met exactly within the last [`HISTORY`] samples; a gyro axis
+    /// at a magnitude above 2 g met exactly [`RAIL_MATCHES`] times within the last [`HISTORY`]
+    /// samples; a gyro axis
     /// at its configured range) and a stuck gyro axis (the same value for `gyro_stuck_s` while
     /// another axis changes). A faulty sample widens the filter by what it may hide: the
     /// velocity by `σ = a_max dt` for a saturated accelerometer (`a_max` the saturation

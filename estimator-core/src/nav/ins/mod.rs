@@ -49,11 +49,14 @@
 //!   is then held by the GNSS velocity and the gyro.
 //! * **Barometer.** Gated.
 //! * **IMU.** A sample with an axis at the sensor's range (configured, or for the
-//!   accelerometer learned: a magnitude above 2 g met again exactly within 16 samples, which
-//!   noise and motion never do) is saturated; a
+//!   accelerometer learned: a magnitude above 2 g met exactly twice before within 16 samples,
+//!   which noise and motion do not do) is saturated; a
 //!   gyro axis repeating its value exactly for `gyro_stuck_s` while another changes is stuck.
 //!   Such a sample is still integrated (nothing else measures the motion), and the velocity
 //!   (accelerometer) or attitude (gyro) covariance is widened by what it may hide.
+//! * **Vibration.** A specific force that changes faster than the samples can follow (its
+//!   second difference beyond what the noise gives) widens the velocity by the error of
+//!   integrating it from its samples (`nav/ins/vibration.rs`).
 //!
 //! Nothing allocates; the navigator is a plain value.
 
@@ -64,6 +67,7 @@ mod faults;
 mod report;
 mod start;
 mod validity;
+mod vibration;
 mod window;
 
 pub use config::InsConfig;
@@ -206,6 +210,8 @@ pub struct InsNavigator<T: Real, const H: usize = 64, const Q: usize = 40> {
     filter_t: Option<u64>,
     /// The newest IMU sample (gyro, accel), for the trapezoidal intervals.
     last_sample: Option<(Vector3<T>, Vector3<T>)>,
+    /// The accelerometer sample before `last_sample`'s, for the vibration check.
+    accel_before: Option<Vector3<T>>,
     /// The last integrated interval's rate and specific force (biases included).
     filter_rate: Vector3<T>,
     filter_accel: Vector3<T>,
@@ -301,6 +307,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             imu_clock: Clock::default(),
             filter_t: None,
             last_sample: None,
+            accel_before: None,
             filter_rate: Vector3::zeros(),
             filter_accel: Vector3::zeros(),
             gnss: GnssTrack::default(),
@@ -490,6 +497,9 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             }
         }
         self.check_imu_faults(t_ns, gyro, accel, interval.as_ref());
+        if let Some(interval) = &interval {
+            self.widen_for_vibration(accel, interval.dt);
+        }
         self.imu_clock.set(t_ns);
         self.last_sample = Some((*gyro, *accel));
         self.counters.imu = self.counters.imu.saturating_add(1);
@@ -675,7 +685,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
                 accel: interval.accel,
                 dt: interval.dt,
             };
-            if ins.predict(&imu).is_err() {
+            // Every buffered sample passed `check_imu` (finite, within range).
+            if ins.predict_finite(&imu).is_err() {
                 self.counters.numerical_failures =
                     self.counters.numerical_failures.saturating_add(1);
             }

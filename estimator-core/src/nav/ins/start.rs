@@ -158,6 +158,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         self.fresh_lag = 0;
         self.filter_t = None;
         self.last_sample = None;
+        self.accel_before = None;
         self.gnss = super::GnssTrack::default();
         self.stuck.since = [None; 3];
         self.stuck.invalid_until = None;

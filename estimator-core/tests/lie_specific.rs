@@ -626,3 +626,109 @@ fn so3_exp_of_huge_vectors_is_a_rotation() {
     assert!(q.coords.iter().all(|c| c.is_finite()) && (q.coords.norm() - 1.0).abs() < 1e-6);
     assert!(q.i == 0.0 && q.k == 0.0);
 }
+
+/// A rotation vector whose `‖ω‖²` overflows (`θ = 1e200` in `f64`): `exp`, `exp_jac` and
+/// `right_jacobian` are finite, `exp_jac`'s rotation is `exp`'s, and `J_r` is its limit
+/// `I + [u]×² = u uᵀ` up to the `O(1/θ)` terms (`(1 − cos θ)/θ`, `sin θ/θ`), here below 1e-199.
+/// On both sides of the overflow (`θ = 1e153`, whose `θ²` is finite, and `1e155`) the Jacobian
+/// is that limit within the same `O(1/θ)`.
+#[test]
+fn so3_huge_rotation_vectors_give_finite_limits() {
+    let u = Vector3::new(2.0, -3.0, 6.0) / 7.0;
+    for theta in [1e153, 1e155, 1e200, 1e308] {
+        let w = u * theta;
+        let (r, jr) = So3::<f64>::exp_jac(&w);
+        assert!(
+            r.is_finite() && jr.iter().all(|x: &f64| x.is_finite()),
+            "θ = {theta}"
+        );
+        assert_eq!(r, So3::exp(&w));
+        assert_eq!(jr, So3::right_jacobian(&w));
+        let limit = u * u.transpose();
+        assert!(max_abs_diff(&jr, &limit) < 1e-12, "θ = {theta}: {jr}");
+    }
+    let w = Vector3::new(1e20_f32, 0.0, 0.0);
+    let (r, jr) = So3::<f32>::exp_jac(&w);
+    assert!(r.is_finite() && jr.iter().all(|x: &f32| x.is_finite()));
+    assert!((jr - Matrix3::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)).amax() < 1e-6);
+}
+
+/// SE(3) with a huge rotation part: `exp`'s translation is `J_l(ω) v → (u·v) u` (the part of
+/// `v` along the axis; the rest is divided by `θ`), `exp_jac` and `right_jacobian` are finite
+/// and agree with each other, and both sides of the overflow agree to `O(1/θ)`.
+#[test]
+fn se3_huge_rotation_vectors_give_finite_limits() {
+    let u = Vector3::new(2.0, -3.0, 6.0) / 7.0;
+    let v = Vector3::new(1.0, 2.0, -0.5);
+    let mut jacobians = Vec::new();
+    for theta in [1e153, 1e155, 1e200] {
+        let w = u * theta;
+        let xi = Vector6::new(v.x, v.y, v.z, w.x, w.y, w.z);
+        let (t, j) = Se3::<f64>::exp_jac(&xi);
+        assert!(
+            t.is_finite() && j.iter().all(|x: &f64| x.is_finite()),
+            "θ = {theta}"
+        );
+        assert_eq!(t, Se3::exp(&xi));
+        assert_eq!(j, Se3::right_jacobian(&xi));
+        let along = u * u.dot(&v);
+        assert!((t.translation() - along).amax() < 1e-12, "θ = {theta}");
+        jacobians.push(j);
+    }
+    assert!(max_abs_diff(&jacobians[0], &jacobians[1]) < 1e-12);
+    assert!(max_abs_diff(&jacobians[1], &jacobians[2]) < 1e-12);
+    let xi = Vector6::new(1.0_f32, 1.0, 1.0, 1e20, 0.0, 0.0);
+    let (t, j) = Se3::<f32>::exp_jac(&xi);
+    assert!(t.is_finite() && j.iter().all(|x: &f32| x.is_finite()));
+}
+
+/// SE(2) with an angle whose square overflows: `exp` is a rotation (unit `(cos, sin)`) with a
+/// translation of order `1/ω`, `exp_jac` and `right_jacobian` are finite, and both sides of the
+/// overflow agree.
+#[test]
+fn se2_huge_angles_give_finite_results() {
+    for w in [1e150, 1e160, -1e200] {
+        let tau = Vector3::new(1.0, 1.0, w);
+        let (t, j) = Se2::<f64>::exp_jac(&tau);
+        assert!(
+            t.is_finite() && j.iter().all(|x: &f64| x.is_finite()),
+            "ω = {w}"
+        );
+        assert_eq!(t, Se2::exp(&tau));
+        assert_eq!(j, Se2::right_jacobian(&tau));
+        let r = t.rotation();
+        assert!((r.cos() * r.cos() + r.sin() * r.sin() - 1.0).abs() < 4.0 * f64::EPSILON);
+        assert!(t.translation().amax() < 1e-140, "ω = {w}");
+    }
+    let (t, j) = Se2::<f32>::exp_jac(&Vector3::new(1.0, 1.0, 1e20));
+    assert!(t.is_finite() && j.iter().all(|x: &f32| x.is_finite()));
+}
+
+/// `So2::from_cos_sin` takes any non-zero finite pair, however large or small: it divides by
+/// the larger magnitude before it normalizes. Zero and non-finite pairs are `None`.
+#[test]
+fn so2_from_cos_sin_takes_extreme_magnitudes() {
+    for (re, im) in [(1e200, 0.0), (1e-200, 0.0), (0.0, 5e-324), (-1e308, 1e308)] {
+        let r = So2::<f64>::from_cos_sin(re, im).expect("a finite non-zero pair");
+        let n = (re / re.abs().max(im.abs()), im / re.abs().max(im.abs()));
+        let norm = (n.0 * n.0 + n.1 * n.1).sqrt();
+        assert!(
+            (r.cos() - n.0 / norm).abs() <= 2.0 * f64::EPSILON,
+            "({re}, {im})"
+        );
+        assert!(
+            (r.sin() - n.1 / norm).abs() <= 2.0 * f64::EPSILON,
+            "({re}, {im})"
+        );
+    }
+    assert!(So2::<f32>::from_cos_sin(1e30, 0.0).is_some());
+    assert!(So2::<f32>::from_cos_sin(1e-30, 0.0).is_some());
+    for (re, im) in [
+        (0.0, 0.0),
+        (f64::NAN, 1.0),
+        (1.0, f64::NAN),
+        (f64::INFINITY, 0.0),
+    ] {
+        assert!(So2::<f64>::from_cos_sin(re, im).is_none(), "({re}, {im})");
+    }
+}

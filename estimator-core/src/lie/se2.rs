@@ -43,6 +43,24 @@ pub struct Se2<T: Real> {
     translation: Vector2<T>,
 }
 
+/// `ω b = (1 − cos ω)/ω`: `±θb` ([`AngleCoeffs::b_theta`]) for a huge `ω`, whose `b = 2h²`
+/// underflows.
+fn w_times_b<T: Real>(k: &AngleCoeffs<T>, w: T) -> T {
+    if k.is_huge() {
+        huge_over_theta(k.b_theta(), w)
+    } else {
+        w * k.b
+    }
+}
+
+/// `x · sign(ω)`: `θ`-scaled coefficients of a huge angle carried to the signed `ω`. Cold and
+/// out of line.
+#[cold]
+#[inline(never)]
+fn huge_over_theta<T: Real>(x: T, w: T) -> T {
+    x * w.signum()
+}
+
 impl<T: Real> Se2<T> {
     /// `T = (R, t)`.
     #[must_use]
@@ -84,7 +102,7 @@ impl<T: Real> Se2<T> {
     /// `exp(τ) = (R(ω), V v)` from the kernel of `ω`.
     fn exp_from(k: &AngleCoeffs<T>, tau: &Vector3<T>) -> Self {
         let w = tau.z;
-        let wb = w * k.b;
+        let wb = w_times_b(k, w);
         // (cos ω, sin ω) from the half-angle kernel: unit to rounding, NaN in gives NaN out.
         let rotation = So2::from_unit(k.cos(), k.a * w);
         Self {
@@ -96,8 +114,13 @@ impl<T: Real> Se2<T> {
     /// `J_r(τ)` from the kernel of `ω` (module docs).
     fn jr_from(k: &AngleCoeffs<T>, tau: &Vector3<T>) -> Matrix3<T> {
         let (vx, vy, w) = (tau.x, tau.y, tau.z);
-        let wb = w * k.b;
-        let wc = w * k.c;
+        let wb = w_times_b(k, w);
+        // ω c = ±(1 − a)/θ for a huge ω (c underflows to 0 there).
+        let wc = if k.is_huge() {
+            huge_over_theta((T::one() - k.a) / k.theta, w)
+        } else {
+            w * k.c
+        };
         Matrix3::new(
             k.a,
             wb,
@@ -156,7 +179,7 @@ impl<T: Real> LieGroup<T> for Se2<T> {
     }
 
     fn exp(tau: &Vector3<T>) -> Self {
-        Self::exp_from(&AngleCoeffs::from_theta_sq(tau.z * tau.z), tau)
+        Self::exp_from(&AngleCoeffs::of_angle(tau.z), tau)
     }
 
     /// `ω = atan2`, and `V⁻¹ t` with `h = (ω/2)cot(ω/2)` taken from the stored `(cos ω, sin ω)`
@@ -215,11 +238,11 @@ impl<T: Real> LieGroup<T> for Se2<T> {
     }
 
     fn right_jacobian(tau: &Vector3<T>) -> Matrix3<T> {
-        Self::jr_from(&AngleCoeffs::from_theta_sq(tau.z * tau.z), tau)
+        Self::jr_from(&AngleCoeffs::of_angle(tau.z), tau)
     }
 
     fn right_jacobian_inv(tau: &Vector3<T>) -> Matrix3<T> {
-        Self::jr_inv_from(&AngleCoeffs::from_theta_sq(tau.z * tau.z), tau)
+        Self::jr_inv_from(&AngleCoeffs::of_angle(tau.z), tau)
     }
 
     fn matrix(&self) -> Matrix3<T> {
@@ -251,7 +274,7 @@ impl<T: Real> LieGroup<T> for Se2<T> {
     }
 
     fn exp_jac(tau: &Vector3<T>) -> (Self, Matrix3<T>) {
-        let k = AngleCoeffs::from_theta_sq(tau.z * tau.z);
+        let k = AngleCoeffs::of_angle(tau.z);
         (Self::exp_from(&k, tau), Self::jr_from(&k, tau))
     }
 

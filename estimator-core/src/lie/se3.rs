@@ -97,12 +97,22 @@ fn upper_block<T: Real>(diag: &Matrix3<T>, upper_t: &Matrix3<T>) -> Matrix6<T> {
 ///
 /// `Q` is even in `(v, ω)` in its symmetric part and odd in its skew part, so
 /// `Q(−v, −ω) = Q(v, ω)ᵀ`.
+///
+/// For a huge `ω` ([`AngleCoeffs::is_huge`]) the same `Q` with `ω = θu`, `δ = θδᵤ`: with
+/// `cθ² = 1 − a`, `eθ² = b − ½` and `fθ² = b − 3c`, `δ(c + 2e)ω = δᵤ(2b − a)u`,
+/// `αωᵀ = α'uᵀ` with `α' = θα = cθ v + ½ fθ³ δᵤ u` (`fθ³ = θb − 3cθ`), and
+/// `δ(2c + fθ²) = δᵤ(θb − cθ)`: every coefficient finite, none multiplied by `θ²`.
 fn q_block<T: Real>(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matrix3<T> {
     let se = k.se();
     let dot = w.dot(v);
     let g = dot * (k.c + k.c + se.f * k.theta_sq);
     let a = v * k.c + w * (T::lit(0.5) * se.f * dot);
     let s = v * k.b - w * (dot * (k.c + se.e + se.e));
+    q_assemble(&a, w, &s, g)
+}
+
+/// `[s]× + a wᵀ + w aᵀ − g I`, the assembly of [`q_block`].
+fn q_assemble<T: Real>(a: &Vector3<T>, w: &Vector3<T>, s: &Vector3<T>, g: T) -> Matrix3<T> {
     // αωᵀ + ωαᵀ: entry (i, j) is αᵢωⱼ + αⱼωᵢ.
     let (xy, xz, yz) = (
         a.x * w.y + a.y * w.x,
@@ -123,11 +133,43 @@ fn q_block<T: Real>(k: &AngleCoeffs<T>, v: &Vector3<T>, w: &Vector3<T>) -> Matri
 }
 
 /// `x + p ω×x + q ω×(ω×x)`: `J_l(ω) x` of SO(3) (`p = b`, `q = c`, the exponential's
-/// translation) and `J_l⁻¹(ω) x` (`p = −½`, `q = d`, the logarithm's).
+/// translation) and `J_l⁻¹(ω) x` (`p = −½`, `q = d`, the logarithm's). For a huge `ω` the
+/// exponential's is `x + θb u×x + θ²c u×(u×x)` ([`AngleCoeffs::is_huge`]).
 fn cross_poly<T: Real>(p: T, q: T, w: &Vector3<T>, x: &Vector3<T>) -> Vector3<T> {
     let wx = w.cross(x);
     let wwx = w.cross(&wx);
     x + wx * p + wwx * q
+}
+
+/// `exp(ξ)` and `J_r(ξ)` of a finite `ξ = [v; ω]` whose `‖ω‖²` overflows
+/// ([`AngleCoeffs::of_huge`]; every `[ω]×ᵏ` written as `θᵏ[u]×ᵏ`, see [`q_block`]):
+/// `(exp(ω), v + θb u×v + θ²c u×(u×v))` and `[[J_r(ω), Q(−v, −ω)], [0, J_r(ω)]]`. Out of line
+/// and cold: the ordinary path of every caller stays as it was.
+#[cold]
+#[inline(never)]
+fn exp_jac_huge<T: Real>(v: &Vector3<T>, w: &Vector3<T>) -> (Se3<T>, Matrix6<T>) {
+    let (k, u) = AngleCoeffs::of_huge(w);
+    let jr = skew_poly(T::one(), -k.b_theta(), T::one() - k.a, &u);
+    let (b_t, c_t) = (k.b_theta(), (T::one() - k.a) / k.theta);
+    // Q(v, ω) with ω = θu (see `q_block`).
+    let dot = u.dot(v);
+    let g = dot * (b_t - c_t);
+    let a = v * c_t + u * (T::lit(0.5) * (b_t - T::lit(3.0) * c_t) * dot);
+    let s = v * k.b - u * (dot * (k.b + k.b - k.a));
+    let q = q_assemble(&a, &u, &s, g);
+    let translation = cross_poly(b_t, T::one() - k.a, &u, v);
+    let exp = Se3::from_parts(super::so3::rotation_huge(&k, &u), translation);
+    (exp, upper_block(&jr, &q))
+}
+
+/// `exp(ξ) = (exp(ω), v + θb u×v + θ²c u×(u×v))` of a finite `ξ` whose `‖ω‖²` overflows (as
+/// [`exp_jac_huge`], without the Jacobian).
+#[cold]
+#[inline(never)]
+fn exp_huge<T: Real>(v: &Vector3<T>, w: &Vector3<T>) -> Se3<T> {
+    let (k, u) = AngleCoeffs::of_huge(w);
+    let translation = cross_poly(k.b_theta(), T::one() - k.a, &u, v);
+    Se3::from_parts(super::so3::rotation_huge(&k, &u), translation)
 }
 
 impl<T: Real> Se3<T> {
@@ -219,7 +261,11 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     fn exp(xi: &Vector6<T>) -> Self {
         let (v, w) = split(xi);
-        Self::exp_from(&AngleCoeffs::of_vector(&w), &v, &w)
+        let theta_sq = w.norm_squared();
+        if !theta_sq.is_finite() {
+            return exp_huge(&v, &w);
+        }
+        Self::exp_from(&AngleCoeffs::from_theta_sq(theta_sq), &v, &w)
     }
 
     fn log(&self) -> Vector6<T> {
@@ -271,7 +317,11 @@ impl<T: Real> LieGroup<T> for Se3<T> {
 
     fn right_jacobian(xi: &Vector6<T>) -> Matrix6<T> {
         let (v, w) = split(xi);
-        Self::jr_from(&AngleCoeffs::of_vector(&w), &v, &w)
+        let theta_sq = w.norm_squared();
+        if !theta_sq.is_finite() {
+            return exp_jac_huge(&v, &w).1;
+        }
+        Self::jr_from(&AngleCoeffs::from_theta_sq(theta_sq), &v, &w)
     }
 
     fn right_jacobian_inv(xi: &Vector6<T>) -> Matrix6<T> {
@@ -319,7 +369,11 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     /// `exp(ξ)` and `J_r(ξ)` from one kernel.
     fn exp_jac(xi: &Vector6<T>) -> (Self, Matrix6<T>) {
         let (v, w) = split(xi);
-        let k = AngleCoeffs::of_vector(&w);
+        let theta_sq = w.norm_squared();
+        if !theta_sq.is_finite() {
+            return exp_jac_huge(&v, &w);
+        }
+        let k = AngleCoeffs::from_theta_sq(theta_sq);
         (Self::exp_from(&k, &v, &w), Self::jr_from(&k, &v, &w))
     }
 

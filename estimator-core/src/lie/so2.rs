@@ -6,7 +6,7 @@
 //! Manifolds for Robotic State Estimation*, `F = R [H(p) | I]` with `H(p) = G¹p`.
 
 use super::{near_rotation, LieGroup, Real};
-use crate::kernels::{all_finite, positive_finite};
+use crate::kernels::{all_finite, larger, positive_finite};
 use nalgebra::{Matrix1, Matrix2, Matrix2x1, Vector1, Vector2};
 
 /// A planar rotation `R ∈ SO(2)`.
@@ -35,17 +35,21 @@ impl<T: Real> So2<T> {
         Self { re: c, im: s }
     }
 
-    /// From `(cos θ, sin θ)` of any non-zero finite norm (normalized); `None` otherwise.
+    /// From `(cos θ, sin θ)` of any non-zero finite norm (normalized); `None` otherwise. The
+    /// pair is first divided by its larger magnitude `m`, so that `re² + im²` can neither
+    /// overflow nor underflow (`(1e200, 0)` and `(1e-200, 0)` in `f64` are both the identity).
     #[must_use]
     pub fn from_cos_sin(re: T, im: T) -> Option<Self> {
-        let n2 = re * re + im * im;
-        if !positive_finite(n2) {
+        let m = larger(re.abs(), im.abs());
+        if !(positive_finite(m) && all_finite(&[re, im])) {
             return None;
         }
-        let inv = T::one() / n2.sqrt_rn();
+        let (x, y) = (re / m, im / m);
+        // 1 ≤ x² + y² ≤ 2.
+        let inv = T::one() / (x * x + y * y).sqrt_rn();
         Some(Self {
-            re: re * inv,
-            im: im * inv,
+            re: x * inv,
+            im: y * inv,
         })
     }
 

@@ -311,7 +311,11 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 
     fn right_jacobian(w: &Vector3<T>) -> Matrix3<T> {
-        Self::jr_from(&AngleCoeffs::of_vector(w), w)
+        let theta_sq = w.norm_squared();
+        if !theta_sq.is_finite() {
+            return exp_jac_huge(w).1;
+        }
+        Self::jr_from(&AngleCoeffs::from_theta_sq(theta_sq), w)
     }
 
     fn right_jacobian_inv(w: &Vector3<T>) -> Matrix3<T> {
@@ -339,7 +343,11 @@ impl<T: Real> LieGroup<T> for So3<T> {
 
     /// `exp(ω)` and `J_r(ω)` from one kernel.
     fn exp_jac(w: &Vector3<T>) -> (Self, Matrix3<T>) {
-        let k = AngleCoeffs::of_vector(w);
+        let theta_sq = w.norm_squared();
+        if !theta_sq.is_finite() {
+            return exp_jac_huge(w);
+        }
+        let k = AngleCoeffs::from_theta_sq(theta_sq);
         (Self::exp_from(&k, w), Self::jr_from(&k, w))
     }
 
@@ -368,23 +376,32 @@ impl<T: Real> LieGroup<T> for So3<T> {
     }
 }
 
-/// `exp` of a finite `ω` whose `‖ω‖²` overflows (`‖ω‖ ≳ 1.8e19` in `f32`, `1.3e154` in `f64`):
-/// the same rotation `[cos(θ/2), sin(θ/2) ω/θ]`, with `θ = m ‖ω/m‖` computed from `ω` scaled by
-/// its largest component `m`, and `sin`/`cos` of the huge `θ/2` reduced exactly by
-/// [`Real::sincos`]. At such angles one unit in the last place of `θ` is many turns, so the
-/// angle is whatever that rounding makes it; the axis is kept and the result is a rotation, not
-/// NaN.
+/// `exp(ω)` and `J_r(ω)` of a finite `ω` whose `‖ω‖²` overflows ([`AngleCoeffs::of_huge`]):
+/// `[cos(θ/2), sin(θ/2)·u]` and `I − θb[u]× + θ²c[u]×²` (`θb = (1 − cos θ)/θ`,
+/// `θ²c = 1 − sin θ/θ`, both finite), with `u = ω/θ`. Out of line and cold: the ordinary path
+/// of every caller stays as it was.
+#[cold]
+#[inline(never)]
+fn exp_jac_huge<T: Real>(w: &Vector3<T>) -> (So3<T>, Matrix3<T>) {
+    let (k, u) = AngleCoeffs::of_huge(w);
+    (
+        rotation_huge(&k, &u),
+        skew_poly(T::one(), -k.b_theta(), T::one() - k.a, &u),
+    )
+}
+
+/// `exp(ω) = [cos(θ/2), sin(θ/2)·u]` of a finite `ω` whose `‖ω‖²` overflows (as
+/// [`exp_jac_huge`], without the Jacobian).
 #[cold]
 #[inline(never)]
 fn exp_huge<T: Real>(w: &Vector3<T>) -> So3<T> {
-    let m = w.iter().fold(T::zero(), |m, c| m.max(c.abs()));
-    let u = w / m;
-    let n = u.norm_squared().sqrt_rn();
-    let axis = u / n;
-    // Halved before the product: `m n` itself can overflow (all three components at the maximum).
-    let (s, c) = (m * T::lit(0.5) * n).sincos();
-    let v = axis * s;
+    let (k, u) = AngleCoeffs::of_huge(w);
+    rotation_huge(&k, &u)
+}
+
+/// `[cos(θ/2), sin(θ/2)·u]` from a huge kernel and its axis.
+pub(crate) fn rotation_huge<T: Real>(k: &AngleCoeffs<T>, u: &Vector3<T>) -> So3<T> {
     So3 {
-        q: UnitQuaternion::new_unchecked(Quaternion::new(c, v.x, v.y, v.z)),
+        q: UnitQuaternion::new_unchecked(Quaternion::from_parts(k.cos_half, u * k.sin_half)),
     }
 }

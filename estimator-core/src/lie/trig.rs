@@ -30,6 +30,7 @@
 //! the exception: SE(3)'s `Q` multiplies it by `θ‖v‖` only, so it carries six terms (its cutoff
 //! sits at `θ ≈ 0.4` in `f64`, where `1 − a` has lost only a few bits).
 
+use crate::kernels::larger;
 use crate::scalar::{taylor_cutoff, Real};
 use core::marker::PhantomData;
 use nalgebra::Vector3;
@@ -92,9 +93,54 @@ impl<T: Real> AngleCoeffs<T> {
         Self::from_half_angle(theta_sq, theta, sin_half, cos_half)
     }
 
-    /// From a rotation vector `ω`: [`Self::from_theta_sq`] of `‖ω‖²`.
+    /// From a rotation vector `ω`: [`Self::from_theta_sq`] of `‖ω‖²` (for a finite `ω` whose
+    /// `‖ω‖²` overflows, the callers take [`Self::of_huge`] instead).
     pub fn of_vector(w: &Vector3<T>) -> Self {
         Self::from_theta_sq(w.norm_squared())
+    }
+
+    /// From a signed angle `ω` (SE(2)): `θ = |ω|` itself, so that an angle whose square
+    /// overflows still has a finite `θ`, sine and cosine (its `θ²` is then infinite: see
+    /// [`Self::is_huge`]).
+    pub fn of_angle(w: T) -> Self {
+        let theta = w.abs();
+        let (sin_half, cos_half) = (theta * T::lit(0.5)).sincos();
+        Self::from_half_angle(w * w, theta, sin_half, cos_half)
+    }
+
+    /// For a finite `ω` whose `‖ω‖²` overflows (`‖ω‖ ≳ 1.8e19` in `f32`, `1.3e154` in `f64`):
+    /// the kernel and the unit axis `u = ω/θ`. `θ = m‖ω/m‖` from `ω` scaled by its largest
+    /// component `m` (infinite only when `‖ω‖` itself exceeds the largest finite number), the
+    /// half angle `(m/2)‖ω/m‖` (always finite) and its sine and cosine, reduced exactly by
+    /// [`Real::sincos`], and `θ²` infinite. At such angles one unit in the last place of `θ` is
+    /// many turns, so the rotation angle is what that rounding makes it; the axis is kept. The
+    /// coefficients stay finite; the users of such a kernel write `[ω]×ᵏ` as `θᵏ[u]×ᵏ`
+    /// ([`Self::is_huge`]).
+    #[cold]
+    #[inline(never)]
+    pub fn of_huge(w: &Vector3<T>) -> (Self, Vector3<T>) {
+        let m = w.iter().fold(T::zero(), |m, c| larger(m, c.abs()));
+        let scaled = w / m;
+        let n = scaled.norm_squared().sqrt_rn();
+        let (sin_half, cos_half) = (m * T::lit(0.5) * n).sincos();
+        (
+            Self::from_half_angle(T::lit(f64::INFINITY), m * n, sin_half, cos_half),
+            scaled / n,
+        )
+    }
+
+    /// `θ²` overflowed ([`Self::of_huge`], or [`Self::of_angle`] of a huge angle): every
+    /// coefficient is finite, but `[ω]×²` is not, so the Jacobians use `θ b = (1 − cos θ)/θ`
+    /// ([`Self::b_theta`]) with `[u]×` and `θ² c = 1 − a` with `[u]×²`, `u = ω/θ`.
+    pub fn is_huge(&self) -> bool {
+        !self.theta_sq.is_finite()
+    }
+
+    /// `θ b = (1 − cos θ)/θ = 2 sin²(θ/2)/θ`, without `b`'s `h²` (which underflows when `θ` is
+    /// huge).
+    pub fn b_theta(&self) -> T {
+        let s = self.sin_half;
+        (s * s + s * s) / self.theta
     }
 
     /// From `θ` and the sine and cosine of `θ/2`, already known (for example the vector norm and
@@ -154,7 +200,8 @@ impl<T: Real> AngleCoeffs<T> {
 
     /// `1 − cos θ`, as `2 sin²(θ/2)`.
     pub fn one_minus_cos(&self) -> T {
-        self.b * self.theta_sq
+        let s = self.sin_half;
+        s * s + s * s
     }
 
     /// `cos θ = 1 − 2 sin²(θ/2)`.

@@ -7,7 +7,8 @@
 use super::linalg;
 use super::{Loss, Manifold, SolveError};
 use crate::kernels::cholesky::solve_in_place;
-use crate::kernels::{all_finite, non_negative_finite, slice::dot};
+use crate::kernels::slice::{columns, dot};
+use crate::kernels::{all_finite, non_negative_finite};
 use crate::Real;
 use nalgebra::{SMatrix, SVector};
 
@@ -658,7 +659,7 @@ fn step_stats<T: Real>(a: &[T], g: &[T], step: &[T]) -> StepStats<T> {
     let info = if n == 0 {
         T::zero()
     } else {
-        a.chunks_exact(n)
+        columns(a, n)
             .zip(step)
             .fold(T::zero(), |acc, (col, &x)| acc + x * dot(col, step))
     };

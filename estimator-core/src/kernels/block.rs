@@ -24,13 +24,21 @@ pub(crate) fn block_in<T: Real>(s: &[T], rows: usize, i: usize, j: usize) -> Mat
     if 3 * i + 3 > rows {
         return out;
     }
-    for (c, dst) in out.as_mut_slice().chunks_exact_mut(3).enumerate() {
+    for (c, dst) in out.data.0.iter_mut().enumerate() {
         let start = rows * (3 * j + c) + 3 * i;
         if let Some(src) = s.get(start..start + 3) {
-            dst.copy_from_slice(src);
+            copy(dst, src);
         }
     }
     out
+}
+
+/// `dst[k] = src[k]` over the common length: `copy_from_slice` without its panic on a length
+/// mismatch (which only the optimizer removes).
+pub(crate) fn copy<T: Copy>(dst: &mut [T], src: &[T]) {
+    for (d, s) in dst.iter_mut().zip(src) {
+        *d = *s;
+    }
 }
 
 /// Writes `v` into block `(i, j)` of `m` (nothing outside the matrix).
@@ -43,10 +51,10 @@ pub(crate) fn set_block<T: Real, const R: usize, const C: usize>(
     if 3 * i + 3 > R {
         return;
     }
-    for (c, src) in v.as_slice().chunks_exact(3).enumerate() {
+    for (c, src) in v.data.0.iter().enumerate() {
         let s = R * (3 * j + c) + 3 * i;
         if let Some(dst) = m.as_mut_slice().get_mut(s..s + 3) {
-            dst.copy_from_slice(src);
+            copy(dst, src);
         }
     }
 }

@@ -10,7 +10,7 @@
 //! is the caller's relative pivot tolerance.
 
 use super::finite::all_finite;
-use super::slice::{axpy, dot};
+use super::slice::{axpy, columns, dot};
 use crate::Real;
 
 /// `A = L Lᵀ` in place on the column-major `n × n` storage `a`: only the lower triangle is
@@ -52,7 +52,7 @@ fn factor_inline<T: Real>(a: &mut [T], n: usize, relative_pivot: T) -> bool {
             return false;
         };
         let a_jj = col_j.first().copied().unwrap_or_else(T::zero);
-        for col_k in before.chunks_exact(n) {
+        for col_k in columns(before, n) {
             let Some(col_k) = col_k.get(j..) else {
                 continue;
             };
@@ -83,7 +83,7 @@ pub(crate) fn solve_in_place<T: Real>(l: &[T], n: usize, b: &mut [T]) {
     if n == 0 {
         return;
     }
-    for (i, col) in l.chunks_exact(n).enumerate().take(n) {
+    for (i, col) in columns(l, n).enumerate().take(n) {
         let diag = col.get(i).copied().unwrap_or_else(T::one);
         let Some(b_i) = b.get_mut(i) else { break };
         let y_i = *b_i / diag;

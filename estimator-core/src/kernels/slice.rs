@@ -15,10 +15,39 @@ pub(crate) fn axpy<T: Real>(y: &mut [T], a: T, x: &[T]) {
     }
 }
 
+/// The whole columns of the column-major storage `a` with `rows` rows, in order (none when
+/// `rows` is 0). The run-time matrices are walked through this, never with
+/// `chunks_exact(rows)`: a chunk iterator divides its length by the chunk size, and that
+/// division's panic path is removed only where the optimizer inlines it; this one splits
+/// the slice off column by column (`split_at_checked`) and cannot panic.
+pub(crate) fn columns<T>(a: &[T], rows: usize) -> Columns<'_, T> {
+    Columns { rest: a, rows }
+}
+
+/// The iterator of [`columns`].
+pub(crate) struct Columns<'a, T> {
+    rest: &'a [T],
+    rows: usize,
+}
+
+impl<'a, T> Iterator for Columns<'a, T> {
+    type Item = &'a [T];
+
+    fn next(&mut self) -> Option<&'a [T]> {
+        if self.rows == 0 {
+            return None;
+        }
+        let (column, rest) = self.rest.split_at_checked(self.rows)?;
+        self.rest = rest;
+        Some(column)
+    }
+}
+
 /// `out ← A x` for the column-major `out.len() × x.len()` matrix `a`.
 pub(crate) fn mat_vec<T: Real>(a: &[T], x: &[T], out: &mut [T]) {
     out.fill(T::zero());
-    for (col, xj) in a.chunks_exact(out.len().max(1)).zip(x) {
+    let rows = out.len();
+    for (col, xj) in columns(a, rows).zip(x) {
         axpy(out, *xj, col);
     }
 }
@@ -66,10 +95,10 @@ pub(crate) fn transpose_into<T: Real>(src: &[T], src_vec: &[T], dst: &mut [T], d
     for (d, s) in dst_vec.iter_mut().zip(src_vec) {
         *d = *s;
     }
-    let rows = src_vec.len().max(1);
-    let cols = src.len() / rows;
+    let rows = src_vec.len();
+    let cols = src.len().checked_div(rows).unwrap_or(0);
     dst.fill(T::zero());
-    for (j, col) in src.chunks_exact(rows).enumerate() {
+    for (j, col) in columns(src, rows).enumerate() {
         for (i, v) in col.iter().enumerate() {
             if let Some(e) = dst.get_mut(i * cols + j) {
                 *e = *v;

@@ -2,6 +2,7 @@
 
 use crate::eskf::error::EskfError;
 use crate::eskf::update::Linearization;
+use crate::kernels::block::copy;
 use crate::lie::{skew, LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -41,7 +42,7 @@ pub(super) fn three_rows<T: Real, const N: usize>(
     let h = jacobian.as_mut_slice();
     for (col, b) in blocks {
         if let Some(dst) = h.get_mut(3 * col..3 * col + 9) {
-            dst.copy_from_slice(b.as_slice());
+            copy(dst, b.as_slice());
         }
     }
     for col in identities {

@@ -4,7 +4,7 @@
 use super::work::{attitude_part, Work};
 use crate::eskf::error::EskfError;
 use crate::eskf::state::ErrorState;
-use crate::kernels::block::block;
+use crate::kernels::block::{block, copy};
 use crate::kernels::slice::axpy;
 use crate::kernels::{mat3, positive_finite};
 use crate::lie::{LieGroup, So3};
@@ -70,9 +70,9 @@ where
     // attitude block replaced by `c00`, and the upper triangle mirrored below.
     let cols = &mut p.data.0;
     rank2_upper(cols, v, k);
-    for (pc, c) in cols.iter_mut().zip(c00.as_slice().chunks_exact(3)) {
+    for (pc, c) in cols.iter_mut().zip(c00.data.0.iter()) {
         if let Some(head) = pc.get_mut(0..3) {
-            head.copy_from_slice(c);
+            copy(head, c);
         }
     }
     for pc in cols.iter_mut().skip(3) {

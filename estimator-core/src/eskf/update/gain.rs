@@ -10,23 +10,26 @@ use crate::kernels::{all_finite, slice::symmetrize};
 use crate::Real;
 use nalgebra::{SMatrix, SVector};
 
-/// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`, for the `n × n` covariance `p`
-/// (column-major) and the `m × m` noise `noise` (column-major), over the `m` active columns of
-/// the working set only. Returns the NIS `rᵀ S⁻¹ r` of the residual in `w`.
+/// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`, for the covariance `p` and the `m × m`
+/// noise `noise` (column-major), over the `m` active columns of the working set only. Returns
+/// the NIS `rᵀ S⁻¹ r` of the residual in `w`. The matrices are walked as arrays of columns
+/// (`[[T; N]; C]`), never as run-time chunks of a slice: no length is divided by a chunk size,
+/// so no panic path depends on what the optimizer inlines.
 #[inline(never)]
 fn gain_into<T: Real, const N: usize, const C: usize>(
-    p: &[T],
+    p: &SMatrix<T, N, N>,
     noise: &[T],
     w: &mut Work<T, N, C>,
 ) -> Result<T, EskfError> {
-    let n = N.max(1);
-    let (m, ht) = (w.m, w.ht.as_slice());
-    let (u, s, k) = (w.g.u.as_mut_slice(), &mut w.g.s, w.g.k.as_mut_slice());
+    let (m, ht) = (w.m, &w.ht.data.0);
+    let (u, s, k) = (&mut w.g.u.data.0, &mut w.g.s, &mut w.g.k.data.0);
     // Column c of U = Σ_j P e_j H_cj over the nonzero entries of row c of H only (most models
     // touch 3–6 of the 15 error components).
-    u.fill(T::zero());
-    for (uc, hc) in u.chunks_exact_mut(n).zip(ht.chunks_exact(n)).take(m) {
-        for (pc, h) in p.chunks_exact(n).zip(hc) {
+    for uc in u.iter_mut() {
+        uc.fill(T::zero());
+    }
+    for (uc, hc) in u.iter_mut().zip(ht.iter()).take(m) {
+        for (pc, h) in p.data.0.iter().zip(hc) {
             if *h != T::zero() {
                 axpy(uc, *h, pc);
             }
@@ -34,8 +37,8 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
     }
     // S_ij = R_ij + (row i of H)·(column j of U) for i, j < m; the identity padding stays.
     *s = padded_noise(noise, m);
-    for (j, uc) in u.chunks_exact(n).enumerate().take(m) {
-        for (i, hc) in ht.chunks_exact(n).enumerate().take(m) {
+    for (j, uc) in u.iter().enumerate().take(m) {
+        for (i, hc) in ht.iter().enumerate().take(m) {
             if let Some(e) = s.get_mut((i, j)) {
                 *e += dot(hc, uc);
             }
@@ -59,17 +62,15 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
     if !inverted {
         return Err(EskfError::SingularInnovation);
     }
-    k.fill(T::zero());
-    for (kc, sc) in k
-        .chunks_exact_mut(n)
-        .zip(s_inv.as_slice().chunks_exact(C.max(1)))
-        .take(m)
-    {
-        for (uc, s) in u.chunks_exact(n).zip(sc).take(m) {
+    for kc in k.iter_mut() {
+        kc.fill(T::zero());
+    }
+    for (kc, sc) in k.iter_mut().zip(s_inv.data.0.iter()).take(m) {
+        for (uc, s) in u.iter().zip(sc).take(m) {
             axpy(kc, *s, uc);
         }
     }
-    if !all_finite(k) {
+    if !all_finite(w.g.k.as_slice()) {
         return Err(EskfError::SingularInnovation);
     }
     // NIS = rᵀ S⁻¹ r.
@@ -85,7 +86,7 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
 /// The gain at the prior, the NIS and the gate, then `δx₁ = K₀ r₀` into `w.dx`. Returns
 /// `Rejected`, or `Accepted` with the NIS (its iteration count is set by the caller).
 pub(super) fn gate_step<T: Real, const N: usize, const C: usize>(
-    p: &[T],
+    p: &SMatrix<T, N, N>,
     noise: &[T],
     m: usize,
     opts: &UpdateOptions<T>,
@@ -105,7 +106,7 @@ pub(super) fn gate_step<T: Real, const N: usize, const C: usize>(
 /// were) when the gain or the step failed, else whether `‖δx_{k+1} − δx_k‖ < tol`.
 #[inline(never)]
 pub(super) fn step<T: Real, const N: usize, const C: usize>(
-    p: &[T],
+    p: &SMatrix<T, N, N>,
     noise: &[T],
     opts: &UpdateOptions<T>,
     w: &mut Work<T, N, C>,
@@ -113,13 +114,12 @@ pub(super) fn step<T: Real, const N: usize, const C: usize>(
     let saved = w.g;
     let ok = gain_into(p, noise, w).is_ok();
     // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
-    let n = N.max(1);
     let mut y = w.r;
-    for (yc, hc) in y.iter_mut().zip(w.ht.as_slice().chunks_exact(n)).take(w.m) {
+    for (yc, hc) in y.iter_mut().zip(w.ht.data.0.iter()).take(w.m) {
         *yc += dot(hc, w.dx.as_slice());
     }
     let mut next = SVector::<T, N>::zeros();
-    for (kc, yc) in w.g.k.as_slice().chunks_exact(n).zip(y.iter()).take(w.m) {
+    for (kc, yc) in w.g.k.data.0.iter().zip(y.iter()).take(w.m) {
         axpy(next.as_mut_slice(), *yc, kc);
     }
     if !(ok && all_finite(next.as_slice())) {

@@ -36,6 +36,7 @@ mod work;
 use super::covariance::is_spd;
 use super::error::{EskfError, UpdateOutcome};
 use super::state::ErrorState;
+use crate::kernels::block::copy;
 use crate::kernels::slice::transpose_into;
 use crate::kernels::{all_finite, mat3};
 use crate::lie::{LieGroup, So3};
@@ -139,7 +140,7 @@ where
         return Err(EskfError::NoiseNotPositiveDefinite);
     }
     linearize_into(model, x, &mut w, true)?;
-    let nis = match gate_step(p.as_slice(), noise, m, opts, &mut w)? {
+    let nis = match gate_step(p, noise, m, opts, &mut w)? {
         UpdateOutcome::Accepted { nis, .. } => nis,
         rejected => return Ok(rejected),
     };
@@ -180,10 +181,10 @@ where
     if !first {
         // H̃ᵀ = blockdiag(J_r(δθ)ᵀ, I) Hᵀ: only the attitude rows change.
         let jrt = So3::right_jacobian(&attitude_part(w.dx.as_slice())).transpose();
-        for col in w.ht.as_mut_slice().chunks_exact_mut(N.max(1)) {
+        for col in w.ht.data.0.iter_mut() {
             if let Some(top) = col.get_mut(0..3) {
                 let v = mat3::mul_vec(&jrt, &attitude_part(top));
-                top.copy_from_slice(v.as_slice());
+                copy(top, v.as_slice());
             }
         }
     }
@@ -211,7 +212,7 @@ where
         if linearize_into(model, x, w, false).is_err() {
             break;
         }
-        let Some(converged) = step(p.as_slice(), noise, opts, w) else {
+        let Some(converged) = step(p, noise, opts, w) else {
             break;
         };
         iterations += 1;

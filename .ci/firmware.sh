@@ -8,6 +8,7 @@
 #  3. builds the demo and runs it under QEMU (mps2-an386, Cortex-M4F) with the instruction-count
 #     plugin: a wrong result makes QEMU exit non-zero and fails CI;
 #  4. the link-time no-panic check at opt-level 3 and "s" (on failure, the panic call sites),
+#     then over the matrix of opt-levels 2, 3, "s", "z", plain and Cortex-M4-tuned, f32 and f64,
 #     and that its harness names every public function of estimator-core;
 #  5. no f64 soft-float routine in the f32 binaries;
 #  6. instruction counts, peak stack, size_of and flash against firmware/budgets.txt (opt-level 3)
@@ -144,6 +145,63 @@ else
     | grep -vE '^    (core::|_\$LT\$core|nalgebra::base::(ops|blas))' || true
   allowed nopanic-f64 || fail "no-panic check (f64 API, release)"
 fi
+# The same link-time check over the matrix of builds a user may choose: opt-levels 2, 3, "s"
+# and "z" (profiles release-2, release, release-s, release-z), each plain and tuned for the
+# Cortex-M4 (`-C target-cpu=cortex-m4`), each for the f32 and the f64 API. Library code has no
+# construct whose panic only the optimizer removes (no run-time chunk iterator, no nalgebra
+# view or product on a hot path of its own), so every cell must link. The three cells checked
+# above are not built again.
+step "no-panic matrix: the whole API at opt-levels 2, 3, s, z, plain and Cortex-M4-tuned, f32 and f64"
+matrix_failed=0
+for profile in release-2 release release-s release-z; do
+  for cpu in plain m4; do
+    for prec in f32 f64; do
+      case "$profile/$cpu/$prec" in
+        release/m4/f32 | release-s/plain/f32 | release/m4/f64) continue ;;
+      esac
+      cmd=build; [ "$cpu" = m4 ] && cmd=build-m4
+      features=(); [ "$prec" = f64 ] && features=(--features f64)
+      log="$OUT/nopanic-matrix-$profile-$cpu-$prec.log"
+      if cargo "$cmd" --profile "$profile" --bin nopanic "${features[@]}" \
+        --target-dir "target/matrix-$cpu-$prec" 2> "$log"; then
+        echo "no-panic ($profile, $cpu, $prec): links, no panic path reachable"
+      else
+        grep -E 'undefined symbol|referenced by|^error' "$log" | sed -n '1,3p' || true
+        echo "no-panic ($profile, $cpu, $prec): FAILED (locate with --features locate-panics)"
+        matrix_failed=1
+      fi
+    done
+  done
+done
+[ "$matrix_failed" = 0 ] || fail "no-panic matrix"
+
+# Each of the calls a firmware main loop makes, alone in its own binary (src/bin/single.rs, one
+# `single-*` feature each: one call site, as a user's firmware holds it), over the same matrix
+# of opt-levels and CPU models (f32; the target dirs of the matrix above, so that only the
+# small binary is built again).
+step "no-panic, one entry point per binary: filters' predict and updates, both navigators' imu"
+single_failed=0
+for profile in release-2 release release-s release-z; do
+  for cpu in plain m4; do
+    cmd=build; [ "$cpu" = m4 ] && cmd=build-m4
+    failed=()
+    for f in single-ins-predict single-ins-gnss-position single-ins-magnetometer \
+      single-ins-heading single-ahrs-predict single-ahrs-gravity single-ahrs-magnetometer \
+      single-ins-navigator-imu single-attitude-navigator-imu; do
+      if ! cargo "$cmd" --profile "$profile" --bin single --features "$f" \
+        --target-dir "target/matrix-$cpu-f32" 2> "$OUT/single-$f-$profile-$cpu.log"; then
+        failed+=("$f")
+      fi
+    done
+    if [ ${#failed[@]} -eq 0 ]; then
+      echo "single entry points ($profile, $cpu): all 9 link, no panic path reachable"
+    else
+      echo "single entry points ($profile, $cpu): FAILED: ${failed[*]}"
+      single_failed=1
+    fi
+  done
+done
+[ "$single_failed" = 0 ] || fail "no-panic, one entry point per binary"
 if cargo build --profile release-s --bin nopanic --features selftest-panic --target-dir target/selftest \
   2> "$OUT/nopanic-selftest.log"; then
   fail "no-panic self-test: a binary with a reachable panic linked (the check is vacuous)"

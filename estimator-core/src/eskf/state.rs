@@ -5,7 +5,7 @@ use super::error::EskfError;
 use crate::kernels::all_finite;
 use crate::lie::{LieGroup, So3};
 use crate::Real;
-use nalgebra::{Matrix3x4, SVector, Vector3};
+use nalgebra::{SVector, Vector3};
 
 /// A nominal state with an `N`-dimensional error state whose first three components are the
 /// right attitude error `δθ` (`R = R̂·exp(δθ^)`, the right `⊕` of *Lie Groups and Smooth
@@ -167,13 +167,13 @@ impl<T: Real> ErrorState<T, 15> for InsState<T> {
 
     fn is_finite(&self) -> bool {
         // The four vectors side by side: one check.
-        let vectors = Matrix3x4::from_columns(&[
-            self.velocity,
-            self.position,
-            self.gyro_bias,
-            self.accel_bias,
-        ]);
-        self.attitude.is_finite() && all_finite(vectors.as_slice())
+        let vectors = [
+            self.velocity.data.0,
+            self.position.data.0,
+            self.gyro_bias.data.0,
+            self.accel_bias.data.0,
+        ];
+        self.attitude.is_finite() && all_finite(vectors.as_flattened().as_flattened())
     }
 
     fn attitude(&self) -> &So3<T> {

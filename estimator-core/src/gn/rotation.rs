@@ -19,7 +19,7 @@
 
 use super::solver::{solve_into, Problem, Solution, SolverOptions, Status};
 use super::SolveError;
-use crate::kernels::{all_finite, positive_finite};
+use crate::kernels::{all_finite, mat3, positive_finite};
 use crate::lie::{skew, LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
@@ -98,7 +98,7 @@ pub(super) fn triad<T: Real>(
 ) -> Option<So3<T>> {
     let b = triad_frame(b1, b2)?;
     let w = triad_frame(w1, w2)?;
-    So3::from_rotation_matrix(&(w * b.transpose()))
+    So3::from_rotation_matrix(&mat3::mul(&w, &b.transpose()))
 }
 
 /// [`triad`] of the unit vectors of two pairs; `None` for a zero vector or parallel directions.

@@ -92,14 +92,18 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
         let (rho, w) = loss.evaluate(e.norm_squared());
         let wj = j * w;
         // `A += (w J)ᵀ J` entry by entry, `A_rc += (w J_r)·J_c` over the columns `J_r`, `J_c`.
-        for (r, wcol) in wj.column_iter().enumerate() {
-            for (c, jcol) in j.column_iter().enumerate() {
+        // Columns as arrays (`[[T; K]; N]`), not nalgebra's column views, whose index
+        // assertion is a panic path wherever they are not inlined.
+        for (r, wcol) in wj.data.0.iter().enumerate() {
+            for (c, jcol) in j.data.0.iter().enumerate() {
                 if let Some(x) = self.information.get_mut((r, c)) {
-                    *x += wcol.dot(&jcol);
+                    *x += dot(wcol, jcol);
                 }
             }
         }
-        self.gradient += wj.tr_mul(e);
+        for (g, wcol) in self.gradient.iter_mut().zip(wj.data.0.iter()) {
+            *g += dot(wcol, e.as_slice());
+        }
         self.cost += rho;
         self.blocks += 1;
     }

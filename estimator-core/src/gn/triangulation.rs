@@ -15,7 +15,7 @@
 use super::rotation::normalized;
 use super::solver::{solve_into, Method, Problem, Solution, SolverOptions, Status};
 use super::{reprojection_error, Factor, Loss, PinholeCamera, SolveError};
-use crate::kernels::all_finite;
+use crate::kernels::{all_finite, mat3};
 use crate::lie::{LieGroup, Se3};
 use crate::Real;
 use nalgebra::{Matrix2x3, Matrix3, SMatrix, SVector, Vector2, Vector3};
@@ -185,9 +185,10 @@ pub fn triangulate<T: Real>(
         let world_from_camera = pose.inverse();
         let c = world_from_camera.translation();
         let (d, _) = normalized(&world_from_camera.rotation().act(&camera.unproject(z)));
-        let projector = Matrix3::identity() - d * d.transpose();
+        // d dᵀ as half of d dᵀ + d dᵀ (exact: a power of two).
+        let projector = Matrix3::identity() - mat3::sym_outer(&d, &d) * T::lit(0.5);
         m += projector;
-        b += projector * c;
+        b += mat3::mul_vec(&projector, &c);
     }
     // Any failure of the factor or the solve is degenerate geometry (parallel rays).
     let start = Factor::new(&m)

@@ -77,6 +77,7 @@ pub use so3::So3;
 
 pub use crate::scalar::Real;
 
+use crate::kernels::slice::dot;
 use nalgebra::{Const, DimMin, Matrix3, SMatrix, SVector, Vector3};
 
 /// A matrix Lie group acting on points, with the operations and Jacobians of the module docs.
@@ -376,7 +377,15 @@ pub(crate) fn near_rotation<T: Real, const N: usize>(m: &SMatrix<T, N, N>) -> bo
 where
     Const<N>: DimMin<Const<N>, Output = Const<N>>,
 {
-    let err = (m.tr_mul(m) - SMatrix::<T, N, N>::identity()).norm_squared();
+    // ‖mᵀm − I‖²_F over the columns as arrays: (mᵀm)_ij = cᵢ·cⱼ (no nalgebra view, whose
+    // index assertion is a panic path wherever it is not inlined).
+    let cols = &m.data.0;
+    let err = cols.iter().enumerate().fold(T::zero(), |acc, (i, ci)| {
+        cols.iter().enumerate().fold(acc, |acc, (j, cj)| {
+            let e = dot(ci, cj) - if i == j { T::one() } else { T::zero() };
+            acc + e * e
+        })
+    });
     let tol = T::lit(ORTHOGONALITY_TOLERANCE);
     // Written so that NaN (which compares false) is rejected too.
     err <= tol * tol && m.determinant() > T::zero()

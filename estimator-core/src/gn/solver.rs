@@ -94,15 +94,15 @@ impl<T: Real, const N: usize> NormalEquations<T, N> {
         // `A += (w J)ᵀ J` entry by entry, `A_rc += (w J_r)·J_c` over the columns `J_r`, `J_c`.
         // Columns as arrays (`[[T; K]; N]`), not nalgebra's column views, whose index
         // assertion is a panic path wherever they are not inlined.
-        for (r, wcol) in wj.data.0.iter().enumerate() {
-            for (c, jcol) in j.data.0.iter().enumerate() {
-                if let Some(x) = self.information.get_mut((r, c)) {
-                    *x += dot(wcol, jcol);
-                }
+        // Column c of A gains (w J_r)·J_c in row r.
+        for (a_col, jcol) in self.information.data.0.iter_mut().zip(j.data.0.iter()) {
+            for (x, wcol) in a_col.iter_mut().zip(wj.data.0.iter()) {
+                *x += dot_k(wcol, jcol);
             }
         }
+        let [e_col] = &e.data.0;
         for (g, wcol) in self.gradient.iter_mut().zip(wj.data.0.iter()) {
-            *g += dot(wcol, e.as_slice());
+            *g += dot_k(wcol, e_col);
         }
         self.cost += rho;
         self.blocks += 1;
@@ -654,6 +654,14 @@ fn damped_step<T: Real>(
         return Err(StepError::Solve(SolveError::NonFiniteResidual));
     }
     Ok(step_stats(a, g, step))
+}
+
+/// `a·b` for two columns of `K` entries: nalgebra's `dot` of owned fixed-size vectors (its
+/// unrolled sums; no column view, so no index assertion), inlined where it is used
+/// (`NormalEquations::add` runs it `N² + N` times per block).
+#[inline(always)]
+fn dot_k<T: Real, const K: usize>(a: &[T; K], b: &[T; K]) -> T {
+    SVector::<T, K>::from(*a).dot(&SVector::<T, K>::from(*b))
 }
 
 /// `‖ξ‖`, `ξᵀAξ` and `ξᵀg` for the column-major `n × n` matrix `a` (`n` the length of `step`).

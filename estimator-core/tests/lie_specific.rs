@@ -680,6 +680,18 @@ fn se3_huge_rotation_vectors_give_finite_limits() {
     let xi = Vector6::new(1.0_f32, 1.0, 1.0, 1e20, 0.0, 0.0);
     let (t, j) = Se3::<f32>::exp_jac(&xi);
     assert!(t.is_finite() && j.iter().all(|x: &f32| x.is_finite()));
+    // ‖ω‖² is finite (1.5e38) but ω×(ω×v) is not: the fuzzer's input.
+    let xi = Vector6::new(
+        99.725334_f32,
+        2812.3904,
+        -0.9869688,
+        0.007411765,
+        -9.218709e18,
+        -8.0297587e18,
+    );
+    let (t, j) = Se3::<f32>::exp_jac(&xi);
+    assert!(t.is_finite() && j.iter().all(|x: &f32| x.is_finite()));
+    assert_eq!(t, Se3::exp(&xi));
 }
 
 /// SE(2) with an angle whose square overflows: `exp` is a rotation (unit `(cos, sin)`) with a

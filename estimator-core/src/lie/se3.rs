@@ -141,7 +141,15 @@ fn cross_poly<T: Real>(p: T, q: T, w: &Vector3<T>, x: &Vector3<T>) -> Vector3<T>
     x + wx * p + wwx * q
 }
 
-/// `exp(ξ)` and `J_r(ξ)` of a finite `ξ = [v; ω]` whose `‖ω‖²` overflows
+/// `true` when the ordinary formulas would overflow in an intermediate product although the
+/// result is finite: `‖ω‖²` itself, or `ω×(ω×v)` (about `θ²‖v‖`, so whenever `θ²‖v‖²`
+/// overflows with `θ > 1`). The scaled path ([`exp_jac_huge`]) never forms those products.
+#[inline(always)]
+fn needs_scaling<T: Real>(theta_sq: T, v: &Vector3<T>) -> bool {
+    !theta_sq.is_finite() || (theta_sq > T::one() && !(theta_sq * v.norm_squared()).is_finite())
+}
+
+/// `exp(ξ)` and `J_r(ξ)` of a finite `ξ = [v; ω]` whose `‖ω‖²` or `θ²‖v‖²` overflows
 /// ([`AngleCoeffs::of_huge`]; every `[ω]×ᵏ` written as `θᵏ[u]×ᵏ`, see [`q_block`]):
 /// `(exp(ω), v + θb u×v + θ²c u×(u×v))` and `[[J_r(ω), Q(−v, −ω)], [0, J_r(ω)]]`. Out of line
 /// and cold: the ordinary path of every caller stays as it was.
@@ -162,7 +170,8 @@ fn exp_jac_huge<T: Real>(v: &Vector3<T>, w: &Vector3<T>) -> (Se3<T>, Matrix6<T>)
     (exp, upper_block(&jr, &q))
 }
 
-/// `exp(ξ) = (exp(ω), v + θb u×v + θ²c u×(u×v))` of a finite `ξ` whose `‖ω‖²` overflows (as
+/// `exp(ξ) = (exp(ω), v + θb u×v + θ²c u×(u×v))` of a finite `ξ` whose `‖ω‖²` or `θ²‖v‖²`
+/// overflows (as
 /// [`exp_jac_huge`], without the Jacobian).
 #[cold]
 #[inline(never)]
@@ -262,7 +271,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     fn exp(xi: &Vector6<T>) -> Self {
         let (v, w) = split(xi);
         let theta_sq = w.norm_squared();
-        if !theta_sq.is_finite() {
+        if needs_scaling(theta_sq, &v) {
             return exp_huge(&v, &w);
         }
         Self::exp_from(&AngleCoeffs::from_theta_sq(theta_sq), &v, &w)
@@ -318,7 +327,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     fn right_jacobian(xi: &Vector6<T>) -> Matrix6<T> {
         let (v, w) = split(xi);
         let theta_sq = w.norm_squared();
-        if !theta_sq.is_finite() {
+        if needs_scaling(theta_sq, &v) {
             return exp_jac_huge(&v, &w).1;
         }
         Self::jr_from(&AngleCoeffs::from_theta_sq(theta_sq), &v, &w)
@@ -370,7 +379,7 @@ impl<T: Real> LieGroup<T> for Se3<T> {
     fn exp_jac(xi: &Vector6<T>) -> (Self, Matrix6<T>) {
         let (v, w) = split(xi);
         let theta_sq = w.norm_squared();
-        if !theta_sq.is_finite() {
+        if needs_scaling(theta_sq, &v) {
             return exp_jac_huge(&v, &w);
         }
         let k = AngleCoeffs::from_theta_sq(theta_sq);

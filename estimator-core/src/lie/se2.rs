@@ -47,18 +47,10 @@ pub struct Se2<T: Real> {
 /// underflows.
 fn w_times_b<T: Real>(k: &AngleCoeffs<T>, w: T) -> T {
     if k.is_huge() {
-        huge_over_theta(k.b_theta(), w)
+        k.b_theta() * w.signum()
     } else {
         w * k.b
     }
-}
-
-/// `x · sign(ω)`: `θ`-scaled coefficients of a huge angle carried to the signed `ω`. Cold and
-/// out of line.
-#[cold]
-#[inline(never)]
-fn huge_over_theta<T: Real>(x: T, w: T) -> T {
-    x * w.signum()
 }
 
 impl<T: Real> Se2<T> {
@@ -117,7 +109,7 @@ impl<T: Real> Se2<T> {
         let wb = w_times_b(k, w);
         // ω c = ±(1 − a)/θ for a huge ω (c underflows to 0 there).
         let wc = if k.is_huge() {
-            huge_over_theta((T::one() - k.a) / k.theta, w)
+            (T::one() - k.a) / k.theta * w.signum()
         } else {
             w * k.c
         };

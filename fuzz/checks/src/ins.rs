@@ -15,7 +15,7 @@
 //! (past, future, duplicate, a jump), or move the clocks.
 
 use crate::input::{Input, Scalar};
-use crate::{covariance_problem, finding, same, Finding, Log, Outcome};
+use crate::{covariance_problem, differing, finding, same, Finding, Log, Outcome};
 use estimator_core::eskf::{ErrorState, FilterConfig};
 use estimator_core::lie::{LieGroup, So3};
 use estimator_core::nalgebra::Vector3;
@@ -613,11 +613,7 @@ fn check<T: Scalar, const H: usize, const Q: usize>(
                         expected.counters().refused == after.counters().refused,
                     ),
                 ];
-                let changed: Vec<&str> = parts
-                    .iter()
-                    .filter(|(_, same)| !same)
-                    .map(|(name, _)| *name)
-                    .collect();
+                let changed = differing(&parts);
                 return Some((
                     "unchanged-on-error",
                     format!(

@@ -244,6 +244,15 @@ pub(crate) fn covariance_problem<T: Real, const N: usize>(p: &SMatrix<T, N, N>) 
     None
 }
 
+/// The names of the parts whose comparison failed, for a finding's detail.
+pub(crate) fn differing(parts: &[(&'static str, bool)]) -> Vec<&'static str> {
+    parts
+        .iter()
+        .filter(|(_, same)| !same)
+        .map(|(name, _)| *name)
+        .collect()
+}
+
 /// `a` and `b` are the same value: `==`, or, where `==` fails on a NaN, the same printed form
 /// (every float printed exactly).
 pub(crate) fn same<V: PartialEq + core::fmt::Debug>(a: &V, b: &V) -> bool {

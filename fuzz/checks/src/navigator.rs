@@ -7,7 +7,7 @@
 //! asks for arbitrary values; timestamps advance by a plausible step, or jump anywhere.
 
 use crate::input::{Input, Scalar};
-use crate::{covariance_problem, finding, same, Log, Outcome};
+use crate::{covariance_problem, differing, finding, same, Log, Outcome};
 use estimator_core::eskf::FilterConfig;
 use estimator_core::lie::{LieGroup, So3};
 use estimator_core::nalgebra::Vector3;
@@ -282,11 +282,7 @@ fn check<T: Scalar>(
                         expected.counters().refused == after.counters().refused,
                     ),
                 ];
-                let changed: Vec<&str> = parts
-                    .iter()
-                    .filter(|(_, same)| !same)
-                    .map(|(name, _)| *name)
-                    .collect();
+                let changed = differing(&parts);
                 return Err(finding(
                     "unchanged-on-error",
                     call,

@@ -524,3 +524,245 @@ fn noise_that_overflows_the_process_noise_is_refused() {
     c64.imu_noise.accelerometer_random_walk = 1e100;
     assert_eq!(c64.validate(), Ok(()));
 }
+
+/// `P` is positive definite: its Cholesky factor exists, in the filter's precision (nalgebra's
+/// factorization, not the filter's own).
+fn positive_definite<T: estimator_core::Real, const N: usize>(p: &SMatrix<T, N, N>) -> bool {
+    p.cholesky().is_some()
+}
+
+/// A heading far more precise than its prior (σ = 1e-5 … 1e-8 rad against about 0.1 rad), in
+/// `f32`, gate off: accepted, and `P` stays positive definite (the row's noise is raised to the
+/// floor `8 N ε Σ_i H_i² P_ii`, and the attitude block keeps its own floor).
+#[test]
+fn f32_heading_far_more_precise_than_its_prior_keeps_covariance_positive_definite() {
+    for sigma in [1e-5f32, 1e-6, 1e-8] {
+        let mut p = SMatrix::<f32, 6, 6>::identity() * 1e-2;
+        for k in 3..6 {
+            p[(k, k)] = 1e-6;
+        }
+        let mut f = Ahrs::new(AhrsState::identity(), p, FilterConfig::default()).expect("valid");
+        let sample = ImuSample {
+            gyro: Vector3::new(0.3f32, -0.2, 0.5),
+            accel: Vector3::zeros(),
+            dt: 0.01,
+        };
+        for _ in 0..10 {
+            f.predict(&sample).expect("valid sample");
+        }
+        let prior = f.covariance()[(2, 2)];
+        let outcome = f
+            .update(&Heading::new(0.1, sigma), &UpdateOptions::ekf(Gate::Off))
+            .expect("a finite heading");
+        assert!(outcome.is_accepted(), "{outcome:?}");
+        assert!(positive_definite(f.covariance()), "σ = {sigma}");
+        // The posterior heading variance is that of a measurement at the floor: below the
+        // prior, and not below f·prior (the yaw row reads the heading with |H| ≤ 1).
+        let floor = 8.0 * 6.0 * f32::EPSILON;
+        let post = f.covariance()[(2, 2)];
+        assert!(
+            post < prior * 1e-3 && post > floor * prior * 0.5,
+            "{post} vs {prior}"
+        );
+    }
+}
+
+/// A subnormal heading noise (5e-324 rad²) in `f64`, gate off, after a fast turn: accepted at
+/// the floor, `P` positive definite.
+#[test]
+fn subnormal_heading_noise_is_fused_at_the_floor() {
+    let alignment = Alignment {
+        attitude: So3::identity(),
+        gyro_bias: Vector3::zeros(),
+        heading_from_magnetometer: false,
+    };
+    let mut f = Ahrs::<f64>::from_alignment(
+        &alignment,
+        &InitialSigmas::default(),
+        FilterConfig::default(),
+    )
+    .expect("valid");
+    f.predict(&imu([0.0, -2.836, -2.086], [0.0; 3], 0.1))
+        .expect("valid sample");
+    let h = Heading {
+        yaw: 5e-324,
+        noise: Matrix1::new(5e-324),
+    };
+    let outcome = f
+        .update(&h, &UpdateOptions::ekf(Gate::Off))
+        .expect("a finite heading");
+    assert!(outcome.is_accepted(), "{outcome:?}");
+    assert!(positive_definite(f.covariance()));
+}
+
+/// `f32`, a body at rest tilted 56° about y with the heading unknown (σ_ψ = π): a minute of
+/// gravity updates at 100 Hz tightens the tilt to about a milliradian beside a heading of
+/// radians. In the body frame every attitude entry is then of the heading's size and the tilt
+/// lives in their differences, below `f32`'s resolution of them: without the attitude floor
+/// `P` is indefinite within seconds. With it `P` stays positive definite after every call and
+/// the tilt's σ stays within its bound `√(16 ε tr P_θθ)` of what `f64` reports.
+#[test]
+fn f32_tilted_at_rest_with_unknown_heading_keeps_covariance_positive_definite() {
+    fn run<T: estimator_core::Real>(mut check: impl FnMut(&Ahrs<T>)) -> Ahrs<T> {
+        let attitude = So3::exp(&Vector3::new(T::zero(), T::lit(0.98), T::zero()));
+        let alignment = Alignment {
+            attitude,
+            gyro_bias: Vector3::zeros(),
+            heading_from_magnetometer: false,
+        };
+        let sigmas = InitialSigmas {
+            yaw: T::lit(core::f64::consts::PI),
+            ..InitialSigmas::default()
+        };
+        let mut f =
+            Ahrs::<T>::from_alignment(&alignment, &sigmas, FilterConfig::default()).expect("valid");
+        let up = attitude
+            .inverse()
+            .act(&Vector3::new(T::zero(), T::zero(), T::lit(9.81)));
+        let sample = ImuSample {
+            gyro: Vector3::zeros(),
+            accel: up,
+            dt: T::lit(0.01),
+        };
+        for _ in 0..6000 {
+            f.predict(&sample).expect("valid sample");
+            check(&f);
+            f.update(
+                &GravityDirection::new(up, T::lit(0.01)),
+                &UpdateOptions::default(),
+            )
+            .expect("valid update");
+            check(&f);
+        }
+        f
+    }
+    let mut calls = 0;
+    let f32_filter = run::<f32>(|f| {
+        calls += 1;
+        assert!(positive_definite(f.covariance()), "call {calls}");
+    });
+    let f64_filter = run::<f64>(|_| ());
+    // The tilt's σ: the smallest σ of the attitude block (the heading is the largest).
+    let tilt = |p: Matrix3<f64>| p.symmetric_eigenvalues().min().sqrt();
+    let p32 = f32_filter
+        .covariance()
+        .fixed_view::<3, 3>(0, 0)
+        .map(f64::from);
+    let p64 = f64_filter
+        .covariance()
+        .fixed_view::<3, 3>(0, 0)
+        .into_owned();
+    let bound = (16.0 * f64::from(f32::EPSILON) * p32.trace()).sqrt();
+    assert!(tilt(p64) < 1e-3, "the tilt is known: {}", tilt(p64));
+    assert!(
+        tilt(p32) >= tilt(p64) * 0.99 && tilt(p32) <= tilt(p64) + 2.0 * bound,
+        "f32 {} f64 {} bound {bound}",
+        tilt(p32),
+        tilt(p64)
+    );
+}
+
+/// Widening by sigmas far above π leaves every attitude variance at most π²: an attitude
+/// error of σ = π is no information. `P` stays positive definite through later predictions.
+#[test]
+fn widening_the_attitude_stops_at_no_information() {
+    let mut f = ahrs::<f32>();
+    f.widen_attitude(1e30, 1e30).expect("finite sigmas");
+    let pi2 = core::f32::consts::PI * core::f32::consts::PI;
+    for k in 0..3 {
+        assert!(f.covariance()[(k, k)] <= pi2 * (1.0 + 4.0 * f32::EPSILON));
+    }
+    let before = *f.covariance();
+    f.widen_attitude(1.0, 1.0).expect("finite sigmas");
+    assert!((0..3).all(|k| f.covariance()[(k, k)] <= pi2 * (1.0 + 4.0 * f32::EPSILON)));
+    assert!(positive_definite(&before) && positive_definite(f.covariance()));
+    let sample = ImuSample {
+        gyro: Vector3::new(0.3f32, -0.2, 0.5),
+        accel: Vector3::zeros(),
+        dt: 0.01,
+    };
+    for _ in 0..100 {
+        f.predict(&sample).expect("valid sample");
+        assert!(positive_definite(f.covariance()));
+    }
+}
+
+/// A GNSS fix of σ = 1e-6 m against a position prior of 0.1 m, in `f32`: accepted, and `P`
+/// stays positive definite because each row's noise is raised to the floor
+/// `8 N ε Σ_i H_i² P_ii` (here `8·15·ε·0.01`). Without the floor the Joseph form cancels and the
+/// position block is indefinite after this one update.
+#[test]
+fn f32_fix_far_more_precise_than_its_prior_is_fused_at_the_noise_floor() {
+    let mut f = ins::<f32>();
+    let fix = GnssPosition::new(f.state().position, Vector3::zeros(), 1e-6);
+    let outcome = f
+        .update(&fix, &UpdateOptions::default())
+        .expect("a finite fix");
+    assert!(outcome.is_accepted(), "{outcome:?}");
+    assert!(positive_definite(f.covariance()));
+    // Fused as a fix of variance f·0.01: the posterior position variance is that, within the
+    // rounding of the prior (0.01 · 4ε).
+    let floor = 8.0 * 15.0 * f32::EPSILON * 0.01;
+    for k in 6..9 {
+        let v = f.covariance()[(k, k)];
+        assert!(
+            (v - floor).abs() <= 0.04 * f32::EPSILON + floor * 1e-2,
+            "{v} vs {floor}"
+        );
+    }
+}
+
+/// `f32`, a position known to 1e-6 m beside a velocity of σ = 1e8 m/s (`P = 1e-12 I`, then the
+/// velocity reset), one prediction of 0.1 ms: the position's new variance (1e8 dt²) is almost
+/// wholly correlated with the velocity, which `f32` cannot carry. The growth floor adds
+/// `f = 8 N ε` times each variance's growth: `P` stays positive definite, and the variances
+/// change by that relative amount only.
+#[test]
+fn f32_prediction_from_a_far_less_certain_velocity_keeps_covariance_positive_definite() {
+    let state = InsState::<f32> {
+        attitude: So3::identity(),
+        velocity: Vector3::zeros(),
+        position: Vector3::zeros(),
+        gyro_bias: Vector3::zeros(),
+        accel_bias: Vector3::zeros(),
+    };
+    let p = SMatrix::<f32, 15, 15>::identity() * 1e-12;
+    let mut f = Ins::new(state, p, FilterConfig::default()).expect("valid");
+    f.reset_velocity(Vector3::zeros(), 1e8).expect("finite");
+    let sample = ImuSample {
+        gyro: Vector3::new(-1e-6, -1e-6, -1e-6),
+        accel: Vector3::new(0.0, 2.55, 10.77),
+        dt: 1e-4,
+    };
+    f.predict(&sample).expect("valid sample");
+    assert!(positive_definite(f.covariance()));
+    // P⁺_pp = P_pp + dt² P_vv (+ a Q of 1e-19), floored: times (1 + f), f = 8·15·ε; within the
+    // rounding of a few operations.
+    let grown = 1e16f64 * 1e-8 * (1.0 + 8.0 * 15.0 * f64::from(f32::EPSILON));
+    for k in 6..9 {
+        let position = f64::from(f.covariance()[(k, k)]);
+        assert!(
+            (position - grown).abs() <= grown * 8.0 * f64::from(f32::EPSILON),
+            "{position} vs {grown}"
+        );
+    }
+}
+
+/// `f32`, forty predictions with a specific force of 5.2e20 m/s² (finite, accepted): each
+/// turns the attitude's variance into the velocity's and the position's, a growth of 1e37
+/// wholly correlated with the attitude. Without the growth floor the correlation matrix's
+/// smallest eigenvalue falls tenfold per prediction and `P` is indefinite after the first or
+/// second; with it `P` stays positive definite after every one.
+#[test]
+fn f32_repeated_predictions_with_a_huge_acceleration_keep_covariance_positive_definite() {
+    let mut f = ins::<f32>();
+    let sample = ImuSample {
+        gyro: Vector3::repeat(0.007_647_059f32),
+        accel: Vector3::new(0.007_647_059, -5.208_492e20, -0.009_931_334),
+        dt: 0.003_078_250_4,
+    };
+    for k in 0..40 {
+        f.predict(&sample).expect("finite: the variances stay below 1e38");
+        assert!(positive_definite(f.covariance()), "prediction {k}");
+    }
+}

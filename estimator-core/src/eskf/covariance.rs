@@ -6,7 +6,7 @@ use super::state::ErrorState;
 use crate::kernels::all_finite;
 use crate::kernels::cholesky::factor_in_place;
 use crate::Real;
-use nalgebra::{SMatrix, SVector};
+use nalgebra::{Matrix3, SMatrix, SVector};
 
 /// `A` is finite, symmetric to `10⁻⁶` of its largest entry, and positive definite (its Cholesky
 /// factor exists).
@@ -46,4 +46,78 @@ pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
 /// `√max(P_ii, 0)` for each `i`: the 1-σ of each error-state component.
 pub(crate) fn sigmas<T: Real, const N: usize>(p: &SMatrix<T, N, N>) -> SVector<T, N> {
     p.diagonal().map(|d| d.max(T::zero()).sqrt_rn())
+}
+
+/// The attitude floor, `f = 16 ε`: the smallest eigenvalue the attitude block of `P` is kept
+/// at, as a fraction of its trace.
+///
+/// The attitude error is in the body frame, so when the heading is unknown (σ_ψ of radians)
+/// and the tilt known (σ of milliradians) every entry of the block is of the heading's size and
+/// the tilt lives in their differences. Rounding moves each entry by a few `ε·tr(P_θθ)` per
+/// call, so a tilt variance below about that is not representable: in `f32` (ε = 1.2e-7) it
+/// leaves `P` indefinite within seconds. The floor is the smallest margin over that rounding.
+const ATTITUDE_FLOOR: f64 = 16.0;
+
+/// The attitude floor of the block `A = P_θθ` (the top-left 3 × 3 of `P`): `f·tr A`
+/// ([`ATTITUDE_FLOOR`]) when the smallest eigenvalue of `A` may be below that, else zero. The
+/// caller adds it to the diagonal of `A`, keeping the block representable in the scalar.
+///
+/// The test is the bound `λ_min ≥ det A / (λ₁ λ₂) ≥ 4 det A / (tr A)²` (the two larger
+/// eigenvalues have a product at most `(tr A / 2)²`), so it costs a determinant, not an
+/// eigen-decomposition. It may floor a block whose smallest eigenvalue is larger; that changes
+/// it by at most `f·tr A`, below the block's own rounding. Adding `c I` to a positive
+/// semi-definite block of a positive semi-definite `P` keeps `P` so, and `c I` is the same in
+/// every frame: the tilt and the heading are widened alike. In `f64` the floor is
+/// `3.6e-15 tr A`: it never acts on a usable filter. In `f32` it acts only when the heading is
+/// unknown, and then keeps the tilt's σ at least `√(f tr A)`: 3.4 mrad when σ_ψ = 2.4 rad.
+#[inline(never)] // one copy per scalar type, not one per filter and call site
+pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
+    let tr = a.m11 + a.m22 + a.m33;
+    let floor = tr * T::lit(ATTITUDE_FLOOR * T::EPSILON_F64);
+    // The symmetric block's determinant by cofactors of its first row (upper triangle only).
+    let det = a.m11 * (a.m22 * a.m33 - a.m23 * a.m23) - a.m12 * (a.m12 * a.m33 - a.m23 * a.m13)
+        + a.m13 * (a.m12 * a.m23 - a.m22 * a.m13);
+    if det * T::lit(4.0) <= floor * tr * tr {
+        floor
+    } else {
+        T::zero()
+    }
+}
+
+/// The growth floor, `f = 8 N ε` (the noise floor's fraction): the part of each variance's
+/// growth in a prediction that is made independent of every other state.
+const GROWTH_FLOOR: f64 = 8.0;
+
+/// Floors the first `K` variances of a predicted `P`: where `P⁺_kk` grew from its value before
+/// the prediction (`before[k]`), adds `f (P⁺_kk − before[k])` ([`GROWTH_FLOOR`]).
+///
+/// A prediction integrates: `p⁺ = p + v dt`, `v⁺ = v + a dt`, `θ⁺ = ΔRᵀ θ − J_r dt b_g`. The
+/// variance it adds comes from other states and may be wholly correlated with them (a velocity
+/// of σ = 10⁸ m/s beside a position of 10⁻⁶ m; an acceleration of 10²⁰ m/s² turning the
+/// attitude's variance into the velocity's). When it dominates, the smallest eigenvalue of the
+/// correlation matrix falls below the rounding of `F P Fᵀ` (a few `ε` per entry) and `P⁺` is
+/// indefinite; prediction after prediction it falls by the growth factor each time. A fraction
+/// `f` of each growth made independent keeps every state's variance, given all the others, at
+/// least about `f/3` of its variance across any number of predictions. In `f64` that is
+/// `2.7e-14` of the growth; in `f32`, `1.4e-5`: a process noise larger by that fraction.
+pub(crate) fn floor_growth<T: Real, const N: usize, const K: usize>(
+    p: &mut SMatrix<T, N, N>,
+    before: &[T; K],
+) {
+    let f = T::lit(GROWTH_FLOOR * T::EPSILON_F64 * N as f64);
+    for (k, own) in before.iter().enumerate() {
+        if let Some(d) = p.get_mut((k, k)) {
+            let grown = *d - *own;
+            if grown > T::zero() {
+                *d += grown * f;
+            }
+        }
+    }
+}
+
+/// The first `K` diagonal entries of `P`.
+pub(crate) fn leading_diagonal<T: Real, const N: usize, const K: usize>(
+    p: &SMatrix<T, N, N>,
+) -> [T; K] {
+    core::array::from_fn(|k| p.get((k, k)).copied().unwrap_or_else(T::zero))
 }

@@ -2,7 +2,7 @@
 
 use super::align::{prior_attitude_covariance, Alignment, InitialSigmas};
 use super::config::{FilterConfig, ImuSample};
-use super::covariance::{check_start, is_spd, sigmas};
+use super::covariance::{attitude_floor, check_start, is_spd, sigmas};
 use super::error::{EskfError, UpdateOutcome};
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use super::update::{update, Measurement, UpdateOptions};
@@ -162,6 +162,13 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
     /// Adding a positive semi-definite matrix keeps `P` positive definite; a navigator calls it
     /// when the data say the estimate is worse than `P` claims.
     ///
+    /// An attitude error of σ = π is no information, and the error model is a small rotation:
+    /// with `A = P_θθ` and `u_b = Rᵀ u`, `σ_ψ` is capped at `√(π² − u_bᵀ A u_b)` (the heading
+    /// variance) and `σ_t` at `√(π² − (tr A − u_bᵀ A u_b))` (the sum of the two tilt
+    /// variances), so widening never takes the heading or a tilt variance above π² (one already
+    /// there is left as it is). Then the attitude block is kept representable in the scalar (an
+    /// isotropic floor of `16 ε tr A` when its smallest eigenvalue may be below it).
+    ///
     /// # Errors
     /// [`EskfError::NonFinite`] for a negative or non-finite sigma, [`EskfError::ZeroNorm`] for
     /// a zero gravity, [`EskfError::NumericalFailure`] when `P` would overflow; `P` is then
@@ -171,9 +178,15 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
         if !(non_negative_finite(tilt) && non_negative_finite(yaw)) {
             return Err(EskfError::NonFinite);
         }
+        let (tilt_room, yaw_room) = widening_room(
+            &block(&self.covariance, 0, 0),
+            self.state.attitude(),
+            &self.config.gravity,
+        );
+        let capped = |s: T, room: T| if s > room { room } else { s };
         let sigmas = InitialSigmas {
-            tilt,
-            yaw,
+            tilt: capped(tilt, tilt_room),
+            yaw: capped(yaw, yaw_room),
             ..InitialSigmas::default()
         };
         let alignment = Alignment {
@@ -187,6 +200,7 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
         };
         let mut p = self.covariance;
         let widened = block(&p, 0, 0) + extra;
+        let widened = widened + Matrix3::from_diagonal_element(attitude_floor(&widened));
         set_block(&mut p, 0, 0, &widened);
         if !all_finite(p.as_slice()) {
             return Err(EskfError::NumericalFailure);
@@ -562,4 +576,31 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 9> {
         let variances = [sq(sigmas.gyro_bias), sq(sigmas.accel_bias)];
         self.reset_block_diagonal(state, &attitude, &variances)
     }
+}
+
+/// The largest tilt and yaw sigmas [`Filter::widen_attitude`] may add to the attitude block
+/// `A` of a filter at `attitude` under `gravity`: `√(π² − (tr A − u_bᵀ A u_b))` and
+/// `√(π² − u_bᵀ A u_b)`, zero when negative. `u_b = Rᵀ u` is the up direction `u = −g/‖g‖`
+/// in the body frame, `u_bᵀ A u_b` the heading variance and `tr A − u_bᵀ A u_b` the sum of the
+/// two tilt variances. Out of line: one copy per scalar type.
+#[inline(never)]
+fn widening_room<T: Real>(a: &Matrix3<T>, attitude: &So3<T>, gravity: &Vector3<T>) -> (T, T) {
+    let gn = mat3::norm(gravity);
+    let up = if positive_finite(gn) {
+        -gravity / gn
+    } else {
+        Vector3::zeros() // the widening refuses it (`ZeroNorm`)
+    };
+    let ub = attitude.inverse().act(&up);
+    let heading = ub.dot(&mat3::mul_vec(a, &ub));
+    let tilts = a.m11 + a.m22 + a.m33 - heading;
+    let room = |v: T| {
+        let r = T::pi() * T::pi() - v;
+        if r > T::zero() {
+            r.sqrt_rn()
+        } else {
+            T::zero()
+        }
+    };
+    (room(tilts), room(heading))
 }

@@ -2,6 +2,7 @@
 //! propagation `P⁺ = F P Fᵀ + Q` (equations in the [`crate::eskf`] module docs).
 
 use super::config::{check_dt, FilterConfig, ImuSample};
+use super::covariance::{attitude_floor, floor_growth, leading_diagonal};
 use super::error::EskfError;
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use crate::kernels::block::{add_scaled_identity, block, block_in, set_block};
@@ -29,21 +30,19 @@ struct FRows<T: Real> {
 }
 
 impl<T: Real> FRows<T> {
-    /// Block rows 0..2 of `F Q` for block column `j` of the 15-row matrix stored in `q`:
-    /// `(F Q)₀ = F00 Q₀ + F03 Q₃` (when `rot`, else left zero), `(F Q)₁ = Q₁ + C`,
-    /// `(F Q)₂ = Q₂ + dt (Q₁ + ½ C)`, with `C = A Q₀ + B Q₄ = B([f]× Q₀ + Q₄)`.
-    fn apply(&self, q: &[T], j: usize, rot: bool, out: &mut [Matrix3<T>; 3]) {
-        let q_blk = |k: usize| block_in(q, 15, k, j);
-        let (q0, q1) = (q_blk(0), q_blk(1));
-        let c = mat3::mul(&self.b, &(mat3::mul(&self.fx, &q0) + q_blk(4)));
-        let [top, v, p] = out;
-        *top = if rot {
-            mat3::mul(&self.f00, &q0) + mat3::mul(&self.f03, &q_blk(3))
+    /// Block rows 0..2 of `F Q` for one block column `Q₀ … Q₄` of a 15-row matrix, its blocks
+    /// read through `q`: `(F Q)₀ = F00 Q₀ + F03 Q₃` (when `rot`, else zero),
+    /// `(F Q)₁ = Q₁ + C`, `(F Q)₂ = Q₂ + dt (Q₁ + ½ C)`, with `C = A Q₀ + B Q₄ = B([f]× Q₀ + Q₄)`.
+    #[inline(always)]
+    fn apply(&self, q: impl Fn(usize) -> Matrix3<T>, rot: bool) -> [Matrix3<T>; 3] {
+        let (q0, q1) = (q(0), q(1));
+        let c = mat3::mul(&self.b, &(mat3::mul(&self.fx, &q0) + q(4)));
+        let top = if rot {
+            mat3::mul(&self.f00, &q0) + mat3::mul(&self.f03, &q(3))
         } else {
             Matrix3::zeros()
         };
-        *p = q_blk(2) + (q1 + c * T::lit(0.5)) * self.dt;
-        *v = q1 + c;
+        [top, q1 + c, q(2) + (q1 + c * T::lit(0.5)) * self.dt]
     }
 }
 
@@ -104,42 +103,42 @@ pub(crate) fn predict_ins_finite<T: Real>(
     };
     // Two passes of one kernel, `FRows::apply` (F's block rows θ, v, p applied to a 15 × 3
     // block column):
-    // * t = 0..5, F P: block column j = t of P gives M_ij = (F P)_ij, i = 0..2, stored as
-    //   L_ji = M_ijᵀ in L = (F P)ᵀ = P Fᵀ (15 × 9). Rows 3 and 4 of F are identity rows, so
-    //   (F P)_3j = P_3j and (F P)_4j = P_4j need no storage.
-    // * t = 5..8, N = F P Fᵀ = F L: block column i = t − 5 of N is F applied to block column i
-    //   of L. Only the blocks on and below the diagonal are kept (N is symmetric), in place of
-    //   L_ki: block column i of L is read once, and later columns are untouched.
+    // * F P: block column j of P gives M_ij = (F P)_ij, i = 0..2, kept as L_ji = M_ijᵀ in
+    //   L = (F P)ᵀ = P Fᵀ (15 × 9). Rows 3 and 4 of F are identity rows, so (F P)_3j = P_3j
+    //   and (F P)_4j = P_4j need no storage.
+    // * N = F P Fᵀ = F L: block column i of N is F applied to block column i of L; only the
+    //   blocks on and below the diagonal are used (N is symmetric), and row θ only for N_00.
     let mut l = SMatrix::<T, 15, 9>::zeros();
-    let mut out = [Matrix3::<T>::zeros(); 3];
-    for t in 0..8 {
-        let (src, j) = if t < 5 {
-            (p.as_slice(), t)
-        } else {
-            (l.as_slice(), t - 5)
-        };
-        // Row θ of F L is needed only for N_00 (N_0i, i > 0, lies above the diagonal).
-        fr.apply(src, j, t <= 5, &mut out);
-        for (i, m) in out.iter().enumerate() {
-            if t < 5 {
-                set_block(&mut l, j, i, &m.transpose());
-            } else if i == j {
-                set_block(&mut l, i, j, &((m + m.transpose()) * half));
-            } else if i > j {
-                set_block(&mut l, i, j, m);
+    for j in 0..5 {
+        let m = fr.apply(|k| block_in(p.as_slice(), 15, k, j), true);
+        for (i, mi) in m.iter().enumerate() {
+            set_block(&mut l, j, i, &mi.transpose());
+        }
+    }
+    // In place: block column i of L is read whole before its blocks k ≥ i (k < 3) are
+    // replaced by N_ki; the blocks k = 3, 4 stay L_ki = N_ki.
+    for i in 0..3 {
+        let m = fr.apply(|k| block(&l, k, i), i == 0);
+        for (k, mk) in m.iter().enumerate().skip(i) {
+            if k == i {
+                set_block(&mut l, k, i, &((mk + mk.transpose()) * half));
+            } else {
+                set_block(&mut l, k, i, mk);
             }
         }
     }
     // P is finite (an invariant of the filter), so N = F P Fᵀ is finite exactly when its
     // diagonal is: a non-finite entry of row i of F makes N_ii = Σ_kl F_ik P_kl F_il infinite
     // or NaN, and for a positive semi-definite N, |N_ij| ≤ √(N_ii N_jj) bounds every other
-    // entry. The diagonal of N is the diagonal of L's top 9 × 9. It must also be positive (P
-    // is positive definite and F invertible): rounding in an extreme step (a huge `dt` times a
-    // huge rate) can leave it zero or negative, and such a P is refused, not stored.
+    // entry. It must also be positive (P is positive definite and F invertible): rounding in
+    // an extreme step (a huge `dt` times a huge rate) can leave it zero or negative, and such
+    // a P is refused, not stored.
     let diagonal_finite = (0..9).all(|k| l.get((k, k)).is_some_and(|d| positive_finite(*d)));
     if !(diagonal_finite && new_x.is_finite()) {
         return Err(EskfError::NonFinite);
     }
+    // The variances of θ, v, p before the prediction, for the growth floor.
+    let before: [T; 9] = leading_diagonal(p);
     // The lower blocks N_ki (k ≥ i, i < 3) and their transposes; P_33, P_34, P_44 are
     // unchanged before Q.
     for i in 0..3 {
@@ -162,6 +161,9 @@ pub(crate) fn predict_ins_finite<T: Real>(
     let rw = |s: T| s * s * dt;
     add_scaled_identity(p, 3, 3, rw(n.gyroscope_random_walk));
     add_scaled_identity(p, 4, 4, rw(n.accelerometer_random_walk));
+    floor_growth(p, &before);
+    let floor = attitude_floor(&block(p, 0, 0));
+    add_scaled_identity(p, 0, 0, floor);
     *x = new_x;
     Ok(())
 }
@@ -190,6 +192,7 @@ fn predict_attitude<T: Real, const N: usize>(
     let f00 = f00t.transpose();
     let f01 = jr * -dt;
     let (p00, p01, p11) = (block(p, 0, 0), block(p, 0, 1), block(p, 1, 1));
+    let before = [p00.m11, p00.m22, p00.m33];
     let m00 = mat3::mul(&f00, &p00) + mat3::mul(&f01, &p01.transpose());
     let m01 = mat3::mul(&f00, &p01) + mat3::mul(&f01, &p11);
     // N00 is symmetric: its upper triangle, mirrored.
@@ -234,6 +237,9 @@ fn predict_attitude<T: Real, const N: usize>(
         2,
         n.accelerometer_random_walk * n.accelerometer_random_walk * dt,
     );
+    floor_growth(p, &before);
+    let floor = attitude_floor(&block(p, 0, 0));
+    add_scaled_identity(p, 0, 0, floor);
     *attitude = next;
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! and the covariance reset.
 
 use super::work::{attitude_part, Work};
+use crate::eskf::covariance::attitude_floor;
 use crate::eskf::error::EskfError;
 use crate::eskf::state::ErrorState;
 use crate::kernels::block::{block, copy};
@@ -18,7 +19,8 @@ use nalgebra::{Matrix3, SMatrix, Vector3};
 /// is `P − K Uᵀ − U Kᵀ + K S Kᵀ = P + V Kᵀ + K Vᵀ = P + Σ_c (v_c k_cᵀ + k_c v_cᵀ)` with
 /// `V = ½ K S − U`: `m` symmetric rank-2 corrections, exactly symmetric, computed in place on
 /// the upper triangle and mirrored, without an `N × N` temporary. Then `P⁺ ← G P⁺ Gᵀ`,
-/// `G = blockdiag(J_r(δθ), I)`: only the attitude rows and columns change.
+/// `G = blockdiag(J_r(δθ), I)`: only the attitude rows and columns change. The new attitude
+/// block gets its floor ([`attitude_floor`]).
 #[inline(never)]
 pub(super) fn commit<T, S, const N: usize, const C: usize>(
     x: &mut S,
@@ -62,6 +64,7 @@ where
     let gr: Matrix3<T> = So3::right_jacobian(&attitude_part(w.dx.as_slice()));
     let c00 = mat3::mul(&mat3::mul(&gr, &m00), &gr.transpose());
     let c00 = (c00 + c00.transpose()) * half;
+    let c00 = c00 + Matrix3::from_diagonal_element(attitude_floor(&c00));
     let diagonal_ok = diagonal_ok && positive_finite(c00.m11) && positive_finite(c00.m22);
     if !(new_x.is_finite() && diagonal_ok && positive_finite(c00.m33)) {
         return Err(EskfError::NumericalFailure);

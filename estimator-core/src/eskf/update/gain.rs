@@ -10,6 +10,25 @@ use crate::kernels::{all_finite, slice::symmetrize};
 use crate::Real;
 use nalgebra::{SMatrix, SVector};
 
+/// The noise floor `f = 8 N ε` (`N` the error-state size): the smallest measurement variance
+/// an update uses, as a fraction of `w_c = Σ_i H_ci² P_ii`, the variance row `c` would have
+/// if the states it reads were uncorrelated.
+///
+/// Rounding moves each entry of `P⁺` by a few `ε √(P_ii P_jj)`: a few `Nε` on the correlation
+/// matrix `C = D^-½ P D^-½` (`D = diag P`), so `P⁺` stays positive definite while the smallest
+/// eigenvalue of its correlation matrix stays well above `Nε`. An update adds the information
+/// `Hᵀ R⁻¹ H`; in correlation terms row `c` adds `h̃ h̃ᵀ / R_cc` with `h̃ = D^½ h_c` and
+/// `‖h̃‖² = w_c`, so with `R_cc ≥ f w_c` it raises the largest eigenvalue of `C⁻¹` by at most
+/// `1/f` and `λ_min(C⁺) ≥ 1 / (1/λ_min(C) + M/f)`: an update cannot take the correlation matrix
+/// below `f / M` (the posterior's smaller diagonal only raises it). Without the floor an
+/// update much more precise than its prior leaves `P` indefinite (in `f32`, a heading of σ =
+/// 1e-5 rad against 0.1 rad; in `f64`, an accelerometer with no noise). A row below it is fused
+/// as if its variance were `f w_c`: `R_eff = R + diag(max(0, f w_c − R_cc))`, positive
+/// definite whenever `R` is and never smaller. In `f64`, `f = 2.7e-14` (σ ratio 1.6e-7): it
+/// acts on no real sensor. In `f32`, `f = 1.4e-5` (σ ratio 3.8e-3): a 1 m fix after a
+/// position prior of 1 km is fused as a 3.8 m fix, and the next one at its own σ.
+const NOISE_FLOOR: f64 = 8.0;
+
 /// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`, for the covariance `p` and the `m × m`
 /// noise `noise` (column-major), over the `m` active columns of the working set only. Returns
 /// the NIS `rᵀ S⁻¹ r` of the residual in `w`. The matrices are walked as arrays of columns
@@ -25,22 +44,34 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
     let (u, s, k) = (&mut w.g.u.data.0, &mut w.g.s, &mut w.g.k.data.0);
     // Column c of U = Σ_j P e_j H_cj over the nonzero entries of row c of H only (most models
     // touch 3–6 of the 15 error components).
+    // With it, w_c = Σ_j H_cj² P_jj for the noise floor.
     for uc in u.iter_mut() {
         uc.fill(T::zero());
     }
-    for (uc, hc) in u.iter_mut().zip(ht.iter()).take(m) {
-        for (pc, h) in p.data.0.iter().zip(hc) {
+    let mut wc = [T::zero(); C];
+    for ((uc, hc), w) in u.iter_mut().zip(ht.iter()).zip(wc.iter_mut()).take(m) {
+        for (j, (pc, h)) in p.data.0.iter().zip(hc).enumerate() {
             if *h != T::zero() {
                 axpy(uc, *h, pc);
+                *w += *h * *h * pc.get(j).copied().unwrap_or_else(T::zero);
             }
         }
     }
     // S_ij = R_ij + (row i of H)·(column j of U) for i, j < m; the identity padding stays.
+    // On the diagonal R_cc is raised to the noise floor f Σ_i H_ci² P_ii ([`NOISE_FLOOR`]).
     *s = padded_noise(noise, m);
-    for (j, uc) in u.iter().enumerate().take(m) {
+    let floor = T::lit(NOISE_FLOOR * T::EPSILON_F64 * N as f64);
+    for (j, (uc, w)) in u.iter().zip(wc).enumerate().take(m) {
         for (i, hc) in ht.iter().enumerate().take(m) {
             if let Some(e) = s.get_mut((i, j)) {
-                *e += dot(hc, uc);
+                let hph = dot(hc, uc);
+                *e = if i == j {
+                    // max(R_cc, f w_c) by comparison: `max` is a libm call on a Cortex-M4F.
+                    let low = floor * w;
+                    hph + if low > *e { low } else { *e }
+                } else {
+                    *e + hph
+                };
             }
         }
     }

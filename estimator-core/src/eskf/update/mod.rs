@@ -4,8 +4,9 @@
 //! Equations cite *Lie Groups and Smooth Manifolds for Robotic State Estimation*.
 //!
 //! 1. Linearize at the prior: `r₀ = z ⊖ h(x̂)` and `H₀` with `h(x̂ ⊕ δx) ≈ h(x̂) + H₀ δx`
-//!    (eq. 4.3); `S = H₀ P H₀ᵀ + R`; `NIS = r₀ᵀ S⁻¹ r₀`, the squared Mahalanobis distance
-//!    `‖e‖²_Σ = eᵀ Σ⁻¹ e` of eq. 4.1; gate `NIS ≤ χ²_M(p)` ([`Gate`]) or return `Rejected`.
+//!    (eq. 4.3); `S = H₀ P H₀ᵀ + R_eff`, `R` with the noise floor of `gain.rs`;
+//!    `NIS = r₀ᵀ S⁻¹ r₀`, the squared Mahalanobis distance `‖e‖²_Σ = eᵀ Σ⁻¹ e` of eq. 4.1;
+//!    gate `NIS ≤ χ²_M(p)` ([`Gate`]) or return `Rejected`.
 //! 2. `δx₁ = K₀ r₀`, `K = P Hᵀ S⁻¹`: the minimizer of eq. 4.4,
 //!    `ξ* = argmin ‖h(a) + H_a ξ − z‖²_Σ`, with the prior `‖δx‖²_P` added. Iterated: at
 //!    `x_k = x̂ ⊕ δx_k` linearize again, `H̃_k = H_k·blockdiag(J_r(δθ_k), I)`,

@@ -762,7 +762,33 @@ fn f32_repeated_predictions_with_a_huge_acceleration_keep_covariance_positive_de
         dt: 0.003_078_250_4,
     };
     for k in 0..40 {
-        f.predict(&sample).expect("finite: the variances stay below 1e38");
+        f.predict(&sample)
+            .expect("finite: the variances stay below 1e38");
         assert!(positive_definite(f.covariance()), "prediction {k}");
     }
+}
+
+/// A fix whose noise has two identical rows (`R` singular: it measures `p_y − p_z` exactly) is
+/// refused with `NoiseNotPositiveDefinite` and the filter unchanged, in both precisions; the same
+/// fix with the rows correlated at 0.99 is accepted and `P` stays positive definite.
+#[test]
+fn gnss_noise_singular_to_the_scalar_is_refused() {
+    fn run<T: estimator_core::Real>() {
+        let mut f = ins::<T>();
+        let before = f;
+        let mut fix = GnssPosition::new(f.state().position, Vector3::zeros(), T::one());
+        let (a, b) = (T::lit(10_000.0), T::lit(26.75));
+        fix.noise = Matrix3::new(a, b, b, b, b, b, b, b, b);
+        let r = f.update(&fix, &UpdateOptions::default());
+        assert_eq!(r, Err(EskfError::NoiseNotPositiveDefinite));
+        assert_eq!(f.covariance(), before.covariance());
+        assert_eq!(f.state(), before.state());
+        let c = b * T::lit(0.99);
+        fix.noise = Matrix3::new(a, T::zero(), T::zero(), T::zero(), b, c, T::zero(), c, b);
+        let outcome = f.update(&fix, &UpdateOptions::default()).expect("usable noise");
+        assert!(outcome.is_accepted());
+        assert!(positive_definite(f.covariance()));
+    }
+    run::<f32>();
+    run::<f64>();
 }

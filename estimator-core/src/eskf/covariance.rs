@@ -15,6 +15,22 @@ pub(crate) fn is_spd<T: Real, const M: usize>(a: &SMatrix<T, M, M>) -> bool {
     is_symmetric(a.as_slice(), M) && factor_in_place(l.as_mut_slice(), M, T::zero())
 }
 
+/// The smallest fraction of a variable's variance, `8 N ε` for a filter of `N` states, that the
+/// other variables of a covariance given to a filter (a starting `P`, a measurement's `R`) may
+/// leave unexplained: below it the matrix is singular to the scalar's resolution (a correlation
+/// above `√(1 − 8Nε)`, 0.999993 in `f32`), the same resolution the update's noise floor keeps.
+pub(crate) fn usable_pivot<T: Real, const N: usize>() -> T {
+    T::lit(8.0 * N as f64 * T::EPSILON_F64)
+}
+
+/// [`is_spd`], and usable by a filter of `N` states: every Cholesky pivot `d_j` above
+/// [`usable_pivot`]`· A_jj` (each variable keeps that fraction of its variance unexplained by the
+/// variables before it).
+pub(crate) fn is_usable_spd<T: Real, const M: usize, const N: usize>(a: &SMatrix<T, M, M>) -> bool {
+    let mut l = *a;
+    is_symmetric(a.as_slice(), M) && factor_in_place(l.as_mut_slice(), M, usable_pivot::<T, N>())
+}
+
 /// The column-major `n × n` storage `a` is finite and symmetric to `10⁻⁶` of its largest entry
 /// (one compiled copy for every size).
 fn is_symmetric<T: Real>(a: &[T], n: usize) -> bool {
@@ -37,7 +53,7 @@ pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
     if !state.is_finite() {
         return Err(EskfError::NonFinite);
     }
-    if !is_spd(covariance) {
+    if !is_usable_spd::<T, N, N>(covariance) {
         return Err(EskfError::CovarianceNotPositiveDefinite);
     }
     Ok(())

@@ -12,9 +12,13 @@ pub enum EskfError {
     NonPositiveDt,
     /// A time step above the configured maximum.
     DtTooLarge,
-    /// A noise matrix (`R`, or a noise density) that is not symmetric positive definite.
+    /// A noise matrix (`R`, or a noise density) that is not symmetric positive definite, or
+    /// an `R` singular to the scalar's resolution (a row whose variance the others explain
+    /// to all but `8 N ε` of it).
     NoiseNotPositiveDefinite,
-    /// A covariance given to a constructor that is not symmetric positive definite.
+    /// A covariance given to a constructor that is not symmetric positive definite, or is
+    /// singular to the scalar's resolution (a variable whose variance the others explain to
+    /// all but `8 N ε` of it).
     CovarianceNotPositiveDefinite,
     /// A vector that must have a direction (magnetometer, accelerometer, reference field) has
     /// zero norm, or no horizontal component where a heading is needed.

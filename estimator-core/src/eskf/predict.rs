@@ -33,7 +33,6 @@ impl<T: Real> FRows<T> {
     /// Block rows 0..2 of `F Q` for one block column `Q₀ … Q₄` of a 15-row matrix, its blocks
     /// read through `q`: `(F Q)₀ = F00 Q₀ + F03 Q₃` (when `rot`, else zero),
     /// `(F Q)₁ = Q₁ + C`, `(F Q)₂ = Q₂ + dt (Q₁ + ½ C)`, with `C = A Q₀ + B Q₄ = B([f]× Q₀ + Q₄)`.
-    #[inline(always)]
     fn apply(&self, q: impl Fn(usize) -> Matrix3<T>, rot: bool) -> [Matrix3<T>; 3] {
         let (q0, q1) = (q(0), q(1));
         let c = mat3::mul(&self.b, &(mat3::mul(&self.fx, &q0) + q(4)));

@@ -34,7 +34,7 @@ mod model;
 mod options;
 mod work;
 
-use super::covariance::is_spd;
+use super::covariance::is_usable_spd;
 use super::error::{EskfError, UpdateOutcome};
 use super::state::ErrorState;
 use crate::kernels::block::copy;
@@ -137,7 +137,7 @@ where
         dx: SVector::zeros(),
         m,
     };
-    if !noise_is_spd::<T, C>(noise, m) {
+    if !noise_is_spd::<T, C, N>(noise, m) {
         return Err(EskfError::NoiseNotPositiveDefinite);
     }
     linearize_into(model, x, &mut w, true)?;
@@ -150,11 +150,13 @@ where
     Ok(UpdateOutcome::Accepted { nis, iterations })
 }
 
-/// `R` (padded to `C × C`, [`padded_noise`]) is symmetric positive definite; out of line, so
-/// that the padded copy is not in the update's frame.
+/// `R` (padded to `C × C`, [`padded_noise`]) is symmetric positive definite and not singular to
+/// the scalar's resolution ([`is_usable_spd`]: a noise `R` with two rows correlated beyond
+/// `√(1 − 8Nε)` measures their difference exactly, which no noise floor on the diagonal
+/// catches); out of line, so that the padded copy is not in the update's frame.
 #[inline(never)]
-fn noise_is_spd<T: Real, const C: usize>(noise: &[T], m: usize) -> bool {
-    is_spd(&padded_noise::<T, C>(noise, m))
+fn noise_is_spd<T: Real, const C: usize, const N: usize>(noise: &[T], m: usize) -> bool {
+    is_usable_spd::<T, C, N>(&padded_noise::<T, C>(noise, m))
 }
 
 /// Linearizes at `x̂ ⊕ δx` (`δx` = `w.dx`; at `x̂` when `first`) into `w.ht`, `w.r`, with the

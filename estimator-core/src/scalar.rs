@@ -48,6 +48,11 @@ pub trait Real: RealField + Copy + sealed::Sealed {
     /// thresholds can be computed in `const` context.
     const EPSILON_F64: f64;
 
+    /// The largest variance a filter holds, `√MAX` rounded down (`1.8e19` for `f32`, `1.3e154`
+    /// for `f64`), as an `f64`: the product of any two such variances (a covariance's
+    /// `P_ii P_jj`, a gain's `P H² P`) stays finite.
+    const VARIANCE_CEILING_F64: f64;
+
     /// Converts a literal: `T::lit(1.0 / 6.0)` folds to a constant of type `T`.
     fn lit(x: f64) -> Self;
 
@@ -74,6 +79,7 @@ pub trait Real: RealField + Copy + sealed::Sealed {
 
 impl Real for f64 {
     const EPSILON_F64: f64 = f64::EPSILON;
+    const VARIANCE_CEILING_F64: f64 = 1.3e154;
 
     fn lit(x: f64) -> Self {
         x
@@ -102,6 +108,7 @@ impl Real for f64 {
 
 impl Real for f32 {
     const EPSILON_F64: f64 = f32::EPSILON as f64;
+    const VARIANCE_CEILING_F64: f64 = 1.8e19;
 
     fn lit(x: f64) -> Self {
         x as f32

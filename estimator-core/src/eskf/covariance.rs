@@ -3,8 +3,8 @@
 use super::config::FilterConfig;
 use super::error::EskfError;
 use super::state::ErrorState;
-use crate::kernels::all_finite;
 use crate::kernels::cholesky::factor_in_place;
+use crate::kernels::{all_finite, usable_variance};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, SVector};
 
@@ -43,7 +43,8 @@ fn is_symmetric<T: Real>(a: &[T], n: usize) -> bool {
 }
 
 /// The checks every filter constructor makes on a given start: a valid configuration, a finite
-/// state and a symmetric positive definite covariance.
+/// state and a symmetric positive definite covariance, usable by the filter (no variance above
+/// [`Real::VARIANCE_CEILING_F64`], [`is_usable_spd`]).
 pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
     state: &S,
     covariance: &SMatrix<T, N, N>,
@@ -53,7 +54,9 @@ pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
     if !state.is_finite() {
         return Err(EskfError::NonFinite);
     }
-    if !is_usable_spd::<T, N, N>(covariance) {
+    let variances_usable =
+        (0..N).all(|k| covariance.get((k, k)).is_some_and(|d| usable_variance(*d)));
+    if !(variances_usable && is_usable_spd::<T, N, N>(covariance)) {
         return Err(EskfError::CovarianceNotPositiveDefinite);
     }
     Ok(())

@@ -29,7 +29,8 @@ pub enum EskfError {
     SingularGeometry,
     /// The innovation covariance `S = H P Hᵀ + R` could not be factored.
     SingularInnovation,
-    /// The updated covariance came out non-finite or with a non-positive diagonal; the update
+    /// The updated covariance came out non-finite, with a non-positive diagonal or with a
+    /// variance above the variance ceiling ([`crate::Real::VARIANCE_CEILING_F64`]); the update
     /// was not applied.
     NumericalFailure,
     /// An alignment window with no samples.

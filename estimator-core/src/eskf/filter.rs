@@ -7,7 +7,7 @@ use super::error::{EskfError, UpdateOutcome};
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use super::update::{update, Measurement, UpdateOptions};
 use crate::kernels::block::{add_scaled_identity, block, set_block};
-use crate::kernels::{all_finite, mat3, non_negative_finite, positive_finite};
+use crate::kernels::{all_finite, mat3, non_negative_finite, positive_finite, usable_variance};
 use crate::lie::{LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
@@ -213,8 +213,9 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
     /// the [`crate::eskf`] module docs).
     ///
     /// # Errors
-    /// [`EskfError::NonFinite`], [`EskfError::NonPositiveDt`], [`EskfError::DtTooLarge`]; the
-    /// filter is then unchanged.
+    /// [`EskfError::NonFinite`] (also for a prediction that would take a variance above the
+    /// variance ceiling, [`crate::Real::VARIANCE_CEILING_F64`]), [`EskfError::NonPositiveDt`],
+    /// [`EskfError::DtTooLarge`]; the filter is then unchanged.
     pub fn predict(&mut self, imu: &ImuSample<T>) -> Result<(), EskfError> {
         Sealed::propagate(&mut self.state, &mut self.covariance, imu, &self.config)
     }
@@ -430,7 +431,8 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
     ///
     /// # Errors
     /// [`EskfError::NonFinite`] for a non-finite position, or a sigma whose square is not
-    /// positive and finite; the filter is then unchanged.
+    /// positive or is above the variance ceiling ([`crate::Real::VARIANCE_CEILING_F64`]); the
+    /// filter is then unchanged.
     pub fn reset_position(&mut self, position: Vector3<T>, sigma: T) -> Result<(), EskfError> {
         self.reset_block(2, position, sigma)
     }
@@ -447,8 +449,9 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
     /// (a clipped accelerometer), of 1σ `sigma` per axis, m/s. `P` stays positive definite.
     ///
     /// # Errors
-    /// [`EskfError::NonFinite`] for a negative or non-finite sigma, or one whose square
-    /// overflows `P`; the filter is then unchanged.
+    /// [`EskfError::NonFinite`] for a negative or non-finite sigma, or one that takes a
+    /// variance above the variance ceiling ([`crate::Real::VARIANCE_CEILING_F64`]); the filter
+    /// is then unchanged.
     pub fn widen_velocity(&mut self, sigma: T) -> Result<(), EskfError> {
         self.widen_blocks(&[(1, sigma)])
     }
@@ -470,7 +473,7 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
             let fits = (0..3).all(|k| {
                 self.covariance
                     .get((3 * b + k, 3 * b + k))
-                    .is_some_and(|d| (*d + v).is_finite())
+                    .is_some_and(|d| usable_variance(*d + v))
             });
             if !(non_negative_finite(*sigma) && v.is_finite() && fits) {
                 return Err(EskfError::NonFinite);
@@ -485,7 +488,7 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
     /// Block `b` (1: velocity, 2: position) set to `value` with covariance `σ² I`, decoupled.
     fn reset_block(&mut self, b: usize, value: Vector3<T>, sigma: T) -> Result<(), EskfError> {
         let variance = sigma * sigma;
-        if !(all_finite(value.as_slice()) && positive_finite(variance)) {
+        if !(all_finite(value.as_slice()) && usable_variance(variance)) {
             return Err(EskfError::NonFinite);
         }
         for k in 0..5 {

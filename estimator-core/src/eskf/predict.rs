@@ -6,7 +6,7 @@ use super::covariance::{attitude_floor, floor_growth, leading_diagonal};
 use super::error::EskfError;
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use crate::kernels::block::{add_scaled_identity, block, block_in, set_block};
-use crate::kernels::{all_finite, mat3, positive_finite};
+use crate::kernels::{all_finite, mat3, usable_variance};
 use crate::lie::{skew, LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -131,8 +131,9 @@ pub(crate) fn predict_ins_finite<T: Real>(
     // or NaN, and for a positive semi-definite N, |N_ij| ≤ √(N_ii N_jj) bounds every other
     // entry. It must also be positive (P is positive definite and F invertible): rounding in
     // an extreme step (a huge `dt` times a huge rate) can leave it zero or negative, and such
-    // a P is refused, not stored.
-    let diagonal_finite = (0..9).all(|k| l.get((k, k)).is_some_and(|d| positive_finite(*d)));
+    // a P is refused, not stored; so is one above the variance ceiling (`√MAX`), beyond which
+    // the products of an update overflow or lose the state's resolution.
+    let diagonal_finite = (0..9).all(|k| l.get((k, k)).is_some_and(|d| usable_variance(*d)));
     if !(diagonal_finite && new_x.is_finite()) {
         return Err(EskfError::NonFinite);
     }
@@ -203,7 +204,7 @@ fn predict_attitude<T: Real, const N: usize>(
     // As in the 15-state prediction: a non-finite F or an overflow shows on the diagonal of
     // N00, which bounds M01 and M02 through the positive semi-definite P⁺; a diagonal that
     // rounding left at zero or below is refused too.
-    let diagonal_finite = (0..3).all(|k| n00.get((k, k)).is_some_and(|d| positive_finite(*d)));
+    let diagonal_finite = (0..3).all(|k| n00.get((k, k)).is_some_and(|d| usable_variance(*d)));
     if !(diagonal_finite && next.is_finite()) {
         return Err(EskfError::NonFinite);
     }

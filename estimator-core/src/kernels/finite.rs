@@ -24,6 +24,13 @@ pub(crate) fn positive_finite<T: Real>(x: T) -> bool {
     x > T::zero() && x * T::zero() == T::zero()
 }
 
+/// `x` is a variance a filter may hold: positive and at most [`Real::VARIANCE_CEILING_F64`]
+/// (so finite; NaN fails).
+#[inline(always)]
+pub(crate) fn usable_variance<T: Real>(x: T) -> bool {
+    x > T::zero() && x <= T::lit(T::VARIANCE_CEILING_F64)
+}
+
 /// The larger of `a` and `b`, `a` when `b` is NaN: a comparison and a select. `f32::max` is
 /// a call of `libm`'s `fmaxf` on a Cortex-M4F (no `vmaxnm` before ARMv8). Folded from a
 /// number over a sequence, NaN elements are passed over, as with `fmax`.

@@ -31,4 +31,6 @@ pub(crate) mod finite;
 pub(crate) mod mat3;
 pub(crate) mod slice;
 
-pub(crate) use finite::{all_finite, larger, non_negative_finite, positive_finite};
+pub(crate) use finite::{
+    all_finite, larger, non_negative_finite, positive_finite, usable_variance,
+};

@@ -7,7 +7,7 @@ use crate::eskf::error::EskfError;
 use crate::eskf::state::ErrorState;
 use crate::kernels::block::{block, copy};
 use crate::kernels::slice::axpy;
-use crate::kernels::{mat3, positive_finite};
+use crate::kernels::{mat3, usable_variance};
 use crate::lie::{LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -59,14 +59,14 @@ where
             .zip(k.iter())
             .take(m)
             .fold(T::zero(), |acc, (vc, kc)| acc + at(vc, j) * at(kc, j));
-        positive_finite(at(pc, j) + d * two)
+        usable_variance(at(pc, j) + d * two)
     });
     let gr: Matrix3<T> = So3::right_jacobian(&attitude_part(w.dx.as_slice()));
     let c00 = mat3::mul(&mat3::mul(&gr, &m00), &gr.transpose());
     let c00 = (c00 + c00.transpose()) * half;
     let c00 = c00 + Matrix3::from_diagonal_element(attitude_floor(&c00));
-    let diagonal_ok = diagonal_ok && positive_finite(c00.m11) && positive_finite(c00.m22);
-    if !(new_x.is_finite() && diagonal_ok && positive_finite(c00.m33)) {
+    let diagonal_ok = diagonal_ok && usable_variance(c00.m11) && usable_variance(c00.m22);
+    if !(new_x.is_finite() && diagonal_ok && usable_variance(c00.m33)) {
         return Err(EskfError::NumericalFailure);
     }
     // The upper triangle (column j holds rows 0..=j): P_ij += Σ_c (v_ci k_cj + k_ci v_cj); then the attitude rows of the columns from 3 on multiplied by J_r(δθ), the

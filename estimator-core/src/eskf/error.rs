@@ -30,8 +30,9 @@ pub enum EskfError {
     /// The innovation covariance `S = H P Hᵀ + R` could not be factored.
     SingularInnovation,
     /// The updated covariance came out non-finite, with a non-positive diagonal or with a
-    /// variance above the variance ceiling ([`crate::Real::VARIANCE_CEILING_F64`]); the update
-    /// was not applied.
+    /// variance above the variance ceiling ([`crate::Real::VARIANCE_CEILING_F64`]), or the
+    /// attitude correction `|δθ|` reached π (outside the chart where `⊕` is one-to-one); the
+    /// update was not applied.
     NumericalFailure,
     /// An alignment window with no samples.
     EmptyWindow,

@@ -20,7 +20,8 @@ use nalgebra::{Matrix3, SMatrix, Vector3};
 /// `V = ½ K S − U`: `m` symmetric rank-2 corrections, exactly symmetric, computed in place on
 /// the upper triangle and mirrored, without an `N × N` temporary. Then `P⁺ ← G P⁺ Gᵀ`,
 /// `G = blockdiag(J_r(δθ), I)`: only the attitude rows and columns change. The new attitude
-/// block gets its floor ([`attitude_floor`]).
+/// block gets its floor ([`attitude_floor`]). A correction with `|δθ| ≥ π` is refused: there
+/// `exp` is no longer one-to-one and `J_r(δθ)` approaches singularity (at `2π`).
 #[inline(never)]
 pub(super) fn commit<T, S, const N: usize, const C: usize>(
     x: &mut S,
@@ -61,12 +62,16 @@ where
             .fold(T::zero(), |acc, (vc, kc)| acc + at(vc, j) * at(kc, j));
         usable_variance(at(pc, j) + d * two)
     });
-    let gr: Matrix3<T> = So3::right_jacobian(&attitude_part(w.dx.as_slice()));
+    let dtheta = attitude_part(w.dx.as_slice());
+    let gr: Matrix3<T> = So3::right_jacobian(&dtheta);
     let c00 = mat3::mul(&mat3::mul(&gr, &m00), &gr.transpose());
     let c00 = (c00 + c00.transpose()) * half;
     let c00 = c00 + Matrix3::from_diagonal_element(attitude_floor(&c00));
     let diagonal_ok = diagonal_ok && usable_variance(c00.m11) && usable_variance(c00.m22);
-    if !(new_x.is_finite() && diagonal_ok && usable_variance(c00.m33)) {
+    // The correction stays inside the chart: below π the exponential map is one-to-one and
+    // J_r(δθ) regular; at 2π it is singular, and the reset G P Gᵀ with it is not definite.
+    let in_chart = dtheta.dot(&dtheta) < T::pi() * T::pi();
+    if !(in_chart && new_x.is_finite() && diagonal_ok && usable_variance(c00.m33)) {
         return Err(EskfError::NumericalFailure);
     }
     // The upper triangle (column j holds rows 0..=j): P_ij += Σ_c (v_ci k_cj + k_ci v_cj); then the attitude rows of the columns from 3 on multiplied by J_r(δθ), the

@@ -16,19 +16,20 @@ pub(crate) fn is_spd<T: Real, const M: usize>(a: &SMatrix<T, M, M>) -> bool {
 }
 
 /// The smallest fraction of a variable's variance, `8 N ε` for a filter of `N` states, that the
-/// other variables of a covariance given to a filter (a starting `P`, a measurement's `R`) may
-/// leave unexplained: below it the matrix is singular to the scalar's resolution (a correlation
-/// above `√(1 − 8Nε)`, 0.999993 in `f32`), the same resolution the update's noise floor keeps.
+/// other variables of a starting `P` may leave unexplained: below it the matrix is singular to
+/// the scalar's resolution (a correlation above `√(1 − 8Nε)`, 0.999993 in `f32`).
 pub(crate) fn usable_pivot<T: Real, const N: usize>() -> T {
     T::lit(8.0 * N as f64 * T::EPSILON_F64)
 }
 
-/// [`is_spd`], and usable by a filter of `N` states: every Cholesky pivot `d_j` above
-/// [`usable_pivot`]`· A_jj` (each variable keeps that fraction of its variance unexplained by the
-/// variables before it).
-pub(crate) fn is_usable_spd<T: Real, const M: usize, const N: usize>(a: &SMatrix<T, M, M>) -> bool {
+/// [`is_spd`], with every Cholesky pivot `d_j` above `relative_pivot · A_jj` (each variable
+/// keeps that fraction of its variance unexplained by the variables before it).
+pub(crate) fn is_usable_spd<T: Real, const M: usize>(
+    a: &SMatrix<T, M, M>,
+    relative_pivot: T,
+) -> bool {
     let mut l = *a;
-    is_symmetric(a.as_slice(), M) && factor_in_place(l.as_mut_slice(), M, usable_pivot::<T, N>())
+    is_symmetric(a.as_slice(), M) && factor_in_place(l.as_mut_slice(), M, relative_pivot)
 }
 
 /// The column-major `n × n` storage `a` is finite and symmetric to `10⁻⁶` of its largest entry
@@ -44,7 +45,7 @@ fn is_symmetric<T: Real>(a: &[T], n: usize) -> bool {
 
 /// The checks every filter constructor makes on a given start: a valid configuration, a finite
 /// state and a symmetric positive definite covariance, usable by the filter (no variance above
-/// [`Real::VARIANCE_CEILING_F64`], [`is_usable_spd`]).
+/// [`Real::VARIANCE_CEILING_F64`], every Cholesky pivot above [`usable_pivot`] of its diagonal).
 pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
     state: &S,
     covariance: &SMatrix<T, N, N>,
@@ -56,7 +57,7 @@ pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
     }
     let variances_usable =
         (0..N).all(|k| covariance.get((k, k)).is_some_and(|d| usable_variance(*d)));
-    if !(variances_usable && is_usable_spd::<T, N, N>(covariance)) {
+    if !(variances_usable && is_usable_spd(covariance, usable_pivot::<T, N>())) {
         return Err(EskfError::CovarianceNotPositiveDefinite);
     }
     Ok(())
@@ -103,7 +104,7 @@ pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
     }
 }
 
-/// The growth floor, `f = 8 N ε` (the noise floor's fraction): the part of each variance's
+/// The growth floor, `f = 8 N ε`: the part of each variance's
 /// growth in a prediction that is made independent of every other state.
 const GROWTH_FLOOR: f64 = 8.0;
 

@@ -14,7 +14,7 @@ pub enum EskfError {
     DtTooLarge,
     /// A noise matrix (`R`, or a noise density) that is not symmetric positive definite, or
     /// an `R` singular to the scalar's resolution (a row whose variance the others explain
-    /// to all but `8 N ε` of it).
+    /// to all but `256 N ε` of it, the update's noise floor).
     NoiseNotPositiveDefinite,
     /// A covariance given to a constructor that is not symmetric positive definite, or is
     /// singular to the scalar's resolution (a variable whose variance the others explain to

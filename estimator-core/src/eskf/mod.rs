@@ -122,11 +122,14 @@
 //! eigenvalue of the correlation matrix `C = D^-½ P D^-½` (`D = diag P`) stays well above `Nε`.
 //! Three floors keep it there; in `f64` none acts on any usable filter.
 //!
-//! * **Noise floor** (`update/gain.rs`): each row's variance is at least `f w_c`,
-//!   `w_c = Σ_i H_ci² P_ii`, `f = 8 N ε`: `R_eff = R + diag(max(0, f w_c − R_cc))`. Row `c` adds
-//!   at most `1/f` to the largest eigenvalue of `C⁻¹`, so an update leaves
-//!   `λ_min(C⁺) ≥ 1 / (1/λ_min(C) + M/f)`. A measurement far more precise than its prior (in
-//!   `f32`: σ below 3.8e-3 of the prior's) is fused as if it had the floor's variance.
+//! * **Noise floor** (`update/gain.rs`): the combination `h_cᵀ δx` a row measures keeps a
+//!   posterior variance of at least `f w_c`, `w_c = Σ_i H_ci² P_ii`, `f = 256 N ε`: its noise
+//!   is raised to `R_eff,cc = max(R_cc, f w_c p_c / (p_c − f w_c))`, `p_c = (H P Hᵀ)_cc`. Row
+//!   `c` then adds at most `1/f` to the largest eigenvalue of `C⁻¹`, so an update leaves
+//!   `λ_min(C⁺) ≥ 1 / (1/λ_min(C) + M/f)`, and a combination measured again and again stays at
+//!   the floor. A measurement far more precise than its prior (in `f32`: σ below 0.021 of the
+//!   prior's) is fused as if it were that precise. A noise `R` whose rows are correlated
+//!   beyond the same resolution is refused.
 //! * **Attitude floor** (`covariance.rs`): the attitude error is in the body frame, so with the
 //!   heading unknown every entry of `P_θθ` is of the heading's size and the tilt is a
 //!   difference of such entries. When `4 det P_θθ / (tr P_θθ)² ≤ 16 ε tr P_θθ` (a lower bound

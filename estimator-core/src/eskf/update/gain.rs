@@ -6,28 +6,45 @@ use super::work::Work;
 use crate::eskf::error::{EskfError, UpdateOutcome};
 use crate::kernels::cholesky::{factor_in_place, inverse_into, spd_inverse_3};
 use crate::kernels::slice::{axpy, distance, dot, mat_vec};
-use crate::kernels::{all_finite, slice::symmetrize};
+use crate::kernels::{all_finite, larger, slice::symmetrize};
 use crate::Real;
 use nalgebra::{SMatrix, SVector};
 
-/// The noise floor `f = 8 N ε` (`N` the error-state size): the smallest measurement variance
-/// an update uses, as a fraction of `w_c = Σ_i H_ci² P_ii`, the variance row `c` would have
-/// if the states it reads were uncorrelated.
+/// The noise floor `f = 256 N ε` (`N` the error-state size): the smallest variance an update may
+/// leave on the combination `h_cᵀ δx` that row `c` measures, as a fraction of
+/// `w_c = Σ_i H_ci² P_ii`, the variance that combination would have if the states it reads
+/// were uncorrelated.
 ///
 /// Rounding moves each entry of `P⁺` by a few `ε √(P_ii P_jj)`: a few `Nε` on the correlation
 /// matrix `C = D^-½ P D^-½` (`D = diag P`), so `P⁺` stays positive definite while the smallest
-/// eigenvalue of its correlation matrix stays well above `Nε`. An update adds the information
-/// `Hᵀ R⁻¹ H`; in correlation terms row `c` adds `h̃ h̃ᵀ / R_cc` with `h̃ = D^½ h_c` and
-/// `‖h̃‖² = w_c`, so with `R_cc ≥ f w_c` it raises the largest eigenvalue of `C⁻¹` by at most
-/// `1/f` and `λ_min(C⁺) ≥ 1 / (1/λ_min(C) + M/f)`: an update cannot take the correlation matrix
-/// below `f / M` (the posterior's smaller diagonal only raises it). Without the floor an
-/// update much more precise than its prior leaves `P` indefinite (in `f32`, a heading of σ =
-/// 1e-5 rad against 0.1 rad; in `f64`, an accelerometer with no noise). A row below it is fused
-/// as if its variance were `f w_c`: `R_eff = R + diag(max(0, f w_c − R_cc))`, positive
-/// definite whenever `R` is and never smaller. In `f64`, `f = 2.7e-14` (σ ratio 1.6e-7): it
-/// acts on no real sensor. In `f32`, `f = 1.4e-5` (σ ratio 3.8e-3): a 1 m fix after a
-/// position prior of 1 km is fused as a 3.8 m fix, and the next one at its own σ.
-const NOISE_FLOOR: f64 = 8.0;
+/// eigenvalue of its correlation matrix stays well above `Nε`. The combination's variance,
+/// relative to `w_c`, is such an eigenvalue's scale: a measurement far more precise than its
+/// prior (in `f32`, a heading of σ = 1e-5 rad against 0.1 rad; in `f64`, an accelerometer with
+/// no noise), or the same combination measured again and again (tilt against accelerometer bias
+/// at rest, with no process noise to loosen it), takes it below rounding and leaves `P`
+/// indefinite. So with `p_c = (H P Hᵀ)_cc` the row's variance is raised to
+///
+/// ```text
+/// R_eff,cc = max(R_cc, f w_c p_c / max(p_c − f w_c, ε p_c))
+/// ```
+///
+/// which keeps the posterior `p_c R / (p_c + R)` at `f w_c` or above; a combination already at
+/// the floor (`p_c ≤ f w_c`) is fused with `R_eff = f w_c / ε`, which shrinks it by about `ε`
+/// per update. `R_eff = R + diag(…)` is positive definite whenever `R` is and never smaller.
+///
+/// Each row adds at most `w_c / R_eff ≤ 1/f` to the largest eigenvalue of `C⁻¹`, so an update
+/// leaves `λ_min(C⁺) ≥ 1 / (1/λ_min(C) + M/f)`; `f/M` must clear the rounding of `C⁺`, about
+/// `(2M + 2) N ε` per update for `M ≤ 3` rows, with room for the prior's own: `256 N ε` is ten
+/// times that (a camera update with σ = 1e-6 px after another left `P` indefinite in `f64` at
+/// `64 N ε`). In `f64`, `f = 8.5e-13` (σ ratio 9e-7): it acts on no real sensor. In `f32`,
+/// `f = 4.6e-4` (σ ratio 0.021): a 1 m fix after a position prior of 1 km is fused as a 21 m
+/// fix, and the next one at its own σ.
+const NOISE_FLOOR: f64 = 256.0;
+
+/// The noise floor's fraction `f = 256 N ε` for a filter of `N` states ([`NOISE_FLOOR`]).
+pub(super) fn noise_floor<T: Real, const N: usize>() -> T {
+    T::lit(NOISE_FLOOR * T::EPSILON_F64 * N as f64)
+}
 
 /// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`, for the covariance `p` and the `m × m`
 /// noise `noise` (column-major), over the `m` active columns of the working set only. Returns
@@ -58,17 +75,19 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
         }
     }
     // S_ij = R_ij + (row i of H)·(column j of U) for i, j < m; the identity padding stays.
-    // On the diagonal R_cc is raised to the noise floor f Σ_i H_ci² P_ii ([`NOISE_FLOOR`]).
+    // On the diagonal R_cc is raised to the noise floor ([`NOISE_FLOOR`]).
     *s = padded_noise(noise, m);
-    let floor = T::lit(NOISE_FLOOR * T::EPSILON_F64 * N as f64);
+    let floor = noise_floor::<T, N>();
     for (j, (uc, w)) in u.iter().zip(wc).enumerate().take(m) {
         for (i, hc) in ht.iter().enumerate().take(m) {
             if let Some(e) = s.get_mut((i, j)) {
                 let hph = dot(hc, uc);
                 *e = if i == j {
-                    // max(R_cc, f w_c) by comparison: `max` is a libm call on a Cortex-M4F.
+                    // max(R_cc, …) by comparison: `max` is a libm call on a Cortex-M4F.
                     let low = floor * w;
-                    hph + if low > *e { low } else { *e }
+                    let room = larger(hph - low, hph * T::lit(T::EPSILON_F64));
+                    let least = low * hph / room;
+                    hph + if least > *e { least } else { *e }
                 } else {
                     *e + hph
                 };

@@ -43,7 +43,7 @@ use crate::kernels::{all_finite, mat3};
 use crate::lie::{LieGroup, So3};
 use crate::Real;
 use commit::commit;
-use gain::{gate_step, padded_noise, step};
+use gain::{gate_step, noise_floor, padded_noise, step};
 pub use model::{Linearization, Measurement};
 use nalgebra::{SMatrix, SVector};
 pub use options::UpdateOptions;
@@ -151,12 +151,13 @@ where
 }
 
 /// `R` (padded to `C × C`, [`padded_noise`]) is symmetric positive definite and not singular to
-/// the scalar's resolution ([`is_usable_spd`]: a noise `R` with two rows correlated beyond
-/// `√(1 − 8Nε)` measures their difference exactly, which no noise floor on the diagonal
-/// catches); out of line, so that the padded copy is not in the update's frame.
+/// the scalar's resolution: every Cholesky pivot above the noise floor's fraction `256 N ε` of
+/// its diagonal (a noise `R` with two rows correlated beyond `√(1 − 256 N ε)` measures their
+/// difference more precisely than the floor on the diagonal allows); out of line, so that the
+/// padded copy is not in the update's frame.
 #[inline(never)]
 fn noise_is_spd<T: Real, const C: usize, const N: usize>(noise: &[T], m: usize) -> bool {
-    is_usable_spd::<T, C, N>(&padded_noise::<T, C>(noise, m))
+    is_usable_spd(&padded_noise::<T, C>(noise, m), noise_floor::<T, N>())
 }
 
 /// Linearizes at `x̂ ⊕ δx` (`δx` = `w.dx`; at `x̂` when `first`) into `w.ht`, `w.r`, with the

@@ -104,12 +104,16 @@ pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
     }
 }
 
-/// The growth floor, `f = 8 N ε`: the part of each variance's
-/// growth in a prediction that is made independent of every other state.
+/// The growth floor, `f = 8 N ε`: the part of each variance's growth in a prediction that is
+/// made independent of every other state.
 const GROWTH_FLOOR: f64 = 8.0;
 
+/// With it, `2 ε` of each growing variance: the rounding of one prediction, twice over.
+const GROWTH_ROUNDING: f64 = 2.0;
+
 /// Floors the first `K` variances of a predicted `P`: where `P⁺_kk` grew from its value before
-/// the prediction (`before[k]`), adds `f (P⁺_kk − before[k])` ([`GROWTH_FLOOR`]).
+/// the prediction (`before[k]`), adds `f (P⁺_kk − before[k]) + 2 ε P⁺_kk` ([`GROWTH_FLOOR`],
+/// [`GROWTH_ROUNDING`]).
 ///
 /// A prediction integrates: `p⁺ = p + v dt`, `v⁺ = v + a dt`, `θ⁺ = ΔRᵀ θ − J_r dt b_g`. The
 /// variance it adds comes from other states and may be wholly correlated with them (a velocity
@@ -118,8 +122,12 @@ const GROWTH_FLOOR: f64 = 8.0;
 /// correlation matrix falls below the rounding of `F P Fᵀ` (a few `ε` per entry) and `P⁺` is
 /// indefinite; prediction after prediction it falls by the growth factor each time. A fraction
 /// `f` of each growth made independent keeps every state's variance, given all the others, at
-/// least about `f/3` of its variance across any number of predictions. In `f64` that is
-/// `2.7e-14` of the growth; in `f32`, `1.4e-5`: a process noise larger by that fraction.
+/// least about `f/3` of its variance across predictions whose growth is large. When the growth
+/// per step is small beside the variance (an attitude of σ = 60 rad fed by a gyro bias of σ =
+/// 3.7 rad/s, 500 steps), the rounding of each step, a few `ε` of the variance, outruns it;
+/// `2 ε P⁺_kk` more on each growing variance covers that. In `f64` the two are `2.7e-14` of
+/// the growth and `4.4e-16` of the variance per step; in `f32`, `1.4e-5` and `2.4e-7`: at
+/// 200 Hz a variance that grows for 600 s without a measurement ends 2.9 % larger.
 pub(crate) fn floor_growth<T: Real, const N: usize, const K: usize>(
     p: &mut SMatrix<T, N, N>,
     before: &[T; K],
@@ -129,7 +137,7 @@ pub(crate) fn floor_growth<T: Real, const N: usize, const K: usize>(
         if let Some(d) = p.get_mut((k, k)) {
             let grown = *d - *own;
             if grown > T::zero() {
-                *d += grown * f;
+                *d += grown * f + *d * T::lit(GROWTH_ROUNDING * T::EPSILON_F64);
             }
         }
     }

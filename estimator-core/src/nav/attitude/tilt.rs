@@ -108,13 +108,21 @@ pub(super) fn update_slow_power<T: Real>(
     slow + (vertical * vertical - slow) * w
 }
 
-/// The world-frame attitude covariance `R P_θθ Rᵀ` of a filter.
+/// The world-frame attitude covariance `R P_θθ Rᵀ` of a filter, its diagonal kept at the
+/// block's resolution `16 ε tr P_θθ` or above: rotated in the scalar, a tilt variance far below
+/// the heading's (which the filter's attitude floor keeps at that resolution) can come out a
+/// little below zero, and its square root NaN.
 pub(super) fn world_attitude_covariance<T: Real, S: ErrorState<T, N>, const N: usize>(
     filter: &Filter<T, S, N>,
 ) -> nalgebra::Matrix3<T> {
     let r = filter.state().attitude().rotation_matrix();
     let p = crate::kernels::block::block(filter.covariance(), 0, 0);
-    mat3::mul(&mat3::mul(&r, &p), &r.transpose())
+    let mut w = mat3::mul(&mat3::mul(&r, &p), &r.transpose());
+    let resolution = (p.m11 + p.m22 + p.m33) * T::lit(16.0 * T::EPSILON_F64);
+    w.m11 = crate::kernels::larger(w.m11, resolution);
+    w.m22 = crate::kernels::larger(w.m22, resolution);
+    w.m33 = crate::kernels::larger(w.m33, resolution);
+    w
 }
 
 /// Fuses the block's mean specific force with 1σ `sigma` per axis; widens the tilt after

@@ -175,13 +175,13 @@ impl<T: Real> InitialSigmas<T> {
     /// The attitude covariance in the body-frame error: the world-frame
     /// `diag(σ_t², σ_t², σ_ψ²)` (z up) mapped by `δθ = Rᵀ δθ_w`: `Rᵀ Σ_w R`.
     ///
-    /// A sigma above π is taken as π: an attitude error of σ = π already carries no
-    /// information, and a larger variance only costs the filter its resolution (the tilt of a
-    /// body-frame attitude block is the difference of entries of the heading's size).
+    /// A sigma is taken by its magnitude, and one above π as π: an attitude error of σ = π
+    /// carries no information, and a larger variance only costs the filter its resolution (the
+    /// tilt of a body-frame attitude block is the difference of entries of the heading's size).
     #[must_use]
     pub fn attitude_covariance(&self, attitude: &So3<T>, up: &Vector3<T>) -> Matrix3<T> {
         let r = attitude.rotation_matrix();
-        let (tilt, yaw) = (self.tilt.min(T::pi()), self.yaw.min(T::pi()));
+        let (tilt, yaw) = (self.tilt.abs().min(T::pi()), self.yaw.abs().min(T::pi()));
         let t2 = tilt * tilt;
         let y2 = yaw * yaw;
         // Σ_w = σ_t² I + (σ_ψ² − σ_t²) u uᵀ.

@@ -149,3 +149,28 @@ pub(crate) fn leading_diagonal<T: Real, const N: usize, const K: usize>(
 ) -> [T; K] {
     core::array::from_fn(|k| p.get((k, k)).copied().unwrap_or_else(T::zero))
 }
+
+/// Scales the attitude rows and columns of `P` by `s = π / σ_max` when the largest attitude
+/// variance `σ_max²` is above π²: an attitude error of σ = π is no information, and the
+/// variance beyond it only costs the filter its resolution (a heading of σ = 3e7 rad beside
+/// biases of 1e-5 leaves nothing of the tilt in `f32`). `S P S` with `S = diag(s I₃, I)` keeps
+/// `P` positive definite and every correlation as it was.
+pub(crate) fn cap_attitude<T: Real, const N: usize>(p: &mut SMatrix<T, N, N>) {
+    let pi2 = T::pi() * T::pi();
+    let largest = (0..3).fold(T::zero(), |m, k| {
+        crate::kernels::larger(m, p.get((k, k)).copied().unwrap_or_else(T::zero))
+    });
+    if largest > pi2 {
+        let s = (pi2 / largest).sqrt_rn();
+        for (j, col) in p.data.0.iter_mut().enumerate() {
+            for (i, e) in col.iter_mut().enumerate() {
+                if i < 3 {
+                    *e *= s;
+                }
+                if j < 3 {
+                    *e *= s;
+                }
+            }
+        }
+    }
+}

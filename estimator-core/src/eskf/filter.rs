@@ -2,7 +2,7 @@
 
 use super::align::{prior_attitude_covariance, Alignment, InitialSigmas};
 use super::config::{FilterConfig, ImuSample};
-use super::covariance::{attitude_floor, check_start, is_spd, sigmas};
+use super::covariance::{attitude_floor, cap_attitude, check_start, is_spd, sigmas};
 use super::error::{EskfError, UpdateOutcome};
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use super::update::{update, Measurement, UpdateOptions};
@@ -125,6 +125,8 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
         config: FilterConfig<T>,
     ) -> Result<Self, EskfError> {
         check_start(&state, &covariance, &config)?;
+        let mut covariance = covariance;
+        cap_attitude(&mut covariance);
         Ok(Self {
             state,
             covariance,

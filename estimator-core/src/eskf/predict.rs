@@ -2,7 +2,7 @@
 //! propagation `P⁺ = F P Fᵀ + Q` (equations in the [`crate::eskf`] module docs).
 
 use super::config::{check_dt, FilterConfig, ImuSample};
-use super::covariance::{attitude_floor, floor_growth, leading_diagonal};
+use super::covariance::{attitude_floor, cap_attitude, floor_growth, leading_diagonal};
 use super::error::EskfError;
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use crate::kernels::block::{add_scaled_identity, block, block_in, set_block};
@@ -164,6 +164,7 @@ pub(crate) fn predict_ins_finite<T: Real>(
     floor_growth(p, &before);
     let floor = attitude_floor(&block(p, 0, 0));
     add_scaled_identity(p, 0, 0, floor);
+    cap_attitude(p);
     *x = new_x;
     Ok(())
 }
@@ -240,6 +241,7 @@ fn predict_attitude<T: Real, const N: usize>(
     floor_growth(p, &before);
     let floor = attitude_floor(&block(p, 0, 0));
     add_scaled_identity(p, 0, 0, floor);
+    cap_attitude(p);
     *attitude = next;
     Ok(())
 }

@@ -155,7 +155,21 @@ pub(crate) fn leading_diagonal<T: Real, const N: usize, const K: usize>(
 /// variance beyond it only costs the filter its resolution (a heading of σ = 3e7 rad beside
 /// biases of 1e-5 leaves nothing of the tilt in `f32`). `S P S` with `S = diag(s I₃, I)` keeps
 /// `P` positive definite and every correlation as it was.
+#[inline(always)]
 pub(crate) fn cap_attitude<T: Real, const N: usize>(p: &mut SMatrix<T, N, N>) {
+    // The trace bounds the largest variance: one comparison on the usual path.
+    let tr = p.get((0, 0)).copied().unwrap_or_else(T::zero)
+        + p.get((1, 1)).copied().unwrap_or_else(T::zero)
+        + p.get((2, 2)).copied().unwrap_or_else(T::zero);
+    if tr > T::pi() * T::pi() {
+        scale_attitude(p);
+    }
+}
+
+/// The scaling of [`cap_attitude`], out of line (rarely taken).
+#[cold]
+#[inline(never)]
+fn scale_attitude<T: Real, const N: usize>(p: &mut SMatrix<T, N, N>) {
     let pi2 = T::pi() * T::pi();
     let largest = (0..3).fold(T::zero(), |m, k| {
         crate::kernels::larger(m, p.get((k, k)).copied().unwrap_or_else(T::zero))

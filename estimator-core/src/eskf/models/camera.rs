@@ -46,7 +46,8 @@ pub struct CameraLandmark<T: Real> {
     pub body_from_camera: Se3<T>,
     /// `R`, px².
     pub noise: Matrix2<T>,
-    /// Smallest accepted depth in the camera, m (e.g. `0.01`).
+    /// Smallest accepted depth in the camera, m (e.g. `0.01`); positive
+    /// ([`EskfError::InvalidOption`] otherwise: at zero depth the projection is singular).
     pub min_depth: T,
 }
 
@@ -106,6 +107,9 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
             && self.body_from_camera.is_finite())
         {
             return Err(EskfError::NonFinite);
+        }
+        if self.min_depth <= T::zero() {
+            return Err(EskfError::InvalidOption);
         }
         let (uv, c, q) = self.project_parts(x)?;
         let r_cb = self

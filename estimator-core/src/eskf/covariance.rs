@@ -104,9 +104,9 @@ pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
     }
 }
 
-/// The growth floor, `f = 8 N ε`: the part of each variance's growth in a prediction that is
+/// The growth floor, `f = 64 N ε`: the part of each variance's growth in a prediction that is
 /// made independent of every other state.
-const GROWTH_FLOOR: f64 = 8.0;
+const GROWTH_FLOOR: f64 = 64.0;
 
 /// With it, `2 ε` of each growing variance: the rounding of one prediction, twice over.
 const GROWTH_ROUNDING: f64 = 2.0;
@@ -125,8 +125,8 @@ const GROWTH_ROUNDING: f64 = 2.0;
 /// least about `f/3` of its variance across predictions whose growth is large. When the growth
 /// per step is small beside the variance (an attitude of σ = 60 rad fed by a gyro bias of σ =
 /// 3.7 rad/s, 500 steps), the rounding of each step, a few `ε` of the variance, outruns it;
-/// `2 ε P⁺_kk` more on each growing variance covers that. In `f64` the two are `2.7e-14` of
-/// the growth and `4.4e-16` of the variance per step; in `f32`, `1.4e-5` and `2.4e-7`: at
+/// `2 ε P⁺_kk` more on each growing variance covers that. In `f64` the two are `2.1e-13` of
+/// the growth and `4.4e-16` of the variance per step; in `f32`, `1.1e-4` and `2.4e-7`: at
 /// 200 Hz a variance that grows for 600 s without a measurement ends 2.9 % larger.
 pub(crate) fn floor_growth<T: Real, const N: usize, const K: usize>(
     p: &mut SMatrix<T, N, N>,

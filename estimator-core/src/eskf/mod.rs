@@ -138,7 +138,7 @@
 //!
 //! * **Growth floor** (`covariance.rs`): a prediction integrates (`p⁺ = p + v dt`, …), and
 //!   the variance it adds may be wholly correlated with its source; where `P⁺_kk` grew,
-//!   `f (P⁺_kk − P_kk) + 2 ε P⁺_kk` is added (`f = 8 N ε`), so that each state keeps a part
+//!   `f (P⁺_kk − P_kk) + 2 ε P⁺_kk` is added (`f = 64 N ε`), so that each state keeps a part
 //!   of its variance independent of the others, ahead of the rounding of each step.
 //!
 //! Attitude sigmas above π are taken as π (start-up, widening): σ = π is no information.

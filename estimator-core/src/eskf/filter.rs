@@ -124,9 +124,10 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
         covariance: SMatrix<T, N, N>,
         config: FilterConfig<T>,
     ) -> Result<Self, EskfError> {
-        check_start(&state, &covariance, &config)?;
+        // Capped first, then checked: the scaling rounds, and the filter keeps what was checked.
         let mut covariance = covariance;
         cap_attitude(&mut covariance);
+        check_start(&state, &covariance, &config)?;
         Ok(Self {
             state,
             covariance,

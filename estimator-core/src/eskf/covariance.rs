@@ -15,11 +15,13 @@ pub(crate) fn is_spd<T: Real, const M: usize>(a: &SMatrix<T, M, M>) -> bool {
     is_symmetric(a.as_slice(), M) && factor_in_place(l.as_mut_slice(), M, T::zero())
 }
 
-/// The smallest fraction of a variable's variance, `8 N ε` for a filter of `N` states, that the
-/// other variables of a starting `P` may leave unexplained: below it the matrix is singular to
-/// the scalar's resolution (a correlation above `√(1 − 8Nε)`, 0.999993 in `f32`).
+/// The smallest fraction of a variable's variance, `256 N ε` for a filter of `N` states (the
+/// update's noise floor), that the other variables of a starting `P` may leave unexplained:
+/// below it the matrix is singular to the resolution the filter keeps (a correlation above
+/// `√(1 − 256 N ε)`, 0.99977 in `f32` for 15 states), and an update's rounding can leave it
+/// indefinite.
 pub(crate) fn usable_pivot<T: Real, const N: usize>() -> T {
-    T::lit(8.0 * N as f64 * T::EPSILON_F64)
+    T::lit(256.0 * N as f64 * T::EPSILON_F64)
 }
 
 /// [`is_spd`], with every Cholesky pivot `d_j` above `relative_pivot · A_jj` (each variable

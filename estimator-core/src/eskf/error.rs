@@ -17,8 +17,8 @@ pub enum EskfError {
     /// to all but `256 N ε` of it, the update's noise floor).
     NoiseNotPositiveDefinite,
     /// A covariance given to a constructor that is not symmetric positive definite, or is
-    /// singular to the scalar's resolution (a variable whose variance the others explain to
-    /// all but `8 N ε` of it).
+    /// singular to the resolution the filter keeps (a variable whose variance the others
+    /// explain to all but `256 N ε` of it).
     CovarianceNotPositiveDefinite,
     /// A vector that must have a direction (magnetometer, accelerometer, reference field) has
     /// zero norm, or no horizontal component where a heading is needed.

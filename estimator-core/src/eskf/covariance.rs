@@ -36,7 +36,7 @@ pub(crate) fn is_usable_spd<T: Real, const M: usize>(
 
 /// The column-major `n × n` storage `a` is finite and symmetric to `10⁻⁶` of its largest entry
 /// (one compiled copy for every size).
-pub(crate) fn is_symmetric<T: Real>(a: &[T], n: usize) -> bool {
+fn is_symmetric<T: Real>(a: &[T], n: usize) -> bool {
     if a.len() != n * n || !all_finite(a) {
         return false;
     }

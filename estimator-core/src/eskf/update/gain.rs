@@ -182,20 +182,14 @@ pub(super) fn step<T: Real, const N: usize, const C: usize>(
 }
 
 /// `R` (`m × m`, column-major in `noise`) in the top-left of the `C × C` identity: the padded
-/// noise of the [module docs](super) (`S_pad = [[S, 0], [0, I]]`), read from its lower triangle
-/// and mirrored, so that the gain uses exactly the matrix the Cholesky check factored (which
-/// reads only the lower triangle). Entries missing from `noise` stay those of the identity.
+/// noise of the [module docs](super) (`S_pad = [[S, 0], [0, I]]`). Entries missing from `noise`
+/// stay those of the identity.
 pub(super) fn padded_noise<T: Real, const C: usize>(noise: &[T], m: usize) -> SMatrix<T, C, C> {
     let mut r = SMatrix::<T, C, C>::identity();
     for j in 0..m {
-        for i in j..m {
-            if let Some(v) = noise.get(j * m + i) {
-                if let Some(e) = r.get_mut((i, j)) {
-                    *e = *v;
-                }
-                if let Some(e) = r.get_mut((j, i)) {
-                    *e = *v;
-                }
+        for i in 0..m {
+            if let (Some(e), Some(v)) = (r.get_mut((i, j)), noise.get(j * m + i)) {
+                *e = *v;
             }
         }
     }

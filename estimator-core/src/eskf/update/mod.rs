@@ -34,7 +34,7 @@ mod model;
 mod options;
 mod work;
 
-use super::covariance::{is_symmetric, is_usable_spd};
+use super::covariance::is_usable_spd;
 use super::error::{EskfError, UpdateOutcome};
 use super::state::ErrorState;
 use crate::kernels::block::copy;
@@ -157,8 +157,7 @@ where
 /// padded copy is not in the update's frame.
 #[inline(never)]
 fn noise_is_spd<T: Real, const C: usize, const N: usize>(noise: &[T], m: usize) -> bool {
-    // Symmetric as given (to 1e-6 of its largest entry), then factored as the gain uses it.
-    is_symmetric(noise, m) && is_usable_spd(&padded_noise::<T, C>(noise, m), noise_floor::<T, N>())
+    is_usable_spd(&padded_noise::<T, C>(noise, m), noise_floor::<T, N>())
 }
 
 /// Linearizes at `x̂ ⊕ δx` (`δx` = `w.dx`; at `x̂` when `first`) into `w.ht`, `w.r`, with the

@@ -4,7 +4,7 @@
 //!   over `f32` and `f64`, following one convention (right perturbation `a ⊕ τ = a·exp(τ^)`,
 //!   eq. 4.5 of the paper below). Its module docs state the conventions.
 //! * [`eskf`]: the on-manifold error-state Kalman filter, 15-state inertial ([`eskf::Ins`]) and
-//!   attitude-only ([`eskf::Ahrs`]), with gated Joseph and iterated updates and typed outcomes.
+//!   attitude-only ([`eskf::Ahrs`]), with gated square-root Joseph and iterated updates and typed outcomes.
 //! * [`gn`]: a fixed-size Gauss-Newton / Levenberg-Marquardt solver on manifolds with robust
 //!   losses, and on top of it [`gn::solve_pnp`], triangulation and rotation from vector pairs.
 //! * [`scalar`]: the [`Real`] scalar trait, with an all-`f32` sine/cosine for Cortex-M4F.

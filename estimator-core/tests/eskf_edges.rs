@@ -69,8 +69,17 @@ fn refused_predict_leaves_filter_unchanged() {
         (imu([0.0; 3], [0.0, 0.0, 9.81], NAN), EskfError::NonFinite),
         (imu([0.0; 3], [0.0, 0.0, 9.81], 0.5), EskfError::DtTooLarge),
         (
-            imu([1e300, 0.0, 0.0], [1e300, 0.0, 9.81], 0.01),
+            imu([0.0; 3], [1e300, 0.0, 9.81], 0.01),
             EskfError::NonFinite,
+        ),
+        // A step that turns by π or more (4 rad here): aliased, and J_r(ω dt) near rank one.
+        (
+            imu([400.0, 0.0, 0.0], [0.0, 0.0, 9.81], 0.01),
+            EskfError::NumericalFailure,
+        ),
+        (
+            imu([1e300, 0.0, 0.0], [1e300, 0.0, 9.81], 0.01),
+            EskfError::NumericalFailure,
         ),
     ];
     for (s, e) in cases {
@@ -82,6 +91,10 @@ fn refused_predict_leaves_filter_unchanged() {
     assert_eq!(
         a.predict(&gyro_only(Vector3::new(NAN, 0.0, 0.0), 0.01)),
         Err(EskfError::NonFinite)
+    );
+    assert_eq!(
+        a.predict(&gyro_only(Vector3::new(0.0, -400.0, 0.0), 0.01)),
+        Err(EskfError::NumericalFailure)
     );
     assert_eq!(
         a.predict(&gyro_only(Vector3::zeros(), 0.0)),
@@ -692,8 +705,8 @@ fn widening_the_attitude_stops_at_no_information() {
 /// A GNSS fix of σ = 1e-6 m against a position prior of 0.1 m, in `f32`: accepted, and `P`
 /// stays positive definite because each row's noise is raised to the floor
 /// `256 N ε Σ_i H_i² P_ii` for the posterior (here `256·15·ε·0.01`). Without the floor the
-/// Joseph form cancels and the
-/// position block is indefinite after this one update.
+/// posterior cancels below `f32`'s resolution and the position block is indefinite after this
+/// one update.
 #[test]
 fn f32_fix_far_more_precise_than_its_prior_is_fused_at_the_noise_floor() {
     let mut f = ins::<f32>();
@@ -718,8 +731,9 @@ fn f32_fix_far_more_precise_than_its_prior_is_fused_at_the_noise_floor() {
 /// `f32`, a position known to 1e-6 m beside a velocity of σ = 1e8 m/s (`P = 1e-12 I`, then the
 /// velocity reset), one prediction of 0.1 ms: the position's new variance (1e8 dt²) is almost
 /// wholly correlated with the velocity, which `f32` cannot carry. The growth floor adds
-/// `f = 64 N ε` times each variance's growth: `P` stays positive definite, and the variances
-/// change by that relative amount only.
+/// `f = 64 N ε` times each variance's growth, `16 ε` of the position block's (three alike) and
+/// `2 ε` of the variance: `P` stays positive definite, and the variances change by that
+/// relative amount only.
 #[test]
 fn f32_prediction_from_a_far_less_certain_velocity_keeps_covariance_positive_definite() {
     let state = InsState::<f32> {
@@ -739,9 +753,10 @@ fn f32_prediction_from_a_far_less_certain_velocity_keeps_covariance_positive_def
     };
     f.predict(&sample).expect("valid sample");
     assert!(positive_definite(f.covariance()));
-    // P⁺_pp = P_pp + dt² P_vv (+ a Q of 1e-19), floored: times (1 + f), f = 64·15·ε; within the
-    // rounding of a few operations.
-    let grown = 1e16f64 * 1e-8 * (1.0 + 64.0 * 15.0 * f64::from(f32::EPSILON));
+    // P⁺_pp = P_pp + dt² P_vv (+ a Q of 1e-19), floored: times 1 + f + 3·16 ε + 2 ε,
+    // f = 64·15·ε; within the rounding of a few operations.
+    let eps = f64::from(f32::EPSILON);
+    let grown = 1e16f64 * 1e-8 * (1.0 + 64.0 * 15.0 * eps + 48.0 * eps + 2.0 * eps);
     for k in 6..9 {
         let position = f64::from(f.covariance()[(k, k)]);
         assert!(
@@ -798,6 +813,73 @@ fn gnss_noise_singular_to_the_scalar_is_refused() {
         let outcome = f
             .update(&fix, &UpdateOptions::default())
             .expect("usable noise");
+        assert!(outcome.is_accepted());
+        assert!(positive_definite(f.covariance()));
+    }
+    run::<f32>();
+    run::<f64>();
+}
+
+#[test]
+fn noise_whose_symmetric_part_is_not_positive_definite_is_refused() {
+    // Symmetric to 1e-6 of its largest entry (1807.7), so it passes the symmetry check, and its
+    // lower triangle is positive definite; its symmetric part, the matrix the gain uses, is not:
+    // ½(R₁₂ + R₂₁) = −5.0e-4 against R₁₁ = R₂₂ = 3.6e-4.
+    let (big, small) = (1807.7363241016253, 0.0003568627450980393);
+    let mut f = ahrs::<f64>();
+    let before = f;
+    let mut stationary = ZeroRate::new(Vector3::zeros(), 1.0);
+    #[rustfmt::skip]
+    let asymmetric = Matrix3::new(
+        big,      -0.001,     0.0,
+        small,    small,      -0.001,
+        1.73e-46, -2.1075e-18, small,
+    );
+    stationary.noise = asymmetric;
+    let r = f.update(&stationary, &UpdateOptions::default());
+    assert_eq!(r, Err(EskfError::NoiseNotPositiveDefinite));
+    assert_eq!(f.covariance(), before.covariance());
+    assert_eq!(f.state(), before.state());
+    // Its lower triangle, mirrored, is a usable noise.
+    stationary.noise = asymmetric.lower_triangle() + asymmetric.lower_triangle().transpose()
+        - Matrix3::from_diagonal(&asymmetric.diagonal());
+    let outcome = f
+        .update(&stationary, &UpdateOptions::default())
+        .expect("usable noise");
+    assert!(outcome.is_accepted());
+    assert!(positive_definite(f.covariance()));
+}
+
+/// Two rows of `H` nearly parallel: an `AccelerometerAtRest` whose bias map reads
+/// `−2.93e7 b_x` in two rows that differ by 1e-5 of that (a fuzz finding, `f64`), with a noise of
+/// σ = 2e-4. `S` then has a condition of about 1e11; the expanded Joseph form
+/// `P + V Kᵀ + K Vᵀ`, whose terms grow with it, left `P` indefinite (correlation matrix at
+/// −3e-10). The square-root form `P − W Wᵀ` has no term larger than `P`: it stays positive
+/// definite, in both precisions.
+#[test]
+fn nearly_parallel_measurement_rows_keep_covariance_positive_definite() {
+    fn run<T: estimator_core::Real>() {
+        let mut f = ins::<T>();
+        let mut at_rest = AccelerometerAtRest::new(Vector3::repeat(T::lit(-0.048)), T::lit(2.1e-4));
+        let (big, a, b, c) = (
+            T::lit(-2.9299e7),
+            T::lit(0.0106),
+            T::lit(36.06),
+            T::lit(105.88),
+        );
+        let small = T::lit(-0.001);
+        #[rustfmt::skip]
+        let map = Matrix3::new(
+            a,   big, big,
+            big, b,   small,
+            big, c,   small,
+        );
+        at_rest.bias_map = map;
+        let options = UpdateOptions {
+            gate: Gate::Off,
+            ..UpdateOptions::default()
+        };
+        let outcome = f.update(&at_rest, &options).expect("valid update");
         assert!(outcome.is_accepted());
         assert!(positive_definite(f.covariance()));
     }

@@ -4,15 +4,20 @@ use super::config::FilterConfig;
 use super::error::EskfError;
 use super::state::ErrorState;
 use crate::kernels::cholesky::factor_in_place;
-use crate::kernels::{all_finite, usable_variance};
+use crate::kernels::slice::symmetrize;
+use crate::kernels::{all_finite, larger, usable_variance};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, SVector};
 
-/// `A` is finite, symmetric to `10⁻⁶` of its largest entry, and positive definite (its Cholesky
-/// factor exists).
+/// `A` is finite, symmetric to `10⁻⁶` of its largest entry, and positive definite: the Cholesky
+/// factor of its symmetric part `½(A + Aᵀ)` exists.
+///
+/// The symmetric part, not the lower triangle as given: `xᵀ A x = xᵀ ½(A + Aᵀ) x`, and it is the
+/// matrix the filter goes on to use (the update symmetrizes `S = H P Hᵀ + R`). Where the small
+/// entries of an `A` symmetric only to `10⁻⁶` of its largest differ, the lower triangle can be
+/// definite and the symmetric part not.
 pub(crate) fn is_spd<T: Real, const M: usize>(a: &SMatrix<T, M, M>) -> bool {
-    let mut l = *a;
-    is_symmetric(a.as_slice(), M) && factor_in_place(l.as_mut_slice(), M, T::zero())
+    is_usable_spd(a, T::zero())
 }
 
 /// The smallest fraction of a variable's variance, `256 N ε` for a filter of `N` states (the
@@ -31,6 +36,7 @@ pub(crate) fn is_usable_spd<T: Real, const M: usize>(
     relative_pivot: T,
 ) -> bool {
     let mut l = *a;
+    symmetrize(l.as_mut_slice(), M);
     is_symmetric(a.as_slice(), M) && factor_in_place(l.as_mut_slice(), M, relative_pivot)
 }
 
@@ -110,12 +116,17 @@ pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
 /// made independent of every other state.
 const GROWTH_FLOOR: f64 = 64.0;
 
-/// With it, `2 ε` of each growing variance: the rounding of one prediction, twice over.
+/// With it, `16 ε` of the growth of the variance's block (v or p), on each of the block's
+/// variances: the rounding of the rotation that mixes the block's axes, with a margin.
+const GROWTH_MIXING: f64 = 16.0;
+
+/// And `2 ε` of each growing variance: the rounding of one prediction, twice over.
 const GROWTH_ROUNDING: f64 = 2.0;
 
-/// Floors the first `K` variances of a predicted `P`: where `P⁺_kk` grew from its value before
-/// the prediction (`before[k]`), adds `f (P⁺_kk − before[k]) + 2 ε P⁺_kk` ([`GROWTH_FLOOR`],
-/// [`GROWTH_ROUNDING`]).
+/// Floors the first `K` variances of a predicted `P` (θ; v; p): where `P⁺_kk` grew from its
+/// value before the prediction (`before[k]`), adds `f (P⁺_kk − before[k]) + 2 ε P⁺_kk`, and
+/// to every variance of the blocks v and p `16 ε G`, `G` the block's growth
+/// `Σ_k max(P⁺_kk − before[k], 0)` ([`GROWTH_FLOOR`], [`GROWTH_ROUNDING`], [`GROWTH_MIXING`]).
 ///
 /// A prediction integrates: `p⁺ = p + v dt`, `v⁺ = v + a dt`, `θ⁺ = ΔRᵀ θ − J_r dt b_g`. The
 /// variance it adds comes from other states and may be wholly correlated with them (a velocity
@@ -124,22 +135,53 @@ const GROWTH_ROUNDING: f64 = 2.0;
 /// correlation matrix falls below the rounding of `F P Fᵀ` (a few `ε` per entry) and `P⁺` is
 /// indefinite; prediction after prediction it falls by the growth factor each time. A fraction
 /// `f` of each growth made independent keeps every state's variance, given all the others, at
-/// least about `f/3` of its variance across predictions whose growth is large. When the growth
-/// per step is small beside the variance (an attitude of σ = 60 rad fed by a gyro bias of σ =
-/// 3.7 rad/s, 500 steps), the rounding of each step, a few `ε` of the variance, outruns it;
-/// `2 ε P⁺_kk` more on each growing variance covers that. In `f64` the two are `2.1e-13` of
-/// the growth and `4.4e-16` of the variance per step; in `f32`, `1.1e-4` and `2.4e-7`: at
-/// 200 Hz a variance that grows for 600 s without a measurement ends 2.9 % larger.
+/// least about `f/3` of its variance across predictions whose growth is large.
+///
+/// The rotation `R [f]× dt` that feeds `v` and `p` mixes their three axes, so the rounding of
+/// each axis is a few `ε` of the products the whole block goes through, not of its own result.
+/// Where `R f` lies along one axis (a specific force of 10²⁰ m/s² nearly vertical), that
+/// axis's variance grows by 10⁻¹⁰ of the others' and its rounding, a few `ε` of theirs, is far
+/// above `f` times its own growth: in `f64` the correlation matrix came out at `−2e-12` with
+/// the first term alone. `16 ε G` covers it. The attitude needs no such term: its growth
+/// `J_r dt P_bg J_rᵀ dt` keeps at least `(2/π)²` of its products' size, as the prediction
+/// refuses a step that turns by π or more, and `ΔRᵀ`'s rounding is the attitude floor's.
+///
+/// When the growth per step is small beside the variance (an attitude of σ = 60 rad fed by a
+/// gyro bias of σ = 3.7 rad/s, 500 steps), the rounding of each step, a few `ε` of the
+/// variance, outruns the first term; `2 ε P⁺_kk` more on each growing variance covers that. In
+/// `f64` the three are `2.1e-13` of the growth, `3.6e-15` of the block's and `4.4e-16` of the
+/// variance per step; in `f32`, `1.1e-4`, `1.9e-6` and `2.4e-7`: at 200 Hz a variance that
+/// grows for 600 s without a measurement ends 2.9 % larger.
 pub(crate) fn floor_growth<T: Real, const N: usize, const K: usize>(
     p: &mut SMatrix<T, N, N>,
     before: &[T; K],
 ) {
     let f = T::lit(GROWTH_FLOOR * T::EPSILON_F64 * N as f64);
+    let mixing = T::lit(GROWTH_MIXING * T::EPSILON_F64);
+    let rounding = T::lit(GROWTH_ROUNDING * T::EPSILON_F64);
+    // The growth of the blocks v and p, before the variances' own floors (none when K = 3).
+    let mut block_growth = [T::zero(); 3];
+    for block in 1..K / 3 {
+        for k in 3 * block..3 * block + 3 {
+            if let (Some(d), Some(b), Some(g)) =
+                (p.get((k, k)), before.get(k), block_growth.get_mut(block))
+            {
+                *g += larger(*d - *b, T::zero());
+            }
+        }
+    }
     for (k, own) in before.iter().enumerate() {
         if let Some(d) = p.get_mut((k, k)) {
             let grown = *d - *own;
             if grown > T::zero() {
-                *d += grown * f + *d * T::lit(GROWTH_ROUNDING * T::EPSILON_F64);
+                *d += grown * f + *d * rounding;
+            }
+        }
+    }
+    for block in 1..K / 3 {
+        for k in 3 * block..3 * block + 3 {
+            if let (Some(d), Some(g)) = (p.get_mut((k, k)), block_growth.get(block)) {
+                *d += *g * mixing;
             }
         }
     }

@@ -32,7 +32,8 @@ pub enum EskfError {
     /// The updated covariance came out non-finite, with a non-positive diagonal or with a
     /// variance above the variance ceiling ([`crate::Real::VARIANCE_CEILING_F64`]), or the
     /// attitude correction `|δθ|` reached π (outside the chart where `⊕` is one-to-one); the
-    /// update was not applied.
+    /// update was not applied. Or a prediction whose bias-corrected rotation in one step,
+    /// `|(ω_m − b_g) dt|`, reached π (the sample cannot say how the body turned).
     NumericalFailure,
     /// An alignment window with no samples.
     EmptyWindow,

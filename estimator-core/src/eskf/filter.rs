@@ -223,7 +223,7 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
         Sealed::propagate(&mut self.state, &mut self.covariance, imu, &self.config)
     }
 
-    /// Fuses one measurement: gate, Joseph form, optional Gauss-Newton iterations, injection
+    /// Fuses one measurement: gate, Joseph form (as `P − W Wᵀ`), optional Gauss-Newton iterations, injection
     /// through `⊕`, reset ([`crate::eskf`] module docs). Returns the outcome with its NIS; a
     /// `Rejected` outcome leaves the filter unchanged.
     ///
@@ -243,10 +243,12 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
 }
 
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
-    /// A filter from a block-diagonal prior: `attitude` (3 × 3) on block 0 and `variances[k]`
-    /// times the identity on block `k + 1`. Such a `P` is symmetric positive definite exactly
-    /// when the attitude block is and every variance is positive, so that is what is checked
-    /// (a 3 × 3 factorization, not one of `P`).
+    /// A filter from a block-diagonal prior: `attitude` (3 × 3) on block 0, with the attitude
+    /// floor of the predictions ([`attitude_floor`]: `16 ε tr A · I` when its smallest
+    /// eigenvalue may be below that), and `variances[k]` times the identity on block `k + 1`.
+    /// Such a `P` is symmetric positive definite exactly when the attitude block is and every
+    /// variance is positive, so that is what is checked (a 3 × 3 factorization, not one of
+    /// `P`), with every variance at most the ceiling.
     fn from_block_diagonal(
         state: S,
         attitude: &Matrix3<T>,
@@ -275,13 +277,18 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
         if !state.is_finite() {
             return Err(EskfError::NonFinite);
         }
-        let spd = is_spd(attitude) && variances.iter().all(|v| positive_finite(*v));
-        if !spd {
+        // A heading of σ = π beside a tilt of 1e-8 rad is a block singular to the scalar's
+        // resolution: floored as every prediction floors it.
+        let attitude = attitude + Matrix3::from_diagonal_element(attitude_floor(attitude));
+        let usable = (0..3).all(|k| attitude.get((k, k)).is_some_and(|d| usable_variance(*d)))
+            && is_spd(&attitude)
+            && variances.iter().all(|v| usable_variance(*v));
+        if !usable {
             return Err(EskfError::CovarianceNotPositiveDefinite);
         }
         self.state = state;
         self.covariance = SMatrix::zeros();
-        set_block(&mut self.covariance, 0, 0, attitude);
+        set_block(&mut self.covariance, 0, 0, &attitude);
         for (k, v) in variances.iter().enumerate() {
             add_scaled_identity(&mut self.covariance, k + 1, k + 1, *v);
         }

@@ -1,6 +1,7 @@
 //! On-manifold error-state Kalman filter: a 15-state inertial navigator ([`Ins`]) and an
 //! attitude-only AHRS ([`Ahrs`]), one generic implementation ([`Filter`]), with chi-square
-//! gating, Joseph-form updates, iterated (Gauss-Newton) updates and typed outcomes.
+//! gating, square-root (Cholesky) Joseph-form updates, iterated (Gauss-Newton) updates and
+//! typed outcomes.
 //! Allocation-free and panic-free.
 //!
 //! Equations cite *Lie Groups and Smooth Manifolds for Robotic State Estimation* ("the
@@ -75,8 +76,9 @@
 //! NIS = rᵀ S⁻¹ r                        squared Mahalanobis distance ‖e‖²_Σ = eᵀΣ⁻¹e (eq. 4.1)
 //! gate: NIS ≤ χ²_m(p), else Rejected { nis } and nothing changes
 //! K   = P Hᵀ S⁻¹,  δx = K r            the minimizer of eq. 4.4 with the prior ‖δx‖²_P added
-//! P⁺  = (I − KH) P (I − KH)ᵀ + K R Kᵀ  Joseph form, evaluated as P − KUᵀ − UKᵀ + KSKᵀ, U = P Hᵀ
-//!                                       = P + V Kᵀ + K Vᵀ, V = ½KS − U (exactly symmetric, in place)
+//!                                       in square-root form: S = L Lᵀ, W = P Hᵀ L⁻ᵀ, K = W L⁻¹
+//! P⁺  = (I − KH) P (I − KH)ᵀ + K R Kᵀ  Joseph form, for this K equal to P − U S⁻¹ Uᵀ, U = P Hᵀ,
+//!                                       evaluated as P − W Wᵀ (every term ≤ P; exactly symmetric)
 //! x⁺  = x̂ ⊕ δx                          injection (eq. 4.5)
 //! P⁺ ← G P⁺ Gᵀ,  G = blockdiag(J_r(δθ), I)   reset to the error about x⁺
 //! ```
@@ -120,7 +122,10 @@
 //! After every accepted call `P` is finite, symmetric and positive definite, in `f32` too.
 //! Rounding moves each entry `P_ij` by a few `ε √(P_ii P_jj)`, so this holds while the smallest
 //! eigenvalue of the correlation matrix `C = D^-½ P D^-½` (`D = diag P`) stays well above `Nε`.
-//! Three floors keep it there; in `f64` none acts on any usable filter.
+//! Three floors keep it there; in `f64` none acts on any usable filter. The premise holds for
+//! the update because its posterior is computed as `P − W Wᵀ` (square-root form, `W Wᵀ ≤ P`);
+//! the expanded Joseph form `P + V Kᵀ + K Vᵀ` has terms that grow with the condition of `S`
+//! and broke it where two rows of `H` were nearly parallel.
 //!
 //! * **Noise floor** (`update/gain.rs`): the combination `h_cᵀ δx` a row measures keeps a
 //!   posterior variance of at least `f w_c`, `w_c = Σ_i H_ci² P_ii`, `f = 256 N ε`: its noise
@@ -139,7 +144,16 @@
 //! * **Growth floor** (`covariance.rs`): a prediction integrates (`p⁺ = p + v dt`, …), and
 //!   the variance it adds may be wholly correlated with its source; where `P⁺_kk` grew,
 //!   `f (P⁺_kk − P_kk) + 2 ε P⁺_kk` is added (`f = 64 N ε`), so that each state keeps a part
-//!   of its variance independent of the others, ahead of the rounding of each step.
+//!   of its variance independent of the others, ahead of the rounding of each step. The
+//!   rotation `R [f]× dt` mixes the axes of `v` and of `p`, so each of their variances also
+//!   gets `16 ε` of its block's growth: the rounding of an axis that hardly grows (the
+//!   vertical under a vertical specific force) is a few `ε` of the others' growth, not of its
+//!   own.
+//!
+//! A prediction whose step turns by `|ω dt| ≥ π` is refused (`NumericalFailure`): the sample
+//! cannot say how the body turned, and `J_r(ω dt)` tends to rank one.
+//!
+//! A noise `R` is checked through its symmetric part `½(R + Rᵀ)`, the matrix the gain uses.
 //!
 //! Attitude sigmas above π are taken as π (start-up, widening): σ = π is no information.
 //!

@@ -78,7 +78,11 @@ pub(crate) fn predict_ins_finite<T: Real>(
 
     let omega = imu.gyro - x.gyro_bias;
     let f = imu.accel - x.accel_bias;
-    let (dr, jr) = So3::exp_jac(&(omega * dt));
+    let turn = omega * dt;
+    if !within_one_turn(&turn) {
+        return Err(EskfError::NumericalFailure);
+    }
+    let (dr, jr) = So3::exp_jac(&turn);
     let r = x.attitude.rotation_matrix();
     let a = mat3::mul_vec(&r, &f) + cfg.gravity;
     let new_x = InsState {
@@ -169,6 +173,17 @@ pub(crate) fn predict_ins_finite<T: Real>(
     Ok(())
 }
 
+/// `|ω dt| < π` (false for NaN): the step's rotation is one the exponential map gives
+/// uniquely. Beyond it the sample cannot say how the body turned (a rate of `π/dt` or more is
+/// aliased), and `J_r(ω dt)`, whose smallest singular value is `|sin(θ/2)/(θ/2)|`, tends to the
+/// rank-one `ω̂ ω̂ᵀ` (singular at `2π`): the attitude's growth `J_r dt P_bg J_rᵀ dt` then
+/// cancels to far below the rounding of its products (a gyro bias of σ = 10²⁹ rad/s left `P`
+/// indefinite).
+#[inline(always)]
+fn within_one_turn<T: Real>(turn: &Vector3<T>) -> bool {
+    turn.dot(turn) < T::pi() * T::pi()
+}
+
 /// The attitude-only prediction for the attitude states (`N = 6`: `(R, b_g)`; `N = 9`:
 /// `(R, b_g, b_a)`): `R⁺ = R exp((ω_m − b_g) dt)`, `P⁺ = F P Fᵀ + Q` with
 /// `F = [ΔRᵀ, −J_r dt, 0; 0, I, 0; 0, 0, I]` and `Q = diag(σ_g² dt I, σ_bg² dt I, σ_ba² dt I)`.
@@ -182,12 +197,19 @@ fn predict_attitude<T: Real, const N: usize>(
     imu: &ImuSample<T>,
     cfg: &FilterConfig<T>,
 ) -> Result<(), EskfError> {
-    if !all_finite(imu.gyro.as_slice()) {
-        return Err(EskfError::NonFinite);
-    }
     let dt = imu.dt;
     check_dt(dt, cfg.max_dt)?;
-    let (dr, jr) = So3::exp_jac(&((imu.gyro - gyro_bias) * dt));
+    // A non-finite gyro fails the turn's comparison too: it is told apart there, off the
+    // usual path.
+    let turn = (imu.gyro - gyro_bias) * dt;
+    if !within_one_turn(&turn) {
+        return Err(if all_finite(imu.gyro.as_slice()) {
+            EskfError::NumericalFailure
+        } else {
+            EskfError::NonFinite
+        });
+    }
+    let (dr, jr) = So3::exp_jac(&turn);
     // F00 = ΔRᵀ, so F00ᵀ = ΔR.
     let f00t = dr.rotation_matrix();
     let f00 = f00t.transpose();

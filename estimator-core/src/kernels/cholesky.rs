@@ -23,18 +23,18 @@ pub(crate) fn factor_in_place<T: Real>(a: &mut [T], n: usize, relative_pivot: T)
     factor_inline(a, n, relative_pivot)
 }
 
-/// `X ← S⁻¹` for a symmetric positive-definite 3 × 3 `s` (column-major): [`factor_in_place`]
-/// then [`inverse_into`] with the dimension a constant, so that the loops unroll and their
-/// index checks fold away (the filters' innovation covariance: about 1,100 Cortex-M4F
-/// instructions fewer than the run-time loops). `false` as either of them.
+/// `L ← S = L Lᵀ` for a symmetric positive-definite 3 × 3 `s` (column-major; `L` in the lower
+/// triangle of `l`, the strict upper triangle of `l` keeps `S`'s): [`factor_in_place`] with the
+/// dimension a constant, so that the loops unroll and their index checks fold away (the
+/// filters' innovation covariance). `false` as [`factor_in_place`] with `relative_pivot = 0`.
 #[inline(never)]
 #[must_use]
-pub(crate) fn spd_inverse_3<T: Real>(s: &[T; 9], x: &mut [T; 9]) -> bool {
-    let mut l = *s;
-    factor_inline(&mut l, 3, T::zero()) && inverse_inline(&l, 3, x)
+pub(crate) fn spd_factor_3<T: Real>(s: &[T; 9], l: &mut [T; 9]) -> bool {
+    *l = *s;
+    factor_inline(l, 3, T::zero())
 }
 
-/// The body of [`factor_in_place`], for it and [`spd_inverse_3`].
+/// The body of [`factor_in_place`], for it and [`spd_factor_3`].
 #[inline(always)]
 #[must_use]
 fn factor_inline<T: Real>(a: &mut [T], n: usize, relative_pivot: T) -> bool {
@@ -118,7 +118,7 @@ pub(crate) fn inverse_into<T: Real>(l: &[T], n: usize, x: &mut [T]) -> bool {
     inverse_inline(l, n, x)
 }
 
-/// The body of [`inverse_into`], for it and [`spd_inverse_3`].
+/// The body of [`inverse_into`].
 #[inline(always)]
 #[must_use]
 fn inverse_inline<T: Real>(l: &[T], n: usize, x: &mut [T]) -> bool {
@@ -223,29 +223,29 @@ mod tests {
         }
     }
 
-    /// The unrolled 3 × 3 inverse against nalgebra's, to the same `κ(A)·n·ε` relative error,
-    /// and its refusals (an indefinite or non-finite `S`).
+    /// The unrolled 3 × 3 factor within the backward error bound of
+    /// `factor_reproduces_a_within_the_backward_error_bound`, and its refusals (an indefinite or
+    /// non-finite `S`).
     #[test]
-    fn spd_inverse_3_agrees_with_nalgebra_and_refuses_what_the_factor_refuses() {
+    fn spd_factor_3_reproduces_s_and_refuses_what_the_factor_refuses() {
         let mut rng = Rng::new(13);
+        let k = 4.0 * f64::EPSILON;
+        let gamma = k / (1.0 - k);
         for _ in 0..200 {
             let a = spd(&mut rng, 3);
-            let svd = a.clone().svd(false, false);
-            let kappa = svd.singular_values.max() / svd.singular_values.min();
-            let tol = kappa * 8.0 * 3.0 * f64::EPSILON;
             let s: [f64; 9] = core::array::from_fn(|i| a[(i % 3, i / 3)]);
-            let mut x = [0.0; 9];
-            assert!(spd_inverse_3(&s, &mut x));
-            let inv = DMatrix::from_column_slice(3, 3, &x);
-            assert_eq!(inv, inv.transpose());
-            let expected = a.clone().cholesky().expect("spd").inverse();
-            assert!((&inv - &expected).norm() <= tol * expected.norm());
+            let mut l = [0.0; 9];
+            assert!(spd_factor_3(&s, &mut l));
+            let l = DMatrix::from_column_slice(3, 3, &l).lower_triangle();
+            let bound = (l.abs() * l.transpose().abs()) * gamma;
+            let err = (&l * l.transpose() - &a).abs();
+            assert!(err.iter().zip(bound.iter()).all(|(e, b)| e <= b));
         }
-        let mut x = [0.0; 9];
+        let mut l = [0.0; 9];
         let indefinite = [1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0];
-        assert!(!spd_inverse_3(&indefinite, &mut x));
+        assert!(!spd_factor_3(&indefinite, &mut l));
         let non_finite = [1.0, 0.0, 0.0, 0.0, f64::NAN, 0.0, 0.0, 0.0, 1.0];
-        assert!(!spd_inverse_3(&non_finite, &mut x));
+        assert!(!spd_factor_3(&non_finite, &mut l));
     }
 
     #[test]

@@ -11,8 +11,8 @@
 //! at opt-level `s`): the sign tests and the 3-vector operations are `#[inline(always)]`; the
 //! routines over a run-time dimension that no prediction runs in its inner loop are
 //! `#[inline(never)]`, one copy for every size (`all_finite`, the Cholesky factor, solve and
-//! inverse, the padded copy of a measurement's rows), and beside them the 3 × 3 inverse of the
-//! update core's innovation covariance (`spd_inverse_3`, the same loops with a constant
+//! inverse, the padded copy of a measurement's rows), and beside them the 3 × 3 factor of the
+//! update core's innovation covariance (`spd_factor_3`, the same loops with a constant
 //! dimension, unrolled); the 3×3 product, the blocks and the slice
 //! loops are left to the compiler, which inlines them where they are hot. The only other inline
 //! attributes of the crate keep the measurement update's phases in stack frames of their own

@@ -355,7 +355,7 @@ impl<Mo: Measurement<f32, AhrsAccelBiasState<f32>, 9, M>, const M: usize> Filter
 }
 
 /// The benchmarked updates and how many of them the filter accepted: every benchmark input is
-/// consistent with the filter's estimate, so each should run the whole update (gain, Joseph
+/// consistent with the filter's estimate, so each should run the whole update (gain, posterior
 /// covariance, injection and reset), not stop at the gate.
 #[derive(Default)]
 struct Updates {

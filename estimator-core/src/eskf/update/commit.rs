@@ -1,27 +1,29 @@
-//! Steps 3–4 of the [update](super): the Joseph-form covariance, the injection `x⁺ = x̂ ⊕ δx`
-//! and the covariance reset.
+//! Steps 3–4 of the [update](super): the posterior covariance `P − W Wᵀ`, the injection
+//! `x⁺ = x̂ ⊕ δx` and the covariance reset.
 
 use super::work::{attitude_part, Work};
 use crate::eskf::covariance::attitude_floor;
 use crate::eskf::error::EskfError;
 use crate::eskf::state::ErrorState;
 use crate::kernels::block::{block, copy};
-use crate::kernels::slice::axpy;
 use crate::kernels::{mat3, usable_variance};
 use crate::lie::{LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
-/// Joseph-form covariance, injection and reset; writes `x` and `P` only when every check
-/// passed. Overwrites `U` with `V`.
+/// The posterior covariance, injection and reset; writes `x` and `P` only when every check
+/// passed.
 ///
-/// The Joseph form `P⁺ = (I − KH)P(I − KH)ᵀ + K R Kᵀ`, expanded with `U = P Hᵀ` and `S = H U + R`,
-/// is `P − K Uᵀ − U Kᵀ + K S Kᵀ = P + V Kᵀ + K Vᵀ = P + Σ_c (v_c k_cᵀ + k_c v_cᵀ)` with
-/// `V = ½ K S − U`: `m` symmetric rank-2 corrections, exactly symmetric, computed in place on
-/// the upper triangle and mirrored, without an `N × N` temporary. Then `P⁺ ← G P⁺ Gᵀ`,
-/// `G = blockdiag(J_r(δθ), I)`: only the attitude rows and columns change. The new attitude
-/// block gets its floor ([`attitude_floor`]). A correction with `|δθ| ≥ π` is refused: there
-/// `exp` is no longer one-to-one and `J_r(δθ)` approaches singularity (at `2π`).
+/// With the optimal gain the Joseph form `P⁺ = (I − KH)P(I − KH)ᵀ + K R Kᵀ` is
+/// `P − U S⁻¹ Uᵀ = P − W Wᵀ = P − Σ_c w_c w_cᵀ` (`U = P Hᵀ`, `W = U L⁻ᵀ`, [`super::gain`]):
+/// `m` symmetric rank-one downdates, exactly symmetric, computed in place on the upper
+/// triangle and mirrored, without an `N × N` temporary. `(W Wᵀ)_jj ≤ P_jj`, so no term is
+/// larger than `P` and the rounding stays a few `ε √(P_ii P_jj)` per entry; the expanded
+/// Joseph form `P + V Kᵀ + K Vᵀ` (`V = ½ K S − U`) has terms that grow with the condition of
+/// `S`, and left `P` indefinite where two rows of `H` were nearly parallel. Then
+/// `P⁺ ← G P⁺ Gᵀ`, `G = blockdiag(J_r(δθ), I)`: only the attitude rows and columns change. The
+/// new attitude block gets its floor ([`attitude_floor`]). A correction with `|δθ| ≥ π` is
+/// refused: there `exp` is no longer one-to-one and `J_r(δθ)` approaches singularity (at `2π`).
 #[inline(never)]
 pub(super) fn commit<T, S, const N: usize, const C: usize>(
     x: &mut S,
@@ -33,34 +35,23 @@ where
     S: ErrorState<T, N>,
 {
     let new_x = x.oplus(&w.dx);
-    let m = w.m;
     let half = T::lit(0.5);
-    // V = ½ K S − U, in place of U (column c of V: −u_c + ½ Σ_j S_jc k_j).
-    let (v, k, s) = (&mut w.g.u.data.0, &w.g.k.data.0, &w.g.s);
-    for (c, vc) in v.iter_mut().enumerate().take(m) {
-        vc.iter_mut().for_each(|e| *e = -*e);
-        for (j, kj) in k.iter().enumerate().take(m) {
-            let sjc = s.get((j, c)).copied().unwrap_or_else(T::zero) * half;
-            axpy(vc, sjc, kj);
-        }
-    }
-    // The checks, before anything is written. K, U, S and P are finite, so P⁺ can only fail by
-    // overflow; for a positive semi-definite P⁺, |P⁺_ij| ≤ √(P⁺_ii P⁺_jj), so a finite positive
-    // diagonal bounds every entry. From row 3 on, P⁺_jj = P_jj + 2 Σ_c v_cj k_cj (the reset
-    // leaves it); the attitude block is G₀ M G₀ᵀ, M = P₀₀ + Σ_c (v_c k_cᵀ + k_c v_cᵀ)₀₀,
-    // G₀ = J_r(δθ), made exactly symmetric.
+    let wcols = &w.g.w.data.0;
+    // The checks, before anything is written. W and P are finite, so P⁺ can only fail by
+    // overflow or by rounding below zero; for a positive semi-definite P⁺,
+    // |P⁺_ij| ≤ √(P⁺_ii P⁺_jj), so a finite positive diagonal bounds every entry. From row 3
+    // on, P⁺_jj = P_jj − Σ_c w_cj² (the reset leaves it); the attitude block is G₀ M G₀ᵀ,
+    // M = P₀₀ − Σ_c (w_c w_cᵀ)₀₀, G₀ = J_r(δθ), made exactly symmetric.
     let mut m00 = block(p, 0, 0);
-    for (vc, kc) in v.iter().zip(k.iter()).take(m) {
-        m00 += mat3::sym_outer(&attitude_part(vc), &attitude_part(kc));
+    for wc in wcols.iter() {
+        let a = attitude_part(wc);
+        m00 -= a * a.transpose();
     }
-    let two = T::lit(2.0);
     let diagonal_ok = p.data.0.iter().enumerate().skip(3).all(|(j, pc)| {
-        let d = v
+        let d = wcols
             .iter()
-            .zip(k.iter())
-            .take(m)
-            .fold(T::zero(), |acc, (vc, kc)| acc + at(vc, j) * at(kc, j));
-        usable_variance(at(pc, j) + d * two)
+            .fold(T::zero(), |acc, wc| acc + at(wc, j) * at(wc, j));
+        usable_variance(at(pc, j) - d)
     });
     let dtheta = attitude_part(w.dx.as_slice());
     let gr: Matrix3<T> = So3::right_jacobian(&dtheta);
@@ -74,10 +65,11 @@ where
     if !(in_chart && new_x.is_finite() && diagonal_ok && usable_variance(c00.m33)) {
         return Err(EskfError::NumericalFailure);
     }
-    // The upper triangle (column j holds rows 0..=j): P_ij += Σ_c (v_ci k_cj + k_ci v_cj); then the attitude rows of the columns from 3 on multiplied by J_r(δθ), the
-    // attitude block replaced by `c00`, and the upper triangle mirrored below.
+    // The upper triangle (column j holds rows 0..=j): P_ij −= Σ_c w_ci w_cj; then the attitude
+    // rows of the columns from 3 on multiplied by J_r(δθ), the attitude block replaced by
+    // `c00`, and the upper triangle mirrored below.
     let cols = &mut p.data.0;
-    rank2_upper(cols, v, k);
+    downdate_upper(cols, wcols);
     for (pc, c) in cols.iter_mut().zip(c00.data.0.iter()) {
         if let Some(head) = pc.get_mut(0..3) {
             copy(head, c);
@@ -105,29 +97,25 @@ where
     Ok(())
 }
 
-/// `P_ij += Σ_c (v_ci k_cj + k_ci v_cj)` on the upper triangle (`i ≤ j`) of the columns `cols`,
-/// over all `C` columns of `v` and `k` (those past the active rows are zero and add nothing).
-/// Each column of `P` is swept once with its `C` pairs `(v_cj, k_cj)` in registers: with `C`
-/// a constant the sum over `c` unrolls, about half the instructions of one sweep per active
-/// row for a three-row model. A model with fewer rows pays for the zero columns (a barometer
-/// update about 3 % more than with one sweep per row) so that one copy serves every row count.
+/// `P_ij −= Σ_c w_ci w_cj` on the upper triangle (`i ≤ j`) of the columns `cols`, over all `C`
+/// columns of `w` (those past the active rows are zero and take nothing). Each column of `P` is
+/// swept once with its `C` entries `w_cj` in registers: with `C` a constant the sum over `c`
+/// unrolls. A model with fewer rows pays for the zero columns so that one copy serves every
+/// row count.
 #[inline(always)]
-fn rank2_upper<T: Real, const N: usize, const C: usize>(
+fn downdate_upper<T: Real, const N: usize, const C: usize>(
     cols: &mut [[T; N]; N],
-    v: &[[T; N]; C],
-    k: &[[T; N]; C],
+    w: &[[T; N]; C],
 ) {
     for (j, pc) in cols.iter_mut().enumerate() {
-        let mut vj = [T::zero(); C];
-        let mut kj = [T::zero(); C];
-        for ((a, b), (vc, kc)) in vj.iter_mut().zip(kj.iter_mut()).zip(v.iter().zip(k)) {
-            *a = at(vc, j);
-            *b = at(kc, j);
+        let mut wj = [T::zero(); C];
+        for (a, wc) in wj.iter_mut().zip(w) {
+            *a = at(wc, j);
         }
         for (i, e) in pc.iter_mut().enumerate().take(j + 1) {
             let mut acc = *e;
-            for ((vc, kc), (a, b)) in v.iter().zip(k).zip(vj.iter().zip(&kj)) {
-                acc += at(vc, i) * *b + at(kc, i) * *a;
+            for (wc, a) in w.iter().zip(wj.iter()) {
+                acc -= at(wc, i) * *a;
             }
             *e = acc;
         }

@@ -1,10 +1,11 @@
-//! The gain `K = P H̃ᵀ S⁻¹`, the NIS and gate at the prior, and the Gauss-Newton step of the
-//! iterated update (steps 1–2 of the [module docs](super)).
+//! The gain `K = P H̃ᵀ S⁻¹`, in square-root form (`S = L Lᵀ`, `W = P H̃ᵀ L⁻ᵀ`, `K = W L⁻¹`),
+//! the NIS and gate at the prior, and the Gauss-Newton step of the iterated update (steps 1–2
+//! of the [module docs](super)).
 
 use super::options::UpdateOptions;
 use super::work::Work;
 use crate::eskf::error::{EskfError, UpdateOutcome};
-use crate::kernels::cholesky::{factor_in_place, inverse_into, spd_inverse_3};
+use crate::kernels::cholesky::{factor_in_place, spd_factor_3};
 use crate::kernels::slice::{axpy, distance, dot, mat_vec};
 use crate::kernels::{all_finite, larger, slice::symmetrize};
 use crate::Real;
@@ -46,19 +47,32 @@ pub(super) fn noise_floor<T: Real, const N: usize>() -> T {
     T::lit(NOISE_FLOOR * T::EPSILON_F64 * N as f64)
 }
 
-/// `U = P H̃ᵀ`, `S = H̃ U + R`, `K = U S⁻¹` into `w`, for the covariance `p` and the `m × m`
-/// noise `noise` (column-major), over the `m` active columns of the working set only. Returns
-/// the NIS `rᵀ S⁻¹ r` of the residual in `w`. The matrices are walked as arrays of columns
-/// (`[[T; N]; C]`), never as run-time chunks of a slice: no length is divided by a chunk size,
-/// so no panic path depends on what the optimizer inlines.
+/// The gain in square-root form into `w.g`: `U = P H̃ᵀ`, `S = H̃ U + R_eff = L Lᵀ` (Cholesky),
+/// and `W = U L⁻ᵀ`, over the `m` active columns of the working set only; the covariance `p`, the
+/// `m × m` noise `noise` (column-major).
+///
+/// With them the gain is `K = U S⁻¹ = W L⁻¹`, so the correction is `δx = K r = W y` with the
+/// whitened residual `y = L⁻¹ r` ([`whitened`]), the NIS is `rᵀ S⁻¹ r = ‖y‖²`, and the
+/// posterior is `P⁺ = P − U S⁻¹ Uᵀ = P − W Wᵀ` ([`super::commit`]). Neither `S⁻¹` nor `K` is
+/// formed: where the rows of `H` are nearly parallel (`S` ill-conditioned, `κ(S)` up to the
+/// noise floor's `M/f`), `K` and `K S Kᵀ` grow with `κ(S)` while `W Wᵀ ≤ P` entry by entry, so
+/// the rounding of `P⁺` stays a few `ε √(P_ii P_jj)`, the size the floors are set against.
+/// The computed `W` is the exact one of an `S` moved by a few `ε √(S_ii S_jj)` (Cholesky and
+/// triangular solves are backward stable), that is of a noise `R_eff` moved by a fraction
+/// `ε/f` of its floor: `P − W Wᵀ` is the posterior of a slightly different, still positive
+/// definite, noise.
+///
+/// The matrices are walked as arrays of columns (`[[T; N]; C]`), never as run-time chunks of a
+/// slice: no length is divided by a chunk size, so no panic path depends on what the optimizer
+/// inlines.
 #[inline(never)]
 fn gain_into<T: Real, const N: usize, const C: usize>(
     p: &SMatrix<T, N, N>,
     noise: &[T],
     w: &mut Work<T, N, C>,
-) -> Result<T, EskfError> {
+) -> Result<(), EskfError> {
     let (m, ht) = (w.m, &w.ht.data.0);
-    let (u, s, k) = (&mut w.g.u.data.0, &mut w.g.s, &mut w.g.k.data.0);
+    let u = &mut w.g.w.data.0;
     // Column c of U = Σ_j P e_j H_cj over the nonzero entries of row c of H only (most models
     // touch 3–6 of the 15 error components).
     // With it, w_c = Σ_j H_cj² P_jj for the noise floor.
@@ -76,7 +90,7 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
     }
     // S_ij = R_ij + (row i of H)·(column j of U) for i, j < m; the identity padding stays.
     // On the diagonal R_cc is raised to the noise floor ([`NOISE_FLOOR`]).
-    *s = padded_noise(noise, m);
+    let mut s = padded_noise::<T, C>(noise, m);
     let floor = noise_floor::<T, N>();
     for (j, (uc, w)) in u.iter().zip(wc).enumerate().take(m) {
         for (i, hc) in ht.iter().enumerate().take(m) {
@@ -95,46 +109,64 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
         }
     }
     symmetrize(s.as_mut_slice(), C);
-    // S⁻¹ from the Cholesky factor (C × C; the 3 × 3 of every model up to three rows through
-    // the unrolled kernel); the columns of K past m stay zero.
-    let mut s_inv = SMatrix::<T, C, C>::zeros();
-    let inverted = match (
+    // S = L Lᵀ (C × C; the 3 × 3 of every model up to three rows through the unrolled kernel).
+    let l = &mut w.g.l;
+    let factored = match (
         s.as_slice().first_chunk::<9>(),
-        s_inv.as_mut_slice().first_chunk_mut::<9>(),
+        l.as_mut_slice().first_chunk_mut::<9>(),
     ) {
-        (Some(s3), Some(x3)) if C == 3 => spd_inverse_3(s3, x3),
+        (Some(s3), Some(l3)) if C == 3 => spd_factor_3(s3, l3),
         _ => {
-            let mut l = *s;
+            *l = s;
             factor_in_place(l.as_mut_slice(), C, T::zero())
-                && inverse_into(l.as_slice(), C, s_inv.as_mut_slice())
         }
     };
-    if !inverted {
+    if !factored {
         return Err(EskfError::SingularInnovation);
     }
-    for kc in k.iter_mut() {
-        kc.fill(T::zero());
-    }
-    for (kc, sc) in k.iter_mut().zip(s_inv.data.0.iter()).take(m) {
-        for (uc, s) in u.iter().zip(sc).take(m) {
-            axpy(kc, *s, uc);
+    // W Lᵀ = U, column by column: w_c = (u_c − Σ_{k<c} L_ck w_k) / L_cc, in place of U.
+    for c in 0..m {
+        let Some((done, rest)) = u.split_at_mut_checked(c) else {
+            break;
+        };
+        let Some(wc) = rest.first_mut() else {
+            break;
+        };
+        for (k, wk) in done.iter().enumerate() {
+            axpy(wc, -l.get((c, k)).copied().unwrap_or_else(T::zero), wk);
         }
+        let inverse = T::one() / l.get((c, c)).copied().unwrap_or_else(T::one);
+        wc.iter_mut().for_each(|e| *e *= inverse);
     }
-    if !all_finite(w.g.k.as_slice()) {
+    if !all_finite(w.g.w.as_slice()) {
         return Err(EskfError::SingularInnovation);
     }
-    // NIS = rᵀ S⁻¹ r.
-    let mut y = SVector::<T, C>::zeros();
-    mat_vec(s_inv.as_slice(), w.r.as_slice(), y.as_mut_slice());
-    let nis = dot(w.r.as_slice(), y.as_slice());
-    if !nis.is_finite() {
-        return Err(EskfError::SingularInnovation);
-    }
-    Ok(nis)
+    Ok(())
 }
 
-/// The gain at the prior, the NIS and the gate, then `δx₁ = K₀ r₀` into `w.dx`. Returns
-/// `Rejected`, or `Accepted` with the NIS (its iteration count is set by the caller).
+/// `y = L⁻¹ v` (forward substitution over the `m` active rows; the rest of `v` is zero and stays
+/// so): the whitened residual of [`gain_into`].
+fn whitened<T: Real, const C: usize>(
+    l: &SMatrix<T, C, C>,
+    m: usize,
+    v: &SVector<T, C>,
+) -> SVector<T, C> {
+    let mut y = *v;
+    for c in 0..m {
+        let mut acc = y.get(c).copied().unwrap_or_else(T::zero);
+        for k in 0..c {
+            acc -= l.get((c, k)).copied().unwrap_or_else(T::zero)
+                * y.get(k).copied().unwrap_or_else(T::zero);
+        }
+        if let Some(e) = y.get_mut(c) {
+            *e = acc / l.get((c, c)).copied().unwrap_or_else(T::one);
+        }
+    }
+    y
+}
+
+/// The gain at the prior, the NIS `‖L⁻¹ r‖²` and the gate, then `δx₁ = W L⁻¹ r₀` into `w.dx`.
+/// Returns `Rejected`, or `Accepted` with the NIS (its iteration count is set by the caller).
 pub(super) fn gate_step<T: Real, const N: usize, const C: usize>(
     p: &SMatrix<T, N, N>,
     noise: &[T],
@@ -142,18 +174,24 @@ pub(super) fn gate_step<T: Real, const N: usize, const C: usize>(
     opts: &UpdateOptions<T>,
     w: &mut Work<T, N, C>,
 ) -> Result<UpdateOutcome<T>, EskfError> {
-    let nis = gain_into(p, noise, w)?;
+    gain_into(p, noise, w)?;
+    let y = whitened(&w.g.l, m, &w.r);
+    let nis = dot(y.as_slice(), y.as_slice());
+    if !nis.is_finite() {
+        return Err(EskfError::SingularInnovation);
+    }
     let threshold = opts.gate.threshold(m);
     if nis > threshold {
         return Ok(UpdateOutcome::Rejected { nis, threshold });
     }
-    mat_vec(w.g.k.as_slice(), w.r.as_slice(), w.dx.as_mut_slice());
+    mat_vec(w.g.w.as_slice(), y.as_slice(), w.dx.as_mut_slice());
     Ok(UpdateOutcome::Accepted { nis, iterations: 1 })
 }
 
 /// One Gauss-Newton step after a re-linearization: the gain there, then
-/// `δx_{k+1} = K_k (r_k + H̃_k δx_k)` into `w.dx`. `None` (with `U`, `S`, `K` and `δx` as they
-/// were) when the gain or the step failed, else whether `‖δx_{k+1} − δx_k‖ < tol`.
+/// `δx_{k+1} = K_k (r_k + H̃_k δx_k) = W_k L_k⁻¹ (r_k + H̃_k δx_k)` into `w.dx`. `None` (with the
+/// gain and `δx` as they were) when the gain or the step failed, else whether
+/// `‖δx_{k+1} − δx_k‖ < tol`.
 #[inline(never)]
 pub(super) fn step<T: Real, const N: usize, const C: usize>(
     p: &SMatrix<T, N, N>,
@@ -163,15 +201,14 @@ pub(super) fn step<T: Real, const N: usize, const C: usize>(
 ) -> Option<bool> {
     let saved = w.g;
     let ok = gain_into(p, noise, w).is_ok();
-    // y = r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), δx_{k+1} = K y.
-    let mut y = w.r;
-    for (yc, hc) in y.iter_mut().zip(w.ht.data.0.iter()).take(w.m) {
-        *yc += dot(hc, w.dx.as_slice());
+    // r + H̃ δx_k (row c of H̃ is column c of H̃ᵀ), whitened.
+    let mut v = w.r;
+    for (vc, hc) in v.iter_mut().zip(w.ht.data.0.iter()).take(w.m) {
+        *vc += dot(hc, w.dx.as_slice());
     }
     let mut next = SVector::<T, N>::zeros();
-    for (kc, yc) in w.g.k.data.0.iter().zip(y.iter()).take(w.m) {
-        axpy(next.as_mut_slice(), *yc, kc);
-    }
+    let y = whitened(&w.g.l, w.m, &v);
+    mat_vec(w.g.w.as_slice(), y.as_slice(), next.as_mut_slice());
     if !(ok && all_finite(next.as_slice())) {
         w.g = saved;
         return None;

@@ -7,21 +7,24 @@
 //!    (eq. 4.3); `S = H₀ P H₀ᵀ + R_eff`, `R` with the noise floor of `gain.rs`;
 //!    `NIS = r₀ᵀ S⁻¹ r₀`, the squared Mahalanobis distance `‖e‖²_Σ = eᵀ Σ⁻¹ e` of eq. 4.1;
 //!    gate `NIS ≤ χ²_M(p)` ([`Gate`]) or return `Rejected`.
-//! 2. `δx₁ = K₀ r₀`, `K = P Hᵀ S⁻¹`: the minimizer of eq. 4.4,
+//! 2. `δx₁ = K₀ r₀`, `K = P Hᵀ S⁻¹ = W L⁻¹` (square-root form: `S = L Lᵀ`, `W = P Hᵀ L⁻ᵀ`,
+//!    [`gain`]): the minimizer of eq. 4.4,
 //!    `ξ* = argmin ‖h(a) + H_a ξ − z‖²_Σ`, with the prior `‖δx‖²_P` added. Iterated: at
 //!    `x_k = x̂ ⊕ δx_k` linearize again, `H̃_k = H_k·blockdiag(J_r(δθ_k), I)`,
 //!    `δx_{k+1} = K_k (r_k + H̃_k δx_k)` (Gauss-Newton in the chart at `x̂`), until
 //!    `‖δx_{k+1} − δx_k‖ < tol` or the iteration cap.
-//! 3. Joseph form, expanded so that it costs `O(N²M)` ([`commit`]):
-//!    `P⁺ = (I − KH)P(I − KH)ᵀ + K R Kᵀ = P − K Uᵀ − U Kᵀ + K S Kᵀ = P + V Kᵀ + K Vᵀ`,
-//!    `U = P Hᵀ`, `V = ½ K S − U`.
+//! 3. The posterior in square-root form ([`commit`]): with the optimal gain the Joseph form
+//!    `P⁺ = (I − KH)P(I − KH)ᵀ + K R Kᵀ = P − K Uᵀ − U Kᵀ + K S Kᵀ` (`U = P Hᵀ`) is
+//!    `P − U S⁻¹ Uᵀ = P − W Wᵀ`: `M` symmetric rank-one downdates whose terms are bounded by
+//!    `P` (`W Wᵀ ≤ P`), so that their rounding stays a few `ε √(P_ii P_jj)` however
+//!    ill-conditioned `S` is (the expanded Joseph terms `K S Kᵀ` grow with `κ(S)`).
 //! 4. Inject `x⁺ = x̂ ⊕ δx`, `a ⊕ ξ = a·exp(ξ^)` (eq. 4.5), and reset `P ← G P Gᵀ`,
 //!    `G = blockdiag(J_r(δθ), I)` (the new error `e⁺ = log(exp(δθ)⁻¹ exp(e)) ≈ J_r(δθ)(e − δθ)`).
 //!
 //! Every model with up to [`CORE_ROWS`] rows runs through one compiled core per scalar type and
 //! filter, not one per model: the core sees a model through [`Rows`], its residual and Jacobian
 //! padded with zero rows and its noise with the identity, which leaves every result unchanged
-//! (`S_pad = [[S, 0], [0, I]]`, `K_pad = [K, 0]`, `NIS = rᵀ S⁻¹ r`), and the products whose cost
+//! (`S_pad = [[S, 0], [0, I]]`, `L_pad = [[L, 0], [0, I]]`, `W_pad = [W, 0]`, `NIS = rᵀ S⁻¹ r`), and the products whose cost
 //! grows with the rows run over the `M` active rows only. The core's phases are separate
 //! functions sharing one working set ([`Work`]), each `#[inline(never)]` so that their stack
 //! frames do not add up (inlined into one another they exceed the 2 KiB stack a Cortex-M
@@ -130,9 +133,8 @@ where
         ht: SMatrix::zeros(),
         r: SVector::zeros(),
         g: Gain {
-            u: SMatrix::zeros(),
-            s: SMatrix::zeros(),
-            k: SMatrix::zeros(),
+            w: SMatrix::zeros(),
+            l: SMatrix::identity(),
         },
         dx: SVector::zeros(),
         m,
@@ -150,8 +152,8 @@ where
     Ok(UpdateOutcome::Accepted { nis, iterations })
 }
 
-/// `R` (padded to `C × C`, [`padded_noise`]) is symmetric positive definite and not singular to
-/// the scalar's resolution: every Cholesky pivot above the noise floor's fraction `256 N ε` of
+/// `R` (padded to `C × C`, [`padded_noise`]) is symmetric and its symmetric part, the matrix
+/// the gain uses, is positive definite and not singular to the scalar's resolution: every Cholesky pivot above the noise floor's fraction `256 N ε` of
 /// its diagonal (a noise `R` with two rows correlated beyond `√(1 − 256 N ε)` measures their
 /// difference more precisely than the floor on the diagonal allows); out of line, so that the
 /// padded copy is not in the update's frame.

@@ -10,7 +10,7 @@ pub(super) struct Work<T: Real, const N: usize, const C: usize> {
     pub(super) ht: SMatrix<T, N, C>,
     /// Residual `r = z ⊖ h(x̂ ⊕ δx)` at the current iterate.
     pub(super) r: SVector<T, C>,
-    /// `U`, `S` and `K` at the current iterate.
+    /// `W` and `L` at the current iterate ([`Gain`]).
     pub(super) g: Gain<T, N, C>,
     /// The current correction `δx`.
     pub(super) dx: SVector<T, N>,
@@ -21,12 +21,10 @@ pub(super) struct Work<T: Real, const N: usize, const C: usize> {
 /// The gain part of the working set, saved and restored as one block by the iterated update.
 #[derive(Clone, Copy)]
 pub(super) struct Gain<T: Real, const N: usize, const C: usize> {
-    /// `U = P H̃ᵀ`.
-    pub(super) u: SMatrix<T, N, C>,
-    /// `S = H̃ P H̃ᵀ + R` (identity past `m`).
-    pub(super) s: SMatrix<T, C, C>,
-    /// `K = U S⁻¹`.
-    pub(super) k: SMatrix<T, N, C>,
+    /// `W = P H̃ᵀ L⁻ᵀ` (`U = P H̃ᵀ` while it is computed): `K = W L⁻¹`, `P⁺ = P − W Wᵀ`.
+    pub(super) w: SMatrix<T, N, C>,
+    /// `L`, the Cholesky factor of `S = H̃ P H̃ᵀ + R_eff` (lower triangle; identity past `m`).
+    pub(super) l: SMatrix<T, C, C>,
 }
 
 /// The attitude part `δθ` (entries 0..3) of an error vector or of a column of `Hᵀ`.

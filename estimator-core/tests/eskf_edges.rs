@@ -533,9 +533,53 @@ fn noise_that_overflows_the_process_noise_is_refused() {
     let mut c64 = FilterConfig::<f64>::default();
     c64.imu_noise.accelerometer_random_walk = 1e160;
     assert_eq!(c64.validate(), Err(EskfError::NoiseNotPositiveDefinite));
-    // The defaults, and a large but representable density, pass.
+    // Finite but above the variance ceiling (1.3e154) over max_dt: refused, as repeated
+    // predictions would carry the bias variance past it to overflow.
     c64.imu_noise.accelerometer_random_walk = 1e100;
+    assert_eq!(c64.validate(), Err(EskfError::NoiseNotPositiveDefinite));
+    // The defaults, and a large density within the ceiling, pass.
+    c64.imu_noise.accelerometer_random_walk = 1e70;
     assert_eq!(c64.validate(), Ok(()));
+}
+
+/// `AhrsAccelBias<f32>` with an accelerometer random walk whose `σ² dt` is within the ceiling:
+/// predictions without a measurement carry the bias variance up to the ceiling (1.8e19), and
+/// the one that would pass it is refused with the filter unchanged (a fuzz finding: it grew
+/// to 2.5e38, then to ∞).
+#[test]
+fn a_bias_walk_that_would_pass_the_variance_ceiling_is_refused() {
+    let mut config = FilterConfig::<f32> {
+        max_dt: 1.0,
+        ..FilterConfig::default()
+    };
+    config.imu_noise.accelerometer_random_walk = 1e9;
+    let mut f = AhrsAccelBias::new(
+        AhrsAccelBiasState::identity(),
+        SMatrix::<f32, 9, 9>::identity() * 1e-2,
+        config,
+    )
+    .expect("valid start");
+    let sample = ImuSample {
+        gyro: Vector3::zeros(),
+        accel: Vector3::zeros(),
+        dt: 1.0,
+    };
+    let mut refused = None;
+    for k in 0..100 {
+        let before = f;
+        match f.predict(&sample) {
+            Ok(()) => assert!(positive_definite(f.covariance()), "prediction {k}"),
+            Err(e) => {
+                assert_eq!(e, EskfError::NonFinite);
+                assert_eq!(f.covariance(), before.covariance());
+                refused = Some(k);
+                break;
+            }
+        }
+    }
+    // 1e18 per step on each variance: after six predictions the three sum to 1.8e19, and the
+    // seventh would take them to 2.1e19, past the ceiling (1.8e19).
+    assert_eq!(refused, Some(6));
 }
 
 /// `P` is positive definite: its Cholesky factor exists, in the filter's precision (nalgebra's

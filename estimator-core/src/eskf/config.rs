@@ -82,8 +82,9 @@ impl<T: Real> Default for FilterConfig<T> {
 
 impl<T: Real> FilterConfig<T> {
     /// `Ok` when every number is finite, the noise densities are `≥ 0`, `max_dt > 0`, and the
-    /// largest process noise a prediction can add, `σ² max_dt` for each density, is finite (a
-    /// finite density can still overflow it).
+    /// largest process noise a prediction can add, `σ² max_dt` for each density, is at most
+    /// the variance ceiling [`Real::VARIANCE_CEILING_F64`] (a finite density can still
+    /// overflow it).
     pub fn validate(&self) -> Result<(), EskfError> {
         if !(all_finite(self.gravity.as_slice()) && self.max_dt.is_finite()) {
             return Err(EskfError::NonFinite);
@@ -103,7 +104,7 @@ impl<T: Real> FilterConfig<T> {
         ];
         if !densities
             .iter()
-            .all(|d| (*d * *d * self.max_dt).is_finite())
+            .all(|d| *d * *d * self.max_dt <= T::lit(T::VARIANCE_CEILING_F64))
         {
             return Err(EskfError::NoiseNotPositiveDefinite);
         }

@@ -138,7 +138,11 @@ pub(crate) fn predict_ins_finite<T: Real>(
     // a P is refused, not stored; so is one above the variance ceiling (`√MAX`), beyond which
     // the products of an update overflow or lose the state's resolution.
     let diagonal_finite = (0..9).all(|k| l.get((k, k)).is_some_and(|d| usable_variance(*d)));
-    if !(diagonal_finite && new_x.is_finite()) {
+    let n = &cfg.imu_noise;
+    let rw = |s: T| s * s * dt;
+    let (q_bg, q_ba) = (rw(n.gyroscope_random_walk), rw(n.accelerometer_random_walk));
+    let walks_usable = walk_usable(p, 3, q_bg) && walk_usable(p, 4, q_ba);
+    if !(diagonal_finite && walks_usable && new_x.is_finite()) {
         return Err(EskfError::NonFinite);
     }
     // The variances of θ, v, p before the prediction, for the growth floor.
@@ -155,22 +159,32 @@ pub(crate) fn predict_ins_finite<T: Real>(
         }
     }
     // Q from the continuous-time densities (module docs).
-    let n = &cfg.imu_noise;
     let qa = n.accelerometer_noise_density * n.accelerometer_noise_density * dt;
     let qg = n.gyroscope_noise_density * n.gyroscope_noise_density * dt;
     add_scaled_identity(p, 0, 0, qg);
     add_scaled_identity(p, 1, 1, qa);
     add_scaled_identity(p, 1, 2, qa * dt * half);
     add_scaled_identity(p, 2, 2, qa * dt * dt * T::lit(0.25));
-    let rw = |s: T| s * s * dt;
-    add_scaled_identity(p, 3, 3, rw(n.gyroscope_random_walk));
-    add_scaled_identity(p, 4, 4, rw(n.accelerometer_random_walk));
+    add_scaled_identity(p, 3, 3, q_bg);
+    add_scaled_identity(p, 4, 4, q_ba);
     floor_growth(p, &before);
     let floor = attitude_floor(&block(p, 0, 0));
     add_scaled_identity(p, 0, 0, floor);
     cap_attitude(p);
     *x = new_x;
     Ok(())
+}
+
+/// The variances of block `block` of `P` (a bias: its row of `F` is the identity) after
+/// their random walk `q = σ² dt` stay usable: their sum `tr P_bb + 3 q` at most the variance
+/// ceiling ([`usable_variance`]; the variances are positive, so each is then at most it too).
+/// Checked before anything is written, as `F P Fᵀ`'s diagonal is, so that a bias left
+/// without a measurement is refused at the ceiling instead of growing to overflow.
+#[inline(always)]
+fn walk_usable<T: Real, const N: usize>(p: &SMatrix<T, N, N>, block: usize, q: T) -> bool {
+    let at = |k: usize| p.get((k, k)).copied().unwrap_or_else(T::zero);
+    let k = 3 * block;
+    usable_variance(at(k) + at(k + 1) + at(k + 2) + q * T::lit(3.0))
 }
 
 /// `|ω dt| < π` (false for NaN): the step's rotation is one the exponential map gives
@@ -224,11 +238,17 @@ fn predict_attitude<T: Real, const N: usize>(
         n.m11, n.m12, n.m13, n.m12, n.m22, n.m23, n.m13, n.m23, n.m33,
     );
     let next = attitude.compose(&dr).renormalize();
-    // As in the 15-state prediction: a non-finite F or an overflow shows on the diagonal of
-    // N00, which bounds M01 and M02 through the positive semi-definite P⁺; a diagonal that
-    // rounding left at zero or below is refused too.
+    // As in the 15-state prediction: an overflow shows on the diagonal of N00, which bounds
+    // M01 and M02 through the positive semi-definite P⁺; a diagonal that rounding left at zero
+    // or below is refused too.
     let diagonal_finite = (0..3).all(|k| n00.get((k, k)).is_some_and(|d| usable_variance(*d)));
-    if !(diagonal_finite && next.is_finite()) {
+    let n = &cfg.imu_noise;
+    let q_bg = n.gyroscope_random_walk * n.gyroscope_random_walk * dt;
+    let q_ba = n.accelerometer_random_walk * n.accelerometer_random_walk * dt;
+    let walks_usable = walk_usable(p, 1, q_bg) && (N < 9 || walk_usable(p, 2, q_ba));
+    // `next` needs no check: the attitude is finite (an invariant of the filter) and the turn
+    // is finite and below π, so `exp`, the product and the renormalization are finite.
+    if !(diagonal_finite && walks_usable) {
         return Err(EskfError::NonFinite);
     }
     set_block(p, 0, 0, &n00);
@@ -241,25 +261,14 @@ fn predict_attitude<T: Real, const N: usize>(
         set_block(p, 0, 2, &m02);
         set_block(p, 2, 0, &m02.transpose());
     }
-    let n = &cfg.imu_noise;
     add_scaled_identity(
         p,
         0,
         0,
         n.gyroscope_noise_density * n.gyroscope_noise_density * dt,
     );
-    add_scaled_identity(
-        p,
-        1,
-        1,
-        n.gyroscope_random_walk * n.gyroscope_random_walk * dt,
-    );
-    add_scaled_identity(
-        p,
-        2,
-        2,
-        n.accelerometer_random_walk * n.accelerometer_random_walk * dt,
-    );
+    add_scaled_identity(p, 1, 1, q_bg);
+    add_scaled_identity(p, 2, 2, q_ba);
     floor_growth(p, &before);
     let floor = attitude_floor(&block(p, 0, 0));
     add_scaled_identity(p, 0, 0, floor);

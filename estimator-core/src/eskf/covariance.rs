@@ -116,16 +116,16 @@ pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
 /// made independent of every other state.
 const GROWTH_FLOOR: f64 = 64.0;
 
-/// With it, `16 ε` of the growth of the variance's block (v or p), on each of the block's
+/// With it, `64 ε` of the growth of the variance's block (v or p), on each of the block's
 /// variances: the rounding of the rotation that mixes the block's axes, with a margin.
-const GROWTH_MIXING: f64 = 16.0;
+const GROWTH_MIXING: f64 = 64.0;
 
 /// And `2 ε` of each growing variance: the rounding of one prediction, twice over.
 const GROWTH_ROUNDING: f64 = 2.0;
 
 /// Floors the first `K` variances of a predicted `P` (θ; v; p): where `P⁺_kk` grew from its
 /// value before the prediction (`before[k]`), adds `f (P⁺_kk − before[k]) + 2 ε P⁺_kk`, and
-/// to every variance of the blocks v and p `16 ε G`, `G` the block's growth
+/// to every variance of the blocks v and p `64 ε G`, `G` the block's growth
 /// `Σ_k max(P⁺_kk − before[k], 0)` ([`GROWTH_FLOOR`], [`GROWTH_ROUNDING`], [`GROWTH_MIXING`]).
 ///
 /// A prediction integrates: `p⁺ = p + v dt`, `v⁺ = v + a dt`, `θ⁺ = ΔRᵀ θ − J_r dt b_g`. The
@@ -142,15 +142,16 @@ const GROWTH_ROUNDING: f64 = 2.0;
 /// Where `R f` lies along one axis (a specific force of 10²⁰ m/s² nearly vertical), that
 /// axis's variance grows by 10⁻¹⁰ of the others' and its rounding, a few `ε` of theirs, is far
 /// above `f` times its own growth: in `f64` the correlation matrix came out at `−2e-12` with
-/// the first term alone. `16 ε G` covers it. The attitude needs no such term: its growth
+/// the first term alone. `64 ε G` covers it (at `16 ε G` a specific force of 2·10³³ m/s²
+/// along the body diagonal still left it at `−7e-15`). The attitude needs no such term: its growth
 /// `J_r dt P_bg J_rᵀ dt` keeps at least `(2/π)²` of its products' size, as the prediction
 /// refuses a step that turns by π or more, and `ΔRᵀ`'s rounding is the attitude floor's.
 ///
 /// When the growth per step is small beside the variance (an attitude of σ = 60 rad fed by a
 /// gyro bias of σ = 3.7 rad/s, 500 steps), the rounding of each step, a few `ε` of the
 /// variance, outruns the first term; `2 ε P⁺_kk` more on each growing variance covers that. In
-/// `f64` the three are `2.1e-13` of the growth, `3.6e-15` of the block's and `4.4e-16` of the
-/// variance per step; in `f32`, `1.1e-4`, `1.9e-6` and `2.4e-7`: at 200 Hz a variance that
+/// `f64` the three are `2.1e-13` of the growth, `1.4e-14` of the block's and `4.4e-16` of the
+/// variance per step; in `f32`, `1.1e-4`, `7.6e-6` and `2.4e-7`: at 200 Hz a variance that
 /// grows for 600 s without a measurement ends 2.9 % larger.
 pub(crate) fn floor_growth<T: Real, const N: usize, const K: usize>(
     p: &mut SMatrix<T, N, N>,

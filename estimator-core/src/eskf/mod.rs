@@ -146,7 +146,7 @@
 //!   `f (P⁺_kk − P_kk) + 2 ε P⁺_kk` is added (`f = 64 N ε`), so that each state keeps a part
 //!   of its variance independent of the others, ahead of the rounding of each step. The
 //!   rotation `R [f]× dt` mixes the axes of `v` and of `p`, so each of their variances also
-//!   gets `16 ε` of its block's growth: the rounding of an axis that hardly grows (the
+//!   gets `64 ε` of its block's growth: the rounding of an axis that hardly grows (the
 //!   vertical under a vertical specific force) is a few `ε` of the others' growth, not of its
 //!   own.
 //!

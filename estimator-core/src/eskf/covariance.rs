@@ -116,17 +116,17 @@ pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
 /// made independent of every other state.
 const GROWTH_FLOOR: f64 = 64.0;
 
-/// With it, `64 ε` of the growth of the variance's block (v or p), on each of the block's
-/// variances: the rounding of the rotation that mixes the block's axes, with a margin.
+/// The mixing floor's `64 ε`, of the size of the products that feed the velocity and the
+/// position ([`floor_mixing`]): the rounding of the rotation that mixes their axes, with a
+/// margin.
 const GROWTH_MIXING: f64 = 64.0;
 
-/// And `2 ε` of each growing variance: the rounding of one prediction, twice over.
+/// And `2 ε` of each variance: the rounding of one prediction, twice over.
 const GROWTH_ROUNDING: f64 = 2.0;
 
-/// Floors the first `K` variances of a predicted `P` (θ; v; p): where `P⁺_kk` grew from its
-/// value before the prediction (`before[k]`), adds `f (P⁺_kk − before[k]) + 2 ε P⁺_kk`, and
-/// to every variance of the blocks v and p `64 ε G`, `G` the block's growth
-/// `Σ_k max(P⁺_kk − before[k], 0)` ([`GROWTH_FLOOR`], [`GROWTH_ROUNDING`], [`GROWTH_MIXING`]).
+/// Floors the first `K` variances of a predicted `P` (θ; v; p): adds
+/// `f max(P⁺_kk − before[k], 0) + 2 ε P⁺_kk` (`before[k]` its value before the prediction)
+/// ([`GROWTH_FLOOR`], [`GROWTH_ROUNDING`]).
 ///
 /// A prediction integrates: `p⁺ = p + v dt`, `v⁺ = v + a dt`, `θ⁺ = ΔRᵀ θ − J_r dt b_g`. The
 /// variance it adds comes from other states and may be wholly correlated with them (a velocity
@@ -137,53 +137,58 @@ const GROWTH_ROUNDING: f64 = 2.0;
 /// `f` of each growth made independent keeps every state's variance, given all the others, at
 /// least about `f/3` of its variance across predictions whose growth is large.
 ///
-/// The rotation `R [f]× dt` that feeds `v` and `p` mixes their three axes, so the rounding of
-/// each axis is a few `ε` of the products the whole block goes through, not of its own result.
-/// Where `R f` lies along one axis (a specific force of 10²⁰ m/s² nearly vertical), that
-/// axis's variance grows by 10⁻¹⁰ of the others' and its rounding, a few `ε` of theirs, is far
-/// above `f` times its own growth: in `f64` the correlation matrix came out at `−2e-12` with
-/// the first term alone. `64 ε G` covers it (at `16 ε G` a specific force of 2·10³³ m/s²
-/// along the body diagonal still left it at `−7e-15`). The attitude needs no such term: its growth
-/// `J_r dt P_bg J_rᵀ dt` keeps at least `(2/π)²` of its products' size, as the prediction
-/// refuses a step that turns by π or more, and `ΔRᵀ`'s rounding is the attitude floor's.
+/// The rotation `R [f]× dt` that feeds `v` and `p` mixes their axes: [`floor_mixing`] covers
+/// that. The attitude needs no such term: its growth `J_r dt P_bg J_rᵀ dt` keeps at least
+/// `(2/π)²` of its products' size, as the prediction refuses a step that turns by π or more,
+/// and `ΔRᵀ`'s rounding is the attitude floor's.
 ///
 /// When the growth per step is small beside the variance (an attitude of σ = 60 rad fed by a
 /// gyro bias of σ = 3.7 rad/s, 500 steps), the rounding of each step, a few `ε` of the
-/// variance, outruns the first term; `2 ε P⁺_kk` more on each growing variance covers that. In
-/// `f64` the three are `2.1e-13` of the growth, `1.4e-14` of the block's and `4.4e-16` of the
-/// variance per step; in `f32`, `1.1e-4`, `7.6e-6` and `2.4e-7`: at 200 Hz a variance that
-/// grows for 600 s without a measurement ends 2.9 % larger.
+/// variance, outruns the first term; `2 ε P⁺_kk` more covers that, on every variance, growing
+/// or not: a variance can shrink in a prediction through its correlation (`−2 dt P_θb` when
+/// the attitude is correlated with the gyro bias) while the rounding of the step is still
+/// there (in `f32`, an attitude widened to a heading of σ = π then sheared by a gyro bias of
+/// σ = 0.1 rad/s went indefinite within 20 predictions when only growing variances had it). In
+/// `f64` the two are `2.1e-13` of the growth and `4.4e-16` of the variance per step; in
+/// `f32`, `1.1e-4` and `2.4e-7`: at 200 Hz a variance left
+/// 600 s without a measurement ends 2.9 % larger.
 pub(crate) fn floor_growth<T: Real, const N: usize, const K: usize>(
     p: &mut SMatrix<T, N, N>,
     before: &[T; K],
 ) {
     let f = T::lit(GROWTH_FLOOR * T::EPSILON_F64 * N as f64);
-    let mixing = T::lit(GROWTH_MIXING * T::EPSILON_F64);
     let rounding = T::lit(GROWTH_ROUNDING * T::EPSILON_F64);
-    // The growth of the blocks v and p, before the variances' own floors (none when K = 3).
-    let mut block_growth = [T::zero(); 3];
-    for block in 1..K / 3 {
-        for k in 3 * block..3 * block + 3 {
-            if let (Some(d), Some(b), Some(g)) =
-                (p.get((k, k)), before.get(k), block_growth.get_mut(block))
-            {
-                *g += larger(*d - *b, T::zero());
-            }
-        }
-    }
     for (k, own) in before.iter().enumerate() {
         if let Some(d) = p.get_mut((k, k)) {
             let grown = *d - *own;
-            if grown > T::zero() {
-                *d += grown * f + *d * rounding;
-            }
+            *d += larger(grown, T::zero()) * f + *d * rounding;
         }
     }
-    for block in 1..K / 3 {
-        for k in 3 * block..3 * block + 3 {
-            if let (Some(d), Some(g)) = (p.get_mut((k, k)), block_growth.get(block)) {
-                *d += *g * mixing;
-            }
+}
+
+/// The mixing floor of the 15-state prediction: adds `64 ε M` to each velocity variance and
+/// `64 ε (dt/2)² M` to each position variance ([`GROWTH_MIXING`]), with
+/// `M = dt² (‖f‖² tr P_θθ + tr P_ba)` the size of the products `R [f]× dt P_θθ` and
+/// `R dt P_ba` that feed them (`P` before the prediction).
+///
+/// `R [f]×` mixes the three axes, so the rounding of each velocity and position variance is a
+/// few `ε` of those products, not of its own result: where `f` lies along a direction in which
+/// the attitude is well known (`[f]× θ` then nearly zero: a specific force of 10²⁰ m/s² nearly
+/// vertical, or of 2·10³³ m/s² along the body diagonal after the attitude was measured across
+/// it), the result is 10⁻⁷ of the products and its rounding far above the growth floor: the
+/// correlation matrix came out at `−2e-12` and `−1e-13` in `f64`. In `f32` at rest with the
+/// heading unknown the term is `2e-7 m²/s²` per 5 ms step, about the accelerometer noise's.
+pub(crate) fn floor_mixing<T: Real>(p: &mut SMatrix<T, 15, 15>, m: T, dt: T) {
+    let mixing = T::lit(GROWTH_MIXING * T::EPSILON_F64) * m;
+    let half_dt = dt * T::lit(0.5);
+    for k in 3..6 {
+        if let Some(d) = p.get_mut((k, k)) {
+            *d += mixing;
+        }
+    }
+    for k in 6..9 {
+        if let Some(d) = p.get_mut((k, k)) {
+            *d += mixing * half_dt * half_dt;
         }
     }
 }

@@ -142,13 +142,14 @@
 //!   `16 ε tr P_θθ · I`. In `f32` with σ_ψ ≈ 2.4 rad this keeps the tilt's σ at least 3.4 mrad.
 //!
 //! * **Growth floor** (`covariance.rs`): a prediction integrates (`p⁺ = p + v dt`, …), and
-//!   the variance it adds may be wholly correlated with its source; where `P⁺_kk` grew,
-//!   `f (P⁺_kk − P_kk) + 2 ε P⁺_kk` is added (`f = 64 N ε`), so that each state keeps a part
-//!   of its variance independent of the others, ahead of the rounding of each step. The
-//!   rotation `R [f]× dt` mixes the axes of `v` and of `p`, so each of their variances also
-//!   gets `64 ε` of its block's growth: the rounding of an axis that hardly grows (the
-//!   vertical under a vertical specific force) is a few `ε` of the others' growth, not of its
-//!   own.
+//!   the variance it adds may be wholly correlated with its source; the floor adds
+//!   `f max(P⁺_kk − P_kk, 0) + 2 ε P⁺_kk` (`f = 64 N ε`), so that each state keeps a part of
+//!   its variance independent of the others, ahead of the rounding of each step (which is
+//!   there whether the variance grew or not). The rotation `R [f]× dt` mixes the axes of `v`
+//!   and of `p`, so their variances also get `64 ε` of the size of the products that feed
+//!   them, `dt² (‖f‖² tr P_θθ + tr P_ba)` (times `(dt/2)²` for `p`): where `f` lies along a
+//!   well-known attitude direction the result is far smaller than the products, and its
+//!   rounding with it.
 //!
 //! A prediction whose step turns by `|ω dt| ≥ π` is refused (`NumericalFailure`): the sample
 //! cannot say how the body turned, and `J_r(ω dt)` tends to rank one.

@@ -2,7 +2,9 @@
 //! propagation `P⁺ = F P Fᵀ + Q` (equations in the [`crate::eskf`] module docs).
 
 use super::config::{check_dt, FilterConfig, ImuSample};
-use super::covariance::{attitude_floor, cap_attitude, floor_growth, leading_diagonal};
+use super::covariance::{
+    attitude_floor, cap_attitude, floor_growth, floor_mixing, leading_diagonal,
+};
 use super::error::EskfError;
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use crate::kernels::block::{add_scaled_identity, block, block_in, set_block};
@@ -142,11 +144,17 @@ pub(crate) fn predict_ins_finite<T: Real>(
     let rw = |s: T| s * s * dt;
     let (q_bg, q_ba) = (rw(n.gyroscope_random_walk), rw(n.accelerometer_random_walk));
     let walks_usable = walk_usable(p, 3, q_bg) && walk_usable(p, 4, q_ba);
-    if !(diagonal_finite && walks_usable && new_x.is_finite()) {
+    // The variances of θ, v, p before the prediction, for the growth floor, and the size of
+    // the products that feed v and p, for the mixing floor (at most the ceiling once floored).
+    let before: [T; 9] = leading_diagonal(p);
+    let diag = |k: usize| p.get((k, k)).copied().unwrap_or_else(T::zero);
+    let products = dt
+        * dt
+        * (f.dot(&f) * (before[0] + before[1] + before[2]) + diag(12) + diag(13) + diag(14));
+    let products_usable = products <= T::lit(T::VARIANCE_CEILING_F64);
+    if !(diagonal_finite && walks_usable && products_usable && new_x.is_finite()) {
         return Err(EskfError::NonFinite);
     }
-    // The variances of θ, v, p before the prediction, for the growth floor.
-    let before: [T; 9] = leading_diagonal(p);
     // The lower blocks N_ki (k ≥ i, i < 3) and their transposes; P_33, P_34, P_44 are
     // unchanged before Q.
     for i in 0..3 {
@@ -168,6 +176,7 @@ pub(crate) fn predict_ins_finite<T: Real>(
     add_scaled_identity(p, 3, 3, q_bg);
     add_scaled_identity(p, 4, 4, q_ba);
     floor_growth(p, &before);
+    floor_mixing(p, products, dt);
     let floor = attitude_floor(&block(p, 0, 0));
     add_scaled_identity(p, 0, 0, floor);
     cap_attitude(p);

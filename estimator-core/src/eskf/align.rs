@@ -12,9 +12,9 @@
 //! Results carrying vectors are matched, not propagated with `?`: on a Cortex-M4F the `?` of a
 //! `Result<Vector3<f32>, _>` copies the value through an unaligned `memcpy`.
 
-use super::config::FilterConfig;
+use super::config::{up_direction, FilterConfig};
 use super::error::EskfError;
-use crate::kernels::{all_finite, mat3, positive_finite};
+use crate::kernels::{all_finite, mat3};
 use crate::lie::So3;
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
@@ -197,10 +197,8 @@ pub(crate) fn prior_attitude_covariance<T: Real>(
     sigmas: &InitialSigmas<T>,
     config: &FilterConfig<T>,
 ) -> Result<Matrix3<T>, EskfError> {
-    let gn = mat3::norm(&config.gravity);
-    if !positive_finite(gn) {
+    let Some(up) = up_direction(&config.gravity) else {
         return Err(EskfError::ZeroNorm);
-    }
-    let up = -config.gravity / gn;
+    };
     Ok(sigmas.attitude_covariance(&alignment.attitude, &up))
 }

@@ -2,7 +2,7 @@
 //! configuration.
 
 use super::error::EskfError;
-use crate::kernels::{all_finite, non_negative_finite};
+use crate::kernels::{all_finite, mat3, non_negative_finite, positive_finite};
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -122,4 +122,11 @@ pub(crate) fn check_dt<T: Real>(dt: T, max_dt: T) -> Result<(), EskfError> {
     } else {
         Ok(())
     }
+}
+
+/// The world's up direction `u = −g / ‖g‖` for the gravity `g` (the direction a specific force
+/// at rest points), or `None` when `‖g‖` is zero or not finite.
+pub(crate) fn up_direction<T: Real>(gravity: &Vector3<T>) -> Option<Vector3<T>> {
+    let norm = mat3::norm(gravity);
+    positive_finite(norm).then(|| -gravity / norm)
 }

@@ -1,7 +1,7 @@
 //! The error-state filter: one generic implementation behind [`Ins`] and [`Ahrs`].
 
 use super::align::{prior_attitude_covariance, Alignment, InitialSigmas};
-use super::config::{FilterConfig, ImuSample};
+use super::config::{up_direction, FilterConfig, ImuSample};
 use super::covariance::{attitude_floor, cap_attitude, check_start, is_spd, sigmas};
 use super::error::{EskfError, UpdateOutcome};
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
@@ -598,12 +598,8 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 9> {
 /// two tilt variances. Out of line: one copy per scalar type.
 #[inline(never)]
 fn widening_room<T: Real>(a: &Matrix3<T>, attitude: &So3<T>, gravity: &Vector3<T>) -> (T, T) {
-    let gn = mat3::norm(gravity);
-    let up = if positive_finite(gn) {
-        -gravity / gn
-    } else {
-        Vector3::zeros() // the widening refuses it (`ZeroNorm`)
-    };
+    // A zero gravity has no up: the widening refuses it (`ZeroNorm`).
+    let up = up_direction(gravity).unwrap_or_else(Vector3::zeros);
     let ub = attitude.inverse().act(&up);
     let heading = ub.dot(&mat3::mul_vec(a, &ub));
     let tilts = a.m11 + a.m22 + a.m33 - heading;

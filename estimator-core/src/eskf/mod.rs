@@ -122,7 +122,7 @@
 //! After every accepted call `P` is finite, symmetric and positive definite, in `f32` too.
 //! Rounding moves each entry `P_ij` by a few `ε √(P_ii P_jj)`, so this holds while the smallest
 //! eigenvalue of the correlation matrix `C = D^-½ P D^-½` (`D = diag P`) stays well above `Nε`.
-//! Three floors keep it there; in `f64` none acts on any usable filter. The premise holds for
+//! Four floors keep it there; in `f64` none acts on any usable filter. The premise holds for
 //! the update because its posterior is computed as `P − W Wᵀ` (square-root form, `W Wᵀ ≤ P`);
 //! the expanded Joseph form `P + V Kᵀ + K Vᵀ` has terms that grow with the condition of `S`
 //! and broke it where two rows of `H` were nearly parallel.
@@ -150,6 +150,10 @@
 //!   them, `dt² (‖f‖² tr P_θθ + tr P_ba)` (times `(dt/2)²` for `p`): where `f` lies along a
 //!   well-known attitude direction the result is far smaller than the products, and its
 //!   rounding with it.
+//! * **Reset floor** (`update/commit.rs`): the reset `G P⁺ Gᵀ`, `G = blockdiag(J_r(δθ), I)`,
+//!   mixes the attitude rows by up to `1.03 |δθ|`, so a large row rotated into a small one
+//!   brings its rounding along. The attitude variances get `8 N ε |δθ| tr P_θθ`, the others
+//!   `16 ε |δθ|` of themselves; a correction of a milliradian makes them negligible.
 //!
 //! A prediction whose step turns by `|ω dt| ≥ π` is refused (`NumericalFailure`): the sample
 //! cannot say how the body turned, and `J_r(ω dt)` tends to rank one.
@@ -177,6 +181,7 @@ mod state;
 mod update;
 
 pub use align::{align_at_rest, Alignment, InitialSigmas, MagnetometerWindow};
+pub(crate) use config::up_direction;
 pub use config::{FilterConfig, ImuNoise, ImuSample};
 pub use error::{EskfError, UpdateOutcome};
 pub use filter::{Ahrs, AhrsAccelBias, Filter, Ins};

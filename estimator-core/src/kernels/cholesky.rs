@@ -77,21 +77,14 @@ fn factor_inline<T: Real>(a: &mut [T], n: usize, relative_pivot: T) -> bool {
 }
 
 /// `b ← (L Lᵀ)⁻¹ b` for the factor `l` (column-major `n × n`, lower triangle): forward
-/// substitution `L y = b` by columns, then back substitution `Lᵀ x = y` by dot products.
+/// substitution `L y = b` ([`forward_in_place`]), then back substitution `Lᵀ x = y` by dot
+/// products.
 #[inline(never)]
 pub(crate) fn solve_in_place<T: Real>(l: &[T], n: usize, b: &mut [T]) {
     if n == 0 {
         return;
     }
-    for (i, col) in columns(l, n).enumerate().take(n) {
-        let diag = col.get(i).copied().unwrap_or_else(T::one);
-        let Some(b_i) = b.get_mut(i) else { break };
-        let y_i = *b_i / diag;
-        *b_i = y_i;
-        if let (Some(rest), Some(below)) = (b.get_mut(i + 1..), col.get(i + 1..)) {
-            axpy(rest, -y_i, below);
-        }
-    }
+    forward_in_place(l, n, b);
     for i in (0..n).rev() {
         let Some(col) = l.get(i * n..i * n + n) else {
             continue;
@@ -103,6 +96,28 @@ pub(crate) fn solve_in_place<T: Real>(l: &[T], n: usize, b: &mut [T]) {
         let diag = col.get(i).copied().unwrap_or_else(T::one);
         if let Some(b_i) = b.get_mut(i) {
             *b_i = (*b_i - s) / diag;
+        }
+    }
+}
+
+/// `b ← L⁻¹ b` for the lower-triangular `l` (column-major `n × n`): forward substitution by
+/// columns, `y_i = b_i / L_ii`, then `b_k −= L_ki y_i` for `k > i`. Each `y_i` costs `n − i`
+/// multiply-adds and one division; it is backward stable (the computed `y` solves
+/// `(L + δL) y = b` with `|δL| ≤ n ε |L|`). Inlined, so that a caller with `n` a constant gets
+/// it unrolled.
+///
+/// ```text
+/// L = [2 0; 1 1], b = [4, 3]  →  y = [2, 1]
+/// ```
+#[inline(always)]
+pub(crate) fn forward_in_place<T: Real>(l: &[T], n: usize, b: &mut [T]) {
+    for (i, col) in columns(l, n).enumerate().take(n) {
+        let diag = col.get(i).copied().unwrap_or_else(T::one);
+        let Some(b_i) = b.get_mut(i) else { break };
+        let y_i = *b_i / diag;
+        *b_i = y_i;
+        if let (Some(rest), Some(below)) = (b.get_mut(i + 1..), col.get(i + 1..)) {
+            axpy(rest, -y_i, below);
         }
     }
 }

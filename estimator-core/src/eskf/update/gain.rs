@@ -5,7 +5,7 @@
 use super::options::UpdateOptions;
 use super::work::Work;
 use crate::eskf::error::{EskfError, UpdateOutcome};
-use crate::kernels::cholesky::{factor_in_place, spd_factor_3};
+use crate::kernels::cholesky::{factor_in_place, forward_in_place, spd_factor_3};
 use crate::kernels::slice::{axpy, distance, dot, mat_vec};
 use crate::kernels::{all_finite, larger, slice::symmetrize};
 use crate::Real;
@@ -124,7 +124,9 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
     if !factored {
         return Err(EskfError::SingularInnovation);
     }
-    // W Lᵀ = U, column by column: w_c = (u_c − Σ_{k<c} L_ck w_k) / L_cc, in place of U.
+    // W Lᵀ = U, column by column: w_c = (u_c − Σ_{k<c} L_ck w_k) / L_cc, in place of U: the
+    // forward substitution of [`forward_in_place`] with N-vectors for entries, one sweep for all
+    // N rows of U.
     for c in 0..m {
         let Some((done, rest)) = u.split_at_mut_checked(c) else {
             break;
@@ -144,24 +146,11 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
     Ok(())
 }
 
-/// `y = L⁻¹ v` (forward substitution over the `m` active rows; the rest of `v` is zero and stays
-/// so): the whitened residual of [`gain_into`].
-fn whitened<T: Real, const C: usize>(
-    l: &SMatrix<T, C, C>,
-    m: usize,
-    v: &SVector<T, C>,
-) -> SVector<T, C> {
+/// `y = L⁻¹ v` ([`forward_in_place`]): the whitened residual of [`gain_into`]. Past the `m`
+/// active rows `L` is the identity and `v` zero, so `y` is zero there too.
+fn whitened<T: Real, const C: usize>(l: &SMatrix<T, C, C>, v: &SVector<T, C>) -> SVector<T, C> {
     let mut y = *v;
-    for c in 0..m {
-        let mut acc = y.get(c).copied().unwrap_or_else(T::zero);
-        for k in 0..c {
-            acc -= l.get((c, k)).copied().unwrap_or_else(T::zero)
-                * y.get(k).copied().unwrap_or_else(T::zero);
-        }
-        if let Some(e) = y.get_mut(c) {
-            *e = acc / l.get((c, c)).copied().unwrap_or_else(T::one);
-        }
-    }
+    forward_in_place(l.as_slice(), C, y.as_mut_slice());
     y
 }
 
@@ -175,7 +164,7 @@ pub(super) fn gate_step<T: Real, const N: usize, const C: usize>(
     w: &mut Work<T, N, C>,
 ) -> Result<UpdateOutcome<T>, EskfError> {
     gain_into(p, noise, w)?;
-    let y = whitened(&w.g.l, m, &w.r);
+    let y = whitened(&w.g.l, &w.r);
     let nis = dot(y.as_slice(), y.as_slice());
     if !nis.is_finite() {
         return Err(EskfError::SingularInnovation);
@@ -207,7 +196,7 @@ pub(super) fn step<T: Real, const N: usize, const C: usize>(
         *vc += dot(hc, w.dx.as_slice());
     }
     let mut next = SVector::<T, N>::zeros();
-    let y = whitened(&w.g.l, w.m, &v);
+    let y = whitened(&w.g.l, &v);
     mat_vec(w.g.w.as_slice(), y.as_slice(), next.as_mut_slice());
     if !(ok && all_finite(next.as_slice())) {
         w.g = saved;

@@ -39,7 +39,9 @@
 use super::block::BlockStats;
 use super::config::AttitudeConfig;
 use super::report::{Event, Fusion};
-use crate::eskf::{AccelerometerAtRest, AhrsAccelBias, ErrorState, Filter, Gate, UpdateOptions};
+use crate::eskf::{
+    up_direction, AccelerometerAtRest, AhrsAccelBias, ErrorState, Filter, Gate, UpdateOptions,
+};
 use crate::kernels::mat3;
 use crate::lie::LieGroup;
 use crate::nav::error::NavError;
@@ -154,7 +156,7 @@ pub(super) fn fuse<T: Real>(
         if *rejected >= config.max_rejected_blocks {
             // The innovation angle: between the measured (bias removed) and the predicted up
             // direction.
-            let up = -config.filter.gravity / mat3::norm(&config.filter.gravity);
+            let up = up_direction(&config.filter.gravity).unwrap_or_else(Vector3::zeros);
             let predicted = filter.state().attitude.inverse().act(&up);
             let f = stats.accel_body - filter.state().accel_bias;
             let angle = mat3::norm(&(f / mat3::norm(&f) - predicted));

@@ -9,7 +9,8 @@
 #     plugin: a wrong result makes QEMU exit non-zero and fails CI;
 #  4. the link-time no-panic check at opt-level 3 and "s" (on failure, the panic call sites),
 #     then over the matrix of opt-levels 2, 3, "s", "z", plain and Cortex-M4-tuned, f32 and f64,
-#     and that its harness names every public function of estimator-core;
+#     and that its harness names every public function of estimator-core; then each entry of
+#     src/bin/single.rs alone in its own binary over the same matrix;
 #  5. no f64 soft-float routine in the f32 binaries;
 #  6. instruction counts, peak stack, size_of and flash against firmware/budgets.txt (opt-level 3)
 #     and firmware/budgets-s.txt (the stack at opt-level "s").
@@ -175,33 +176,47 @@ for profile in release-2 release release-s release-z; do
 done
 [ "$matrix_failed" = 0 ] || fail "no-panic matrix"
 
-# Each of the calls a firmware main loop makes, alone in its own binary (src/bin/single.rs, one
-# `single-*` feature each: one call site, as a user's firmware holds it), over the same matrix
-# of opt-levels and CPU models (f32; the target dirs of the matrix above, so that only the
-# small binary is built again).
-step "no-panic, one entry point per binary: filters' predict and updates, both navigators' imu"
-single_failed=0
-for profile in release-2 release release-s release-z; do
-  for cpu in plain m4; do
-    cmd=build; [ "$cpu" = m4 ] && cmd=build-m4
-    failed=()
-    for f in single-ins-predict single-ins-gnss-position single-ins-magnetometer \
-      single-ins-heading single-ahrs-predict single-ahrs-gravity single-ahrs-magnetometer \
-      single-ins-navigator-imu single-attitude-navigator-imu; do
-      if ! cargo "$cmd" --profile "$profile" --bin single --features "$f" \
-        --target-dir "target/matrix-$cpu-f32" 2> "$OUT/single-$f-$profile-$cpu.log"; then
-        failed+=("$f")
+# Each of the calls a firmware main loop makes, and each constructor that starts a filter or a
+# navigator, alone in its own binary (src/bin/single.rs, chosen by SINGLE_ENTRY at build time:
+# one call site, as a user's firmware holds it), over the same matrix of opt-levels, CPU models
+# and scalar types (the target dirs of the matrix above, so that only the small binary is built
+# again; f32 and f64 side by side, one per core).
+step "no-panic, one entry point per binary: every entry of src/bin/single.rs over the matrix"
+mapfile -t entries < <(python3 -c '
+import re, sys
+s = open("src/bin/single.rs").read()
+i = s.index("const ENTRIES")
+print("\n".join(re.findall(r"\"([a-z0-9-]+)\"", s[i:s.index("];", i)])))')
+single_matrix() { # precision: links every entry at every profile and CPU model, one line each
+  local prec=$1 profile cpu cmd e failed features=()
+  [ "$prec" = f64 ] && features=(--features f64)
+  for profile in release-2 release release-s release-z; do
+    for cpu in plain m4; do
+      cmd=build; [ "$cpu" = m4 ] && cmd=build-m4
+      failed=()
+      for e in "${entries[@]}"; do
+        if ! SINGLE_ENTRY=$e cargo "$cmd" -q --profile "$profile" --bin single "${features[@]}" \
+          --target-dir "target/matrix-$cpu-$prec" 2> "$OUT/single-$e-$profile-$cpu-$prec.log"; then
+          failed+=("$e")
+        fi
+      done
+      if [ ${#failed[@]} -eq 0 ]; then
+        echo "single entry points ($profile, $cpu, $prec): all ${#entries[@]} link, no panic path reachable"
+      else
+        echo "single entry points ($profile, $cpu, $prec): FAILED: ${failed[*]}"
       fi
     done
-    if [ ${#failed[@]} -eq 0 ]; then
-      echo "single entry points ($profile, $cpu): all 9 link, no panic path reachable"
-    else
-      echo "single entry points ($profile, $cpu): FAILED: ${failed[*]}"
-      single_failed=1
-    fi
   done
-done
-[ "$single_failed" = 0 ] || fail "no-panic, one entry point per binary"
+}
+single_matrix f32 > "$OUT/single-f32.txt" &
+single_pid=$!
+single_matrix f64 > "$OUT/single-f64.txt"
+wait "$single_pid" || true
+cat "$OUT/single-f32.txt" "$OUT/single-f64.txt"
+echo "single entry points: ${#entries[@]} entries x 4 opt-levels x 2 CPU models x 2 scalar types"
+if grep -q FAILED "$OUT/single-f32.txt" "$OUT/single-f64.txt" || [ ${#entries[@]} -lt 30 ]; then
+  fail "no-panic, one entry point per binary"
+fi
 if cargo build --profile release-s --bin nopanic --features selftest-panic --target-dir target/selftest \
   2> "$OUT/nopanic-selftest.log"; then
   fail "no-panic self-test: a binary with a reachable panic linked (the check is vacuous)"

@@ -9,8 +9,8 @@
 #     plugin: a wrong result makes QEMU exit non-zero and fails CI;
 #  4. the link-time no-panic check at opt-level 3 and "s" (on failure, the panic call sites),
 #     then over the matrix of opt-levels 2, 3, "s", "z", plain and Cortex-M4-tuned, f32 and f64,
-#     and that its harness names every public function of estimator-core; then each entry of
-#     src/bin/single.rs alone in its own binary over the same matrix;
+#     and that its harness names every public function of estimator-core; then each entry point
+#     of src/bin/single.rs alone in its own binary over the same matrix;
 #  5. no f64 soft-float routine in the f32 binaries;
 #  6. instruction counts, peak stack, size_of and flash against firmware/budgets.txt (opt-level 3)
 #     and firmware/budgets-s.txt (the stack at opt-level "s").
@@ -176,23 +176,39 @@ for profile in release-2 release release-s release-z; do
 done
 [ "$matrix_failed" = 0 ] || fail "no-panic matrix"
 
-# Each of the calls a firmware main loop makes, and each constructor that starts a filter or a
-# navigator, alone in its own binary (src/bin/single.rs, chosen by SINGLE_ENTRY at build time:
-# one call site, as a user's firmware holds it), over the same matrix of opt-levels, CPU models
-# and scalar types (the target dirs of the matrix above, so that only the small binary is built
-# again; f32 and f64 side by side, one per core).
-step "no-panic, one entry point per binary: every entry of src/bin/single.rs over the matrix"
-mapfile -t entries < <(python3 -c '
+# Each public entry point alone in its own binary (src/bin/single.rs, chosen by SINGLE_ENTRY at
+# build time: one call site, as a user's firmware holds it). Its ENTRIES (every constructor,
+# prediction, measurement model and sensor call of the filters and navigators, the solvers, the
+# camera, the losses, the gates and the scalar kernels) are linked over the same matrix of
+# opt-levels, CPU models and scalar types as above; the Lie-group operations (GROUPS x
+# GROUP_OPS, 116 small generic functions) over the two builds firmware ships (opt "s" plain,
+# opt 3 Cortex-M4) in f32 and f64, and over the whole matrix with FIRMWARE_SINGLE_FULL=1 (about
+# 2,900 links, 20 minutes on two cores). The target dirs are those of the matrix above, so that
+# only the small binary is built again; f32 and f64 side by side, one per core.
+step "no-panic, one entry point per binary: src/bin/single.rs over the matrix"
+single_names() { # the names in the array constant $1 of src/bin/single.rs
+  python3 -c '
 import re, sys
 s = open("src/bin/single.rs").read()
-i = s.index("const ENTRIES")
-print("\n".join(re.findall(r"\"([a-z0-9-]+)\"", s[i:s.index("];", i)])))')
-single_matrix() { # precision: links every entry at every profile and CPU model, one line each
-  local prec=$1 profile cpu cmd e failed features=()
+i = s.index("const " + sys.argv[1])
+print("\n".join(re.findall(r"\"([a-z0-9_-]+)\"", s[i:s.index("];", i)])))' "$1"
+}
+mapfile -t main_entries < <(single_names ENTRIES)
+mapfile -t groups < <(single_names GROUPS)
+mapfile -t group_ops < <(single_names GROUP_OPS)
+group_entries=()
+for g in "${groups[@]}"; do for o in "${group_ops[@]}"; do group_entries+=("$g-$o"); done; done
+single_matrix() { # precision: links the entries at every profile and CPU model, one line each
+  local prec=$1 profile cpu cmd e failed features=() entries
   [ "$prec" = f64 ] && features=(--features f64)
   for profile in release-2 release release-s release-z; do
     for cpu in plain m4; do
       cmd=build; [ "$cpu" = m4 ] && cmd=build-m4
+      entries=("${main_entries[@]}")
+      case "$profile/$cpu" in
+        release-s/plain | release/m4) entries+=("${group_entries[@]}") ;;
+        *) [ "${FIRMWARE_SINGLE_FULL:-0}" = 1 ] && entries+=("${group_entries[@]}") ;;
+      esac
       failed=()
       for e in "${entries[@]}"; do
         if ! SINGLE_ENTRY=$e cargo "$cmd" -q --profile "$profile" --bin single "${features[@]}" \
@@ -213,8 +229,10 @@ single_pid=$!
 single_matrix f64 > "$OUT/single-f64.txt"
 wait "$single_pid" || true
 cat "$OUT/single-f32.txt" "$OUT/single-f64.txt"
-echo "single entry points: ${#entries[@]} entries x 4 opt-levels x 2 CPU models x 2 scalar types"
-if grep -q FAILED "$OUT/single-f32.txt" "$OUT/single-f64.txt" || [ ${#entries[@]} -lt 30 ]; then
+links=$(grep -ho 'all [0-9]* link' "$OUT/single-f32.txt" "$OUT/single-f64.txt" | awk '{ s += $2 } END { print s + 0 }')
+echo "single entry points: ${#main_entries[@]} entries and ${#group_entries[@]} group operations, $links links"
+if grep -q FAILED "$OUT/single-f32.txt" "$OUT/single-f64.txt" || [ ${#main_entries[@]} -lt 60 ] \
+  || [ ${#group_entries[@]} -lt 116 ]; then
   fail "no-panic, one entry point per binary"
 fi
 if cargo build --profile release-s --bin nopanic --features selftest-panic --target-dir target/selftest \

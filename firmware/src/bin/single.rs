@@ -21,16 +21,21 @@ mod footprint;
 use cortex_m_rt::entry;
 use estimator_core::eskf::{
     align_at_rest, AccelerometerAtRest, Ahrs, AhrsAccelBias, AhrsAccelBiasState, AhrsState,
-    Alignment, BaroAltitude, CameraLandmark, FilterConfig, GnssPosition, GnssVelocity,
-    GravityDirection, Heading, ImuSample, InitialSigmas, Ins, InsState, MagneticHeading,
-    Magnetometer, PinholeIntrinsics, UpdateOptions, ZeroRate, ZeroVelocity,
+    Alignment, BaroAltitude, CameraLandmark, FilterConfig, Gate, GateProbability, GnssPosition,
+    GnssVelocity, GravityDirection, Heading, ImuSample, InitialSigmas, Ins, InsState,
+    MagneticHeading, Magnetometer, PinholeIntrinsics, UpdateOptions, ZeroRate, ZeroVelocity,
 };
-use estimator_core::lie::{LieGroup, Se3, So3};
+use estimator_core::gn::{
+    check_point_spread, point_reprojection_error, reprojection_error, solve, solve_pnp,
+    solve_rotation_from_vectors, triangulate, vector_pair_error, Factor, Loss, NormalEquations,
+    PinholeCamera, PnpOptions, PnpProblem, SolverOptions, TriangulationOptions, VectorPair,
+};
+use estimator_core::lie::{LieGroup, Se2, Se3, So2, So3};
 use estimator_core::nav::{
-    AttitudeConfig, AttitudeNavigator, GnssFix, InsConfig, InsNavigator, MagneticConfig,
+    AttitudeConfig, AttitudeNavigator, GnssFix, InsConfig, InsNavigator, MagneticConfig, VectorMean,
 };
 use footprint::keep;
-use nalgebra::{SMatrix, Vector2, Vector3, Vector6};
+use nalgebra::{Matrix3, Quaternion, SMatrix, SVector, Vector2, Vector3, Vector6};
 
 /// The scalar type of the build.
 #[cfg(not(feature = "f64"))]
@@ -51,10 +56,10 @@ fn x3(i: usize) -> Vector3<F> {
     Vector3::new(x(i), x(i + 1), x(i + 2))
 }
 
-/// Every entry this binary can hold: the calls a firmware main loop makes (each filter's
-/// prediction and each of its measurement models, both navigators' sensor calls) and the
-/// constructors that start them.
-const ENTRIES: [&str; 36] = [
+/// Every entry this binary can hold besides the group operations ([`GROUPS`] × [`GROUP_OPS`]):
+/// the calls a firmware main loop makes (each filter's prediction and each of its measurement
+/// models, both navigators' sensor calls), the constructors that start them, and the solvers.
+const ENTRIES: [&str; 63] = [
     "ins-new",
     "ins-from-alignment",
     "ins-predict",
@@ -91,6 +96,69 @@ const ENTRIES: [&str; 36] = [
     "ins-navigator-imu",
     "ins-navigator-gnss",
     "ins-navigator-magnetometer-barometer",
+    "solve-pnp",
+    "solve",
+    "triangulate",
+    "solve-rotation-from-vectors",
+    "factor",
+    "normal-equations-add",
+    "loss-evaluate",
+    "camera-project",
+    "camera-project-jac",
+    "camera-unproject",
+    "reprojection-error",
+    "point-reprojection-error",
+    "vector-pair-error",
+    "check-point-spread",
+    "so2-from-cos-sin",
+    "so3-from-quaternion",
+    "so3-from-rotation-matrix",
+    "so3-renormalize",
+    "gate-threshold",
+    "gate-quantile",
+    "filter-config-validate",
+    "attitude-navigator-estimate",
+    "ins-navigator-estimate",
+    "vector-mean",
+    "sincos-f32",
+    "atan2-f32",
+    "sqrt-f32",
+];
+
+/// The groups whose every [`LieGroup`] method is an entry, `<group>-<method>`.
+const GROUPS: [&str; 4] = ["so2", "se2", "so3", "se3"];
+
+/// The [`LieGroup`] methods, each an entry for each of [`GROUPS`].
+const GROUP_OPS: [&str; 29] = [
+    "identity",
+    "exp",
+    "log",
+    "hat",
+    "vee",
+    "compose",
+    "inverse",
+    "between",
+    "act",
+    "rplus",
+    "rminus",
+    "adjoint",
+    "right_jacobian",
+    "left_jacobian",
+    "right_jacobian_inv",
+    "left_jacobian_inv",
+    "exp_jac",
+    "log_jac",
+    "inverse_jac",
+    "compose_jac",
+    "act_jac",
+    "rplus_jac",
+    "rminus_jac",
+    "between_jac",
+    "matrix",
+    "normalize",
+    "try_from_matrix",
+    "interpolate",
+    "is_finite",
 ];
 
 /// The entry chosen at build time, or `""`.
@@ -115,7 +183,30 @@ const fn same(a: &str, b: &str) -> bool {
     true
 }
 
-/// `ENTRY` is empty or one of [`ENTRIES`].
+/// `entry` is `group-op`.
+const fn same_op(entry: &str, group: &str, op: &str) -> bool {
+    let (e, g, o) = (entry.as_bytes(), group.as_bytes(), op.as_bytes());
+    if e.len() != g.len() + 1 + o.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < e.len() {
+        let c = if i < g.len() {
+            g[i]
+        } else if i == g.len() {
+            b'-'
+        } else {
+            o[i - g.len() - 1]
+        };
+        if e[i] != c {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
+/// `entry` is empty, one of [`ENTRIES`], or a group operation.
 const fn known(entry: &str) -> bool {
     let mut i = 0;
     while i < ENTRIES.len() {
@@ -124,10 +215,71 @@ const fn known(entry: &str) -> bool {
         }
         i += 1;
     }
+    let mut g = 0;
+    while g < GROUPS.len() {
+        let mut o = 0;
+        while o < GROUP_OPS.len() {
+            if same_op(entry, GROUPS[g], GROUP_OPS[o]) {
+                return true;
+            }
+            o += 1;
+        }
+        g += 1;
+    }
     entry.is_empty()
 }
 
-const _: () = assert!(known(ENTRY), "SINGLE_ENTRY names no entry of ENTRIES");
+const _: () = assert!(known(ENTRY), "SINGLE_ENTRY names no entry");
+
+/// Every [`LieGroup`] method of the group `$g` (tangent `N`, points `D`, matrices `M × M`), each
+/// alone when the binary is built for `<$name>-<method>`, on opaque inputs (the second element
+/// and the matrix made from opaque numbers too). Each condition is a constant.
+macro_rules! group_ops {
+    ($g:ty, $name:literal, $n:literal, $d:literal, $m:literal) => {{
+        let tau = SVector::<F, $n>::from_fn(|i, _| x(i));
+        let a = || <$g>::exp(&tau);
+        let b = || <$g>::exp(&(tau * x(6)));
+        let p = SVector::<F, $d>::from_fn(|i, _| x(i + 3));
+        let m = SMatrix::<F, $m, $m>::from_fn(|i, j| x(i + 2 * j));
+        macro_rules! op {
+            ($op:literal, $call:expr) => {{
+                const ON: bool = same_op(ENTRY, $name, $op);
+                if ON {
+                    keep(&$call);
+                }
+            }};
+        }
+        op!("identity", <$g>::identity());
+        op!("exp", <$g>::exp(&tau));
+        op!("log", a().log());
+        op!("hat", <$g>::hat(&tau));
+        op!("vee", <$g>::vee(&m));
+        op!("compose", a().compose(&b()));
+        op!("inverse", a().inverse());
+        op!("between", a().between(&b()));
+        op!("act", a().act(&p));
+        op!("rplus", a().rplus(&tau));
+        op!("rminus", a().rminus(&b()));
+        op!("adjoint", a().adjoint());
+        op!("right_jacobian", <$g>::right_jacobian(&tau));
+        op!("left_jacobian", <$g>::left_jacobian(&tau));
+        op!("right_jacobian_inv", <$g>::right_jacobian_inv(&tau));
+        op!("left_jacobian_inv", <$g>::left_jacobian_inv(&tau));
+        op!("exp_jac", <$g>::exp_jac(&tau));
+        op!("log_jac", a().log_jac());
+        op!("inverse_jac", a().inverse_jac());
+        op!("compose_jac", a().compose_jac(&b()));
+        op!("act_jac", a().act_jac(&p));
+        op!("rplus_jac", a().rplus_jac(&tau));
+        op!("rminus_jac", a().rminus_jac(&b()));
+        op!("between_jac", a().between_jac(&b()));
+        op!("matrix", a().matrix());
+        op!("normalize", a().normalize());
+        op!("try_from_matrix", <$g>::try_from_matrix(&m));
+        op!("interpolate", a().interpolate(&b(), x(6)));
+        op!("is_finite", a().is_finite());
+    }};
+}
 
 /// Runs the block when the binary is built for entry `$name` (a constant condition: the other
 /// blocks are not compiled into the binary).
@@ -150,7 +302,13 @@ fn main() -> ! {
             config,
         )
     };
-    let ahrs_new = || Ahrs::new(AhrsState::identity(), SMatrix::<F, 6, 6>::identity() * x(7), config);
+    let ahrs_new = || {
+        Ahrs::new(
+            AhrsState::identity(),
+            SMatrix::<F, 6, 6>::identity() * x(7),
+            config,
+        )
+    };
     let aab_new = || {
         AhrsAccelBias::new(
             AhrsAccelBiasState::identity(),
@@ -188,7 +346,12 @@ fn main() -> ! {
         };
         only!("ins-new", { keep(&ins_new()) });
         only!("ins-from-alignment", {
-            keep(&Ins::from_alignment(&alignment(), x3(2), &InitialSigmas::default(), config));
+            keep(&Ins::from_alignment(
+                &alignment(),
+                x3(2),
+                &InitialSigmas::default(),
+                config,
+            ));
         });
         macro_rules! ins_call {
             ($name:literal, $f:ident => $call:expr) => {
@@ -239,7 +402,11 @@ fn main() -> ! {
         ahrs_call!("ahrs-magnetic-heading", f => f.update(&MagneticHeading::new(x3(4), x3(1), x(7)), &options));
         ahrs_call!("ahrs-widen-attitude", f => f.widen_attitude(x(0), x(1)));
         only!("aab-from-alignment", {
-            keep(&AhrsAccelBias::from_alignment(&alignment(), &InitialSigmas::default(), config));
+            keep(&AhrsAccelBias::from_alignment(
+                &alignment(),
+                &InitialSigmas::default(),
+                config,
+            ));
         });
         macro_rules! aab_call {
             ($name:literal, $f:ident => $call:expr) => {
@@ -285,6 +452,169 @@ fn main() -> ! {
             if let Ok(n) = &mut ins_nav {
                 keep(&(n.magnetometer(t, &x3(4)), n.barometer(t, x(3))));
             }
+        });
+        group_ops!(So2<F>, "so2", 1, 2, 2);
+        group_ops!(Se2<F>, "se2", 3, 2, 3);
+        group_ops!(So3<F>, "so3", 3, 3, 3);
+        group_ops!(Se3<F>, "se3", 6, 3, 4);
+        let camera = PinholeCamera::new(x(6), x(6), x(4), x(5));
+        let pose = Se3::exp(&Vector6::repeat(x(0)));
+        let points = [x3(0); 12];
+        let pixels = [Vector2::new(x(4), x(5)); 12];
+        only!("solve-pnp", {
+            keep(&solve_pnp(
+                &points,
+                &pixels,
+                &camera,
+                &pose,
+                &PnpOptions::default(),
+            ));
+        });
+        only!("solve", {
+            let problem = PnpProblem {
+                world_points: &points,
+                pixels: &pixels,
+                camera,
+                inv_sigma: x(1),
+                min_depth: x(7),
+            };
+            keep(&solve::<F, Se3<F>, _, 6, 2>(
+                &problem,
+                &pose,
+                &SolverOptions::default(),
+            ));
+        });
+        only!("triangulate", {
+            let poses = [pose; 4];
+            keep(&triangulate(
+                &poses,
+                &pixels[..4],
+                &camera,
+                &TriangulationOptions::default(),
+            ));
+        });
+        only!("solve-rotation-from-vectors", {
+            let pairs = [VectorPair {
+                body: x3(0),
+                world: x3(3),
+                sigma: x(6),
+            }; 3];
+            keep(&solve_rotation_from_vectors(
+                &pairs,
+                None,
+                &SolverOptions::default(),
+            ));
+        });
+        only!("factor", {
+            if let Ok(f) = Factor::new(&SMatrix::<F, 6, 6>::from_fn(|i, j| x(i + j))) {
+                keep(&(f.solve(&SVector::<F, 6>::repeat(x(2))), f.inverse()));
+            }
+        });
+        only!("normal-equations-add", {
+            let mut ne = NormalEquations::<F, 6>::zeros();
+            ne.add::<2>(
+                &Loss::Cauchy(x(1)),
+                &SVector::<F, 2>::repeat(x(3)),
+                &SMatrix::<F, 2, 6>::from_fn(|i, j| x(i + j)),
+            );
+            keep(&ne);
+        });
+        only!("loss-evaluate", {
+            let loss = Loss::Huber(x(2));
+            keep(&(loss.is_valid(), loss.scaled(x(5)).evaluate(x(4))));
+        });
+        only!("camera-project", { keep(&camera.project(&x3(0), x(6))) });
+        only!("camera-project-jac", {
+            keep(&camera.project_jac(&x3(0), x(6)))
+        });
+        only!("camera-unproject", {
+            keep(&camera.unproject(&Vector2::new(x(4), x(5))))
+        });
+        let m3 = Matrix3::from_fn(|i, j| x(i + 3 * j));
+        only!("reprojection-error", {
+            let z = Vector2::new(x(4), x(5));
+            keep(&reprojection_error(
+                &camera,
+                &m3,
+                &x3(0),
+                &x3(3),
+                &z,
+                x(1),
+                x(6),
+            ));
+        });
+        only!("point-reprojection-error", {
+            let z = Vector2::new(x(4), x(5));
+            keep(&point_reprojection_error(
+                &camera,
+                &pose,
+                &x3(0),
+                &z,
+                x(1),
+                x(6),
+            ));
+        });
+        only!("vector-pair-error", {
+            keep(&vector_pair_error(&So3::exp(&x3(3)), &x3(0), &x3(3), x(1)));
+        });
+        only!("check-point-spread", { keep(&check_point_spread(&points)) });
+        only!("so2-from-cos-sin", { keep(&So2::from_cos_sin(x(1), x(2))) });
+        only!("so3-from-quaternion", {
+            keep(&So3::from_quaternion(&Quaternion::new(
+                x(3),
+                x(0),
+                x(1),
+                x(2),
+            )));
+        });
+        only!("so3-from-rotation-matrix", {
+            keep(&So3::from_rotation_matrix(&m3))
+        });
+        only!("so3-renormalize", { keep(&So3::exp(&x3(0)).renormalize()) });
+        only!("gate-threshold", {
+            keep(&Gate::<F>::Probability(GateProbability::P95).threshold(3));
+        });
+        only!("gate-quantile", {
+            keep(&(
+                GateProbability::P999.quantile::<F>(9),
+                GateProbability::P95.z_score(),
+            ));
+        });
+        only!("filter-config-validate", {
+            let c = FilterConfig::<F> {
+                gravity: x3(3),
+                max_dt: x(7),
+                ..config
+            };
+            keep(&c.validate());
+        });
+        only!("attitude-navigator-estimate", {
+            if let Ok(n) = &att_nav {
+                keep(&n.estimate());
+            }
+        });
+        only!("ins-navigator-estimate", {
+            if let Ok(n) = &ins_nav {
+                keep(&n.estimate());
+            }
+        });
+        only!("vector-mean", {
+            let mut mean = VectorMean::<F>::default();
+            mean.add(&x3(0));
+            mean.add(&x3(3));
+            keep(&(mean.count(), mean.mean(), mean.scatter_sq()));
+        });
+        only!("sincos-f32", {
+            keep(&estimator_core::scalar::sincos_f32(footprint::input(0)))
+        });
+        only!("atan2-f32", {
+            keep(&estimator_core::scalar::atan2_f32(
+                footprint::input(1),
+                footprint::input(2),
+            ));
+        });
+        only!("sqrt-f32", {
+            keep(&estimator_core::scalar::sqrt_f32(footprint::input(3)))
         });
         keep(&t);
     }

@@ -101,7 +101,7 @@ const ATTITUDE_FLOOR: f64 = 16.0;
 #[inline(never)] // one copy per scalar type, not one per filter and call site
 pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
     let tr = a.m11 + a.m22 + a.m33;
-    let floor = tr * T::lit(ATTITUDE_FLOOR * T::EPSILON_F64);
+    let floor = attitude_resolution(a);
     // The symmetric block's determinant by cofactors of its first row (upper triangle only).
     let det = a.m11 * (a.m22 * a.m33 - a.m23 * a.m23) - a.m12 * (a.m12 * a.m33 - a.m23 * a.m13)
         + a.m13 * (a.m12 * a.m23 - a.m22 * a.m13);
@@ -110,6 +110,17 @@ pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
     } else {
         T::zero()
     }
+}
+
+/// `f tr A` ([`ATTITUDE_FLOOR`]): the attitude floor itself, whatever the block's smallest
+/// eigenvalue. The widening adds it always: it scales the attitude rows up (a heading of
+/// σ = 10⁻³ rad to σ = 2.5 rad) and leaves their covariance with the other states as it was,
+/// so a tilt well known on its own can be known to `10⁻⁸` of the new rows given the gyro bias
+/// it is correlated with: the block passes the test of [`attitude_floor`] and `P` is not
+/// positive definite in `f32`. `f tr A · I` raises the variance of every attitude combination,
+/// given all the other states, by `f tr A`.
+pub(crate) fn attitude_resolution<T: Real>(a: &Matrix3<T>) -> T {
+    (a.m11 + a.m22 + a.m33) * T::lit(ATTITUDE_FLOOR * T::EPSILON_F64)
 }
 
 /// The growth floor, `f = 64 N ε`: the part of each variance's growth in a prediction that is

@@ -2,7 +2,9 @@
 
 use super::align::{prior_attitude_covariance, Alignment, InitialSigmas};
 use super::config::{up_direction, FilterConfig, ImuSample};
-use super::covariance::{attitude_floor, cap_attitude, check_start, is_spd, sigmas};
+use super::covariance::{
+    attitude_floor, attitude_resolution, cap_attitude, check_start, is_spd, sigmas,
+};
 use super::error::{EskfError, UpdateOutcome};
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use super::update::{update, Measurement, UpdateOptions};
@@ -169,8 +171,10 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
     /// with `A = P_θθ` and `u_b = Rᵀ u`, `σ_ψ` is capped at `√(π² − u_bᵀ A u_b)` (the heading
     /// variance) and `σ_t` at `√(π² − (tr A − u_bᵀ A u_b))` (the sum of the two tilt
     /// variances), so widening never takes the heading or a tilt variance above π² (one already
-    /// there is left as it is). Then the attitude block is kept representable in the scalar (an
-    /// isotropic floor of `16 ε tr A` when its smallest eigenvalue may be below it).
+    /// there is left as it is). Then the attitude block gets the attitude floor `16 ε tr A · I`
+    /// whatever its smallest eigenvalue: the widened rows are large beside their covariance with
+    /// the other states, and a tilt correlated with the gyro bias would otherwise be known, given
+    /// the bias, below the scalar's resolution of those rows.
     ///
     /// # Errors
     /// [`EskfError::NonFinite`] for a negative or non-finite sigma, [`EskfError::ZeroNorm`] for
@@ -203,7 +207,7 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
         };
         let mut p = self.covariance;
         let widened = block(&p, 0, 0) + extra;
-        let widened = widened + Matrix3::from_diagonal_element(attitude_floor(&widened));
+        let widened = widened + Matrix3::from_diagonal_element(attitude_resolution(&widened));
         set_block(&mut p, 0, 0, &widened);
         if !all_finite(p.as_slice()) {
             return Err(EskfError::NumericalFailure);

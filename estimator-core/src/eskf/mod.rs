@@ -139,7 +139,9 @@
 //!   heading unknown every entry of `P_θθ` is of the heading's size and the tilt is a
 //!   difference of such entries. When `4 det P_θθ / (tr P_θθ)² ≤ 16 ε tr P_θθ` (a lower bound
 //!   of its smallest eigenvalue), the prediction, the update and the widening add
-//!   `16 ε tr P_θθ · I`. In `f32` with σ_ψ ≈ 2.4 rad this keeps the tilt's σ at least 3.4 mrad.
+//!   `16 ε tr P_θθ · I`; the widening adds it always (it scales the attitude rows up and keeps
+//!   their covariance with the biases). In `f32` with σ_ψ ≈ 2.4 rad this keeps the tilt's σ at
+//!   least 3.4 mrad.
 //!
 //! * **Growth floor** (`covariance.rs`): a prediction integrates (`p⁺ = p + v dt`, …), and
 //!   the variance it adds may be wholly correlated with its source; the floor adds

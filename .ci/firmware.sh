@@ -25,7 +25,7 @@ OUT=$FW/target/ci
 mkdir -p "$OUT"
 status=0
 
-step() { printf '\n==== firmware: %s\n' "$*"; }
+step() { printf '\n==== firmware: %s (at %d s)\n' "$*" "$SECONDS"; }
 fail() { printf 'FIRMWARE CHECK FAILED: %s\n' "$*"; status=1; }
 allowed() { python3 tools/check_budgets.py budgets.txt --allowed "$1"; }
 
@@ -180,10 +180,11 @@ done
 # build time: one call site, as a user's firmware holds it). Its ENTRIES (every constructor,
 # prediction, measurement model and sensor call of the filters and navigators, the solvers, the
 # camera, the losses, the gates and the scalar kernels) are linked over the same matrix of
-# opt-levels, CPU models and scalar types as above; the Lie-group operations (GROUPS x
-# GROUP_OPS, 116 small generic functions) over the two builds firmware ships (opt "s" plain,
+# opt-levels, CPU models and scalar types as above; the small functions (AUXILIARY: readouts,
+# value constructors, configurations, the models' own linearizations, trait methods; and the
+# Lie-group operations, GROUPS x GROUP_OPS) over the two builds firmware ships (opt "s" plain,
 # opt 3 Cortex-M4) in f32 and f64, and over the whole matrix with FIRMWARE_SINGLE_FULL=1 (about
-# 2,900 links, 20 minutes on two cores). The target dirs are those of the matrix above, so that
+# 3,600 links, 40 minutes on two cores). The target dirs are those of the matrix above, so that
 # only the small binary is built again; f32 and f64 side by side, one per core.
 step "no-panic, one entry point per binary: src/bin/single.rs over the matrix"
 single_names() { # the names in the array constant $1 of src/bin/single.rs
@@ -196,8 +197,10 @@ print("\n".join(re.findall(r"\"([a-z0-9_-]+)\"", s[i:s.index("];", i)])))' "$1"
 mapfile -t main_entries < <(single_names ENTRIES)
 mapfile -t groups < <(single_names GROUPS)
 mapfile -t group_ops < <(single_names GROUP_OPS)
+mapfile -t auxiliary < <(single_names AUXILIARY)
 group_entries=()
 for g in "${groups[@]}"; do for o in "${group_ops[@]}"; do group_entries+=("$g-$o"); done; done
+small_entries=("${auxiliary[@]}" "${group_entries[@]}")
 single_matrix() { # precision: links the entries at every profile and CPU model, one line each
   local prec=$1 profile cpu cmd e failed features=() entries
   [ "$prec" = f64 ] && features=(--features f64)
@@ -206,8 +209,8 @@ single_matrix() { # precision: links the entries at every profile and CPU model,
       cmd=build; [ "$cpu" = m4 ] && cmd=build-m4
       entries=("${main_entries[@]}")
       case "$profile/$cpu" in
-        release-s/plain | release/m4) entries+=("${group_entries[@]}") ;;
-        *) [ "${FIRMWARE_SINGLE_FULL:-0}" = 1 ] && entries+=("${group_entries[@]}") ;;
+        release-s/plain | release/m4) entries+=("${small_entries[@]}") ;;
+        *) [ "${FIRMWARE_SINGLE_FULL:-0}" = 1 ] && entries+=("${small_entries[@]}") ;;
       esac
       failed=()
       for e in "${entries[@]}"; do
@@ -230,9 +233,9 @@ single_matrix f64 > "$OUT/single-f64.txt"
 wait "$single_pid" || true
 cat "$OUT/single-f32.txt" "$OUT/single-f64.txt"
 links=$(grep -ho 'all [0-9]* link' "$OUT/single-f32.txt" "$OUT/single-f64.txt" | awk '{ s += $2 } END { print s + 0 }')
-echo "single entry points: ${#main_entries[@]} entries and ${#group_entries[@]} group operations, $links links"
+echo "single entry points: ${#main_entries[@]} entries, ${#auxiliary[@]} auxiliary and ${#group_entries[@]} group operations, $links links"
 if grep -q FAILED "$OUT/single-f32.txt" "$OUT/single-f64.txt" || [ ${#main_entries[@]} -lt 60 ] \
-  || [ ${#group_entries[@]} -lt 116 ]; then
+  || [ ${#auxiliary[@]} -lt 46 ] || [ ${#group_entries[@]} -lt 116 ]; then
   fail "no-panic, one entry point per binary"
 fi
 if cargo build --profile release-s --bin nopanic --features selftest-panic --target-dir target/selftest \

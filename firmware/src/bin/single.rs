@@ -1,7 +1,7 @@
 //! One public entry point of estimator-core alone in a firmware: the way a user's firmware holds
 //! one call, with one call site for LTO to inline or not. The entry is chosen when the binary is
-//! built, by name, in the environment variable `SINGLE_ENTRY` (one of [`ENTRIES`]; `f64` with
-//! `--features f64`, else `f32`):
+//! built, by name, in the environment variable `SINGLE_ENTRY` (one of [`ENTRIES`], [`AUXILIARY`]
+//! or `<group>-<method>` of [`GROUPS`] × [`GROUP_OPS`]; `f64` with `--features f64`, else `f32`):
 //!
 //! ```sh
 //! SINGLE_ENTRY=ins-gnss-position cargo build --profile release-s --bin single
@@ -9,7 +9,8 @@
 //!
 //! The binary links only if no panic path is reachable from that call and what builds its
 //! arguments (the filter's constructor). `.ci/firmware.sh` links every entry over the matrix of
-//! opt-levels, CPU models and scalar types. An unknown name fails the build; without the
+//! opt-levels, CPU models and scalar types (the small ones over the two builds firmware ships,
+//! all of them with `FIRMWARE_SINGLE_FULL=1`). An unknown name fails the build; without the
 //! variable the binary calls nothing.
 #![no_std]
 #![no_main]
@@ -21,21 +22,26 @@ mod footprint;
 use cortex_m_rt::entry;
 use estimator_core::eskf::{
     align_at_rest, AccelerometerAtRest, Ahrs, AhrsAccelBias, AhrsAccelBiasState, AhrsState,
-    Alignment, BaroAltitude, CameraLandmark, FilterConfig, Gate, GateProbability, GnssPosition,
-    GnssVelocity, GravityDirection, Heading, ImuSample, InitialSigmas, Ins, InsState,
-    MagneticHeading, Magnetometer, PinholeIntrinsics, UpdateOptions, ZeroRate, ZeroVelocity,
+    Alignment, BaroAltitude, CameraLandmark, ErrorState, FilterConfig, Gate, GateProbability,
+    GnssPosition, GnssVelocity, GravityDirection, Heading, ImuNoise, ImuSample, InitialSigmas, Ins,
+    InsState, MagneticHeading, Magnetometer, Measurement, PinholeIntrinsics, UpdateOptions,
+    UpdateOutcome, ZeroRate, ZeroVelocity,
 };
 use estimator_core::gn::{
     check_point_spread, point_reprojection_error, reprojection_error, solve, solve_pnp,
-    solve_rotation_from_vectors, triangulate, vector_pair_error, Factor, Loss, NormalEquations,
-    PinholeCamera, PnpOptions, PnpProblem, SolverOptions, TriangulationOptions, VectorPair,
+    solve_rotation_from_vectors, triangulate, vector_pair_error, Factor, Loss, Manifold,
+    NormalEquations, PinholeCamera, PnpOptions, PnpProblem, Product, ResidualBlock, SolveError,
+    SolverOptions, TriangulationOptions, VectorPair,
 };
 use estimator_core::lie::{LieGroup, Se2, Se3, So2, So3};
 use estimator_core::nav::{
     AttitudeConfig, AttitudeNavigator, GnssFix, InsConfig, InsNavigator, MagneticConfig, VectorMean,
 };
+use estimator_core::Real;
 use footprint::keep;
-use nalgebra::{Matrix3, Quaternion, SMatrix, SVector, Vector2, Vector3, Vector6};
+use nalgebra::{
+    Matrix3, Quaternion, SMatrix, SVector, UnitQuaternion, Vector1, Vector2, Vector3, Vector6,
+};
 
 /// The scalar type of the build.
 #[cfg(not(feature = "f64"))]
@@ -125,6 +131,82 @@ const ENTRIES: [&str; 63] = [
     "sqrt-f32",
 ];
 
+/// Every other public function, each an entry: the readouts, the value constructors and
+/// configurations, the start-up paths besides the main ones, the models' own linearizations, the
+/// trait methods (state `⊕`, manifolds, a user's residual blocks, the scalar trait). Small
+/// functions, linked like the group operations (`.ci/firmware.sh`).
+const AUXILIARY: [&str; 46] = [
+    "ins-accessors",
+    "ahrs-accessors",
+    "aab-accessors",
+    "ins-from-attitude-filter",
+    "ins-restart-from-attitude-filter",
+    "ins-widen-attitude",
+    "ahrs-from-alignment",
+    "aab-new",
+    "aab-restart-from-alignment",
+    "aab-widen-attitude",
+    "initial-sigmas-attitude-covariance",
+    "update-options",
+    "update-outcome",
+    "config-constructors",
+    "attitude-config-validate",
+    "ins-config-validate",
+    "attitude-navigator-new",
+    "ins-navigator-new",
+    "attitude-navigator-accessors",
+    "ins-navigator-accessors",
+    "gnss-position-linearize",
+    "gnss-velocity-linearize",
+    "zero-velocity-linearize",
+    "baro-linearize",
+    "magnetometer-linearize",
+    "gravity-linearize",
+    "heading-linearize",
+    "accel-at-rest-linearize",
+    "zero-rate-linearize",
+    "magnetic-heading-linearize",
+    "camera-landmark-linearize",
+    "state-oplus",
+    "se2-new",
+    "so2-from-angle",
+    "so3-from-wxyz",
+    "so3-from-unit-quaternion",
+    "lie-cast",
+    "lie-accessors",
+    "skew",
+    "camera-is-valid",
+    "manifold-oplus",
+    "solve-residual-blocks",
+    "pnp-options",
+    "pnp-inliers",
+    "solver-options-is-valid",
+    "real-methods",
+];
+
+/// A user's residual block on `SO(3) × R³`: the error `e = [R ⊖ R̂; p − p̂] = [Log(R̂ᵀR); p − p̂]`
+/// of a prior with unit sigmas, and its Jacobian `[J_r⁻¹(e_θ) 0; 0 I]` (right perturbation).
+#[derive(Clone, Copy)]
+struct Prior {
+    rotation: So3<F>,
+    point: Vector3<F>,
+}
+
+impl ResidualBlock<F, Product<So3<F>, Vector3<F>, 3, 3>, 6, 6> for Prior {
+    fn evaluate(
+        &self,
+        state: &Product<So3<F>, Vector3<F>, 3, 3>,
+    ) -> Result<(Vector6<F>, SMatrix<F, 6, 6>), SolveError> {
+        let (e_theta, j_theta, _) = state.a.rminus_jac(&self.rotation);
+        let mut e = Vector6::zeros();
+        e.fixed_rows_mut::<3>(0).copy_from(&e_theta);
+        e.fixed_rows_mut::<3>(3).copy_from(&(state.b - self.point));
+        let mut j = SMatrix::<F, 6, 6>::identity();
+        j.fixed_view_mut::<3, 3>(0, 0).copy_from(&j_theta);
+        Ok((e, j))
+    }
+}
+
 /// The groups whose every [`LieGroup`] method is an entry, `<group>-<method>`.
 const GROUPS: [&str; 4] = ["so2", "se2", "so3", "se3"];
 
@@ -206,11 +288,18 @@ const fn same_op(entry: &str, group: &str, op: &str) -> bool {
     true
 }
 
-/// `entry` is empty, one of [`ENTRIES`], or a group operation.
+/// `entry` is empty, one of [`ENTRIES`] or [`AUXILIARY`], or a group operation.
 const fn known(entry: &str) -> bool {
     let mut i = 0;
     while i < ENTRIES.len() {
         if same(entry, ENTRIES[i]) {
+            return true;
+        }
+        i += 1;
+    }
+    let mut i = 0;
+    while i < AUXILIARY.len() {
+        if same(entry, AUXILIARY[i]) {
             return true;
         }
         i += 1;
@@ -615,6 +704,334 @@ fn main() -> ! {
         });
         only!("sqrt-f32", {
             keep(&estimator_core::scalar::sqrt_f32(footprint::input(3)))
+        });
+        // The auxiliary entries ([`AUXILIARY`]).
+        macro_rules! readouts {
+            ($name:literal, $f:expr) => {
+                only!($name, {
+                    if let Ok(f) = &$f {
+                        keep(&(f.state(), f.covariance(), f.config(), f.sigmas()));
+                    }
+                })
+            };
+        }
+        readouts!("ins-accessors", ins);
+        readouts!("ahrs-accessors", ahrs);
+        readouts!("aab-accessors", aab);
+        only!("ins-from-attitude-filter", {
+            if let Ok(a) = &aab {
+                keep(&Ins::from_attitude_filter(
+                    a,
+                    &So3::exp(&x3(2)),
+                    x3(3),
+                    x3(4),
+                    x(5),
+                    x(6),
+                ));
+            }
+        });
+        only!("ins-restart-from-attitude-filter", {
+            if let (Ok(f), Ok(a)) = (&mut ins, &aab) {
+                keep(&f.restart_from_attitude_filter(
+                    a,
+                    &So3::exp(&x3(2)),
+                    x3(3),
+                    x3(4),
+                    x(5),
+                    x(6),
+                ));
+            }
+        });
+        ins_call!("ins-widen-attitude", f => f.widen_attitude(x(0), x(1)));
+        only!("ahrs-from-alignment", {
+            keep(&Ahrs::from_alignment(
+                &alignment(),
+                &InitialSigmas::default(),
+                config,
+            ));
+        });
+        only!("aab-new", { keep(&aab_new()) });
+        aab_call!("aab-restart-from-alignment", f => f.restart_from_alignment(&alignment(), &InitialSigmas::default()));
+        aab_call!("aab-widen-attitude", f => f.widen_attitude(x(0), x(1)));
+        only!("initial-sigmas-attitude-covariance", {
+            let sigmas = InitialSigmas {
+                tilt: x(1),
+                yaw: x(2),
+                ..InitialSigmas::default()
+            };
+            keep(&sigmas.attitude_covariance(&So3::exp(&x3(0)), &x3(3)));
+        });
+        only!("update-options", {
+            keep(&(
+                UpdateOptions::ekf(Gate::Threshold(x(1))),
+                UpdateOptions::iterated(Gate::Probability(GateProbability::P99), 4, x(2)),
+            ));
+        });
+        only!("update-outcome", {
+            let outcome = if x(1) > x(2) {
+                UpdateOutcome::Accepted {
+                    nis: x(3),
+                    iterations: 1,
+                }
+            } else {
+                UpdateOutcome::Rejected {
+                    nis: x(4),
+                    threshold: x(5),
+                }
+            };
+            keep(&(outcome.nis(), outcome.is_accepted()));
+        });
+        only!("config-constructors", {
+            let filter = FilterConfig::<F> {
+                imu_noise: ImuNoise::mems(),
+                ..FilterConfig::default()
+            };
+            let attitude = AttitudeConfig::new(filter);
+            keep(&(
+                attitude,
+                MagneticConfig::new(x(1), Some(x3(2))),
+                InsConfig::new(attitude),
+                InitialSigmas::<F>::default(),
+                GnssFix::new(x3(2), None, x(5), x(6)),
+            ));
+        });
+        only!("attitude-config-validate", {
+            let mut c = AttitudeConfig::new(config);
+            c.startup_s = x(1);
+            c.magnetometer = Some(MagneticConfig::new(x(2), Some(x3(3))));
+            keep(&c.validate());
+        });
+        only!("ins-config-validate", {
+            let mut c = InsConfig::new(AttitudeConfig::new(config));
+            c.horizon_s = x(1);
+            c.barometer_sigma = Some(x(2));
+            keep(&c.validate());
+        });
+        only!("attitude-navigator-new", {
+            let mut c = AttitudeConfig::new(config);
+            c.startup_s = x(1);
+            keep(&AttitudeNavigator::<F>::new(c));
+        });
+        only!("ins-navigator-new", {
+            let mut c = InsConfig::new(AttitudeConfig::new(config));
+            c.horizon_s = x(1);
+            keep(&InsNavigator::<F>::new(c));
+        });
+        only!("attitude-navigator-accessors", {
+            if let Ok(n) = &att_nav {
+                keep(&(
+                    n.config(),
+                    n.filter(),
+                    n.report(),
+                    n.report().tilt.is_valid(),
+                    n.counters(),
+                    n.magnetic_reference(),
+                ));
+            }
+        });
+        only!("ins-navigator-accessors", {
+            if let Ok(n) = &ins_nav {
+                keep(&(
+                    n.config(),
+                    n.report(),
+                    n.counters(),
+                    n.filter(),
+                    n.aligning(),
+                ));
+            }
+        });
+        let state = InsState {
+            attitude: So3::exp(&x3(0)),
+            velocity: x3(1),
+            position: x3(2),
+            gyro_bias: x3(3),
+            accel_bias: x3(4),
+        };
+        macro_rules! linearize {
+            ($name:literal, $model:expr, $m:literal) => {
+                only!($name, {
+                    let model = $model;
+                    keep(&(
+                        Measurement::<F, InsState<F>, 15, $m>::linearize(&model, &state),
+                        Measurement::<F, InsState<F>, 15, $m>::noise(&model),
+                    ));
+                })
+            };
+        }
+        linearize!(
+            "gnss-position-linearize",
+            GnssPosition::new(x3(2), x3(5), x(6)),
+            3
+        );
+        linearize!("gnss-velocity-linearize", GnssVelocity::new(x3(2), x(6)), 3);
+        linearize!("zero-velocity-linearize", ZeroVelocity::new(x(6)), 3);
+        linearize!("baro-linearize", BaroAltitude::new(x(3), x(6)), 1);
+        linearize!(
+            "magnetometer-linearize",
+            Magnetometer::new(x3(4), x3(1), x(7)),
+            3
+        );
+        linearize!("gravity-linearize", GravityDirection::new(x3(1), x(7)), 3);
+        linearize!("heading-linearize", Heading::new(x(2), x(7)), 1);
+        linearize!(
+            "accel-at-rest-linearize",
+            AccelerometerAtRest::new(x3(1), x(7)),
+            3
+        );
+        linearize!("zero-rate-linearize", ZeroRate::new(x3(0), x(7)), 3);
+        linearize!(
+            "magnetic-heading-linearize",
+            MagneticHeading::new(x3(4), x3(1), x(7)),
+            1
+        );
+        only!("camera-landmark-linearize", {
+            let intrinsics = PinholeIntrinsics {
+                fx: x(6),
+                fy: x(6),
+                cx: x(4),
+                cy: x(5),
+            };
+            let camera = Se3::exp(&Vector6::repeat(x(0)));
+            let model =
+                CameraLandmark::new(Vector2::new(x(3), x(4)), x3(0), intrinsics, camera, x(1));
+            keep(&(
+                model.project(&state),
+                model.linearize(&state),
+                model.noise(),
+            ));
+        });
+        only!("state-oplus", {
+            let ahrs_state = AhrsState {
+                attitude: state.attitude,
+                gyro_bias: state.gyro_bias,
+            };
+            let aab_state = AhrsAccelBiasState {
+                attitude: state.attitude,
+                gyro_bias: state.gyro_bias,
+                accel_bias: state.accel_bias,
+            };
+            let dx = SVector::<F, 15>::from_fn(|i, _| x(i % 8));
+            keep(&(
+                state.oplus(&dx),
+                ahrs_state.oplus(&dx.fixed_rows::<6>(0).into_owned()),
+                aab_state.oplus(&dx.fixed_rows::<9>(0).into_owned()),
+                state.is_finite(),
+                ErrorState::attitude(&aab_state),
+            ));
+        });
+        only!("se2-new", {
+            keep(&(
+                Se2::new(x(0), x(1), x(2)),
+                Se2::from_parts(So2::from_angle(x(3)), Vector2::new(x(4), x(5))),
+            ));
+        });
+        only!("so2-from-angle", { keep(&So2::from_angle(x(2))) });
+        only!("so3-from-wxyz", {
+            keep(&So3::from_wxyz(x(3), x(0), x(1), x(2)))
+        });
+        only!("so3-from-unit-quaternion", {
+            keep(&So3::from_unit_quaternion(UnitQuaternion::new_unchecked(
+                Quaternion::new(x(3), x(0), x(1), x(2)),
+            )));
+        });
+        only!("lie-cast", {
+            keep(&(
+                So2::<F>::from_angle(x(0)).cast::<f32>(),
+                Se2::<F>::new(x(0), x(1), x(2)).cast::<f32>(),
+                So3::<F>::exp(&x3(0)).cast::<f32>(),
+                Se3::<F>::exp(&Vector6::repeat(x(1))).cast::<f32>(),
+            ));
+        });
+        only!("lie-accessors", {
+            let so2 = So2::from_angle(x(0));
+            let se2 = Se2::new(x(0), x(1), x(2));
+            let so3 = So3::exp(&x3(0));
+            let se3 = Se3::from_parts(so3, x3(3));
+            keep(&(
+                (so2.angle(), so2.cos(), so2.sin(), so2.rotation_matrix()),
+                (se2.rotation(), se2.translation()),
+                (so3.quaternion(), so3.rotation_matrix()),
+                (se3.rotation(), se3.translation()),
+            ));
+        });
+        only!("skew", { keep(&estimator_core::lie::skew(&x3(0))) });
+        only!("camera-is-valid", { keep(&camera.is_valid()) });
+        only!("manifold-oplus", {
+            let product = Product::<So3<F>, Vector3<F>, 3, 3>::new(So3::exp(&x3(0)), x3(3));
+            let xi = Vector6::from_fn(|i, _| x(i));
+            let moved: Product<So3<F>, Vector3<F>, 3, 3> = product.oplus(&xi);
+            keep(&(
+                Manifold::<F, 6>::all_finite(&moved),
+                Manifold::<F, 1>::oplus(&So2::from_angle(x(1)), &Vector1::new(x(2))),
+                Product::<So3<F>, Vector3<F>, 3, 3>::split(&xi),
+            ));
+        });
+        only!("solve-residual-blocks", {
+            let blocks = [
+                Prior {
+                    rotation: So3::exp(&x3(0)),
+                    point: x3(3),
+                },
+                Prior {
+                    rotation: So3::exp(&x3(1)),
+                    point: x3(4),
+                },
+            ];
+            let start = Product::new(So3::exp(&x3(2)), x3(5));
+            keep(&solve::<F, _, [Prior], 6, 6>(
+                &blocks[..],
+                &start,
+                &SolverOptions::default(),
+            ));
+            keep(&NormalEquations::<F, 6>::build::<_, [Prior], 6>(
+                &blocks[..],
+                &start,
+                &Loss::Huber(x(6)),
+            ));
+        });
+        only!("pnp-options", {
+            keep(
+                &PnpOptions::<F>::default()
+                    .with_loss(Loss::Cauchy(x(1)))
+                    .with_sigma(x(2)),
+            );
+        });
+        only!("pnp-inliers", {
+            if let Ok(solution) =
+                solve_pnp(&points, &pixels, &camera, &pose, &PnpOptions::default())
+            {
+                let inliers = solution.inliers;
+                keep(&(
+                    inliers.contains(footprint::input(0) as usize),
+                    inliers.count(),
+                    inliers.len(),
+                    inliers.is_empty(),
+                    inliers.bits(),
+                    inliers.iter().filter(|&b| b).count(),
+                ));
+            }
+        });
+        only!("solver-options-is-valid", {
+            let options = SolverOptions::<F> {
+                step_tolerance: x(1),
+                ..SolverOptions::default()
+            };
+            keep(&options.is_valid());
+        });
+        only!("real-methods", {
+            keep(&(
+                F::lit(0.5) * x(0),
+                x(1).sincos(),
+                x(2).arctan2(x(3)),
+                F::from_count(footprint::input(4) as u32),
+                x(5).to_count(),
+                estimator_core::scalar::taylor_cutoff(
+                    f64::from(footprint::input(7)),
+                    f64::from(footprint::input(6)),
+                    f64::from(footprint::input(5)),
+                    footprint::input(4) as u32,
+                ),
+            ));
         });
         keep(&t);
     }

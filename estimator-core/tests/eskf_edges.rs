@@ -930,3 +930,46 @@ fn nearly_parallel_measurement_rows_keep_covariance_positive_definite() {
     run::<f32>();
     run::<f64>();
 }
+
+/// A filter can be built again from its own state and covariance (a firmware restoring a saved
+/// estimate): `new` accepts every `P` the filters keep. Here a body pitched 56° with the heading
+/// unknown (σ_ψ = π) and the tilt known to 1°: in the body frame every attitude entry is of the
+/// heading's size and the tilt is in their differences, a block that only the attitude floor
+/// keeps representable in `f32`.
+#[test]
+fn f32_filter_rebuilt_from_its_own_covariance_with_unknown_heading() {
+    let attitude = So3::exp(&Vector3::new(0.0f32, 0.98, 0.3));
+    let alignment = Alignment {
+        attitude,
+        gyro_bias: Vector3::zeros(),
+        heading_from_magnetometer: false,
+    };
+    let sigmas = InitialSigmas {
+        yaw: core::f32::consts::PI,
+        ..InitialSigmas::default()
+    };
+    let config = FilterConfig::<f32>::default();
+    let mut ahrs = Ahrs::from_alignment(&alignment, &sigmas, config).expect("valid");
+    let ins = Ins::from_alignment(&alignment, Vector3::zeros(), &sigmas, config).expect("valid");
+    let rebuilt = Ins::new(*ins.state(), *ins.covariance(), config);
+    assert!(rebuilt.is_ok(), "INS: {:?}", rebuilt.err());
+    let up = attitude.inverse().act(&Vector3::new(0.0, 0.0, 9.81));
+    let sample = ImuSample {
+        gyro: Vector3::zeros(),
+        accel: up,
+        dt: 0.01,
+    };
+    for call in 0..2000 {
+        ahrs.predict(&sample).expect("valid sample");
+        ahrs.update(&GravityDirection::new(up, 0.01), &UpdateOptions::default())
+            .expect("valid update");
+        if call % 100 == 0 {
+            let rebuilt = Ahrs::new(*ahrs.state(), *ahrs.covariance(), config);
+            assert!(
+                rebuilt.is_ok(),
+                "AHRS after {call} updates: {:?}",
+                rebuilt.err()
+            );
+        }
+    }
+}

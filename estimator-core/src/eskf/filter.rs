@@ -116,11 +116,17 @@ impl<T: Real> AhrsAccelBias<T> {
 }
 
 impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
-    /// From a given state and covariance.
+    /// From a given state and covariance. The filter keeps `P` as every prediction leaves it:
+    /// attitude variances above π² scaled down to it, and the attitude floor `16 ε tr P_θθ · I`
+    /// added to the attitude block when its smallest eigenvalue may be below that. So a filter
+    /// can be built again from its own [`state`](Self::state) and
+    /// [`covariance`](Self::covariance).
     ///
     /// # Errors
-    /// A non-finite state, `P` not symmetric positive definite, or an invalid configuration
-    /// ([`FilterConfig::validate`]).
+    /// A non-finite state, `P` not symmetric positive definite or singular to the scalar's
+    /// resolution (a state known, given the others, to less than `256 N ε` of its variance,
+    /// judged with the attitude error in the world frame, where tilt and heading are separate),
+    /// or an invalid configuration ([`FilterConfig::validate`]).
     pub fn new(
         state: S,
         covariance: SMatrix<T, N, N>,
@@ -129,6 +135,10 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
         // Capped first, then checked: the scaling rounds, and the filter keeps what was checked.
         let mut covariance = covariance;
         cap_attitude(&mut covariance);
+        // The attitude floor every prediction adds: a body-frame block with the heading unknown
+        // is representable only with it (`check_start`).
+        let floor = attitude_floor(&block(&covariance, 0, 0));
+        add_scaled_identity(&mut covariance, 0, 0, floor);
         check_start(&state, &covariance, &config)?;
         Ok(Self {
             state,

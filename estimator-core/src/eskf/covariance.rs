@@ -17,7 +17,7 @@ use nalgebra::{Matrix3, SMatrix, SVector};
 /// entries of an `A` symmetric only to `10⁻⁶` of its largest differ, the lower triangle can be
 /// definite and the symmetric part not.
 pub(crate) fn is_spd<T: Real, const M: usize>(a: &SMatrix<T, M, M>) -> bool {
-    is_usable_spd(a, T::zero())
+    is_usable_spd(a, T::zero(), 0)
 }
 
 /// The smallest fraction of a variable's variance, `256 N ε` for a filter of `N` states (the
@@ -29,15 +29,18 @@ pub(crate) fn usable_pivot<T: Real, const N: usize>() -> T {
     T::lit(256.0 * N as f64 * T::EPSILON_F64)
 }
 
-/// [`is_spd`], with every Cholesky pivot `d_j` above `relative_pivot · A_jj` (each variable
-/// keeps that fraction of its variance unexplained by the variables before it).
+/// [`is_spd`], with every Cholesky pivot `d_j`, `j ≥ first_tested`, above
+/// `relative_pivot · A_jj` (each variable keeps that fraction of its variance unexplained by
+/// the variables before it).
 pub(crate) fn is_usable_spd<T: Real, const M: usize>(
     a: &SMatrix<T, M, M>,
     relative_pivot: T,
+    first_tested: usize,
 ) -> bool {
     let mut l = *a;
     symmetrize(l.as_mut_slice(), M);
-    is_symmetric(a.as_slice(), M) && factor_in_place(l.as_mut_slice(), M, relative_pivot)
+    is_symmetric(a.as_slice(), M)
+        && factor_in_place(l.as_mut_slice(), M, relative_pivot, first_tested)
 }
 
 /// The column-major `n × n` storage `a` is finite and symmetric to `10⁻⁶` of its largest entry
@@ -53,8 +56,12 @@ fn is_symmetric<T: Real>(a: &[T], n: usize) -> bool {
 
 /// The checks every filter constructor makes on a given start: a valid configuration, a finite
 /// state and a symmetric positive definite covariance, usable by the filter (no variance above
-/// [`Real::VARIANCE_CEILING_F64`], every Cholesky pivot above [`usable_pivot`] of its diagonal
-/// with the attitude rows in the world frame, [`world_attitude`]).
+/// [`Real::VARIANCE_CEILING_F64`], every Cholesky pivot after the attitude rows above
+/// [`usable_pivot`] of its diagonal). The attitude block must have had its floor added
+/// ([`attitude_floor`]): that floor, not the pivot test, is its resolution. With the heading
+/// unknown and the tilt known, every entry of a body-frame attitude block is of the heading's
+/// size and the tilt is in their differences, a block the pivot test would refuse however well
+/// the tilt is known, and one the filters keep themselves.
 pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
     state: &S,
     covariance: &SMatrix<T, N, N>,
@@ -66,50 +73,13 @@ pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
     }
     let variances_usable =
         (0..N).all(|k| covariance.get((k, k)).is_some_and(|d| usable_variance(*d)));
-    if !(variances_usable
-        && is_spd(covariance)
-        && is_usable_spd(
-            &world_attitude(covariance, &state.attitude().rotation_matrix()),
-            usable_pivot::<T, N>(),
-        ))
-    {
+    // The attitude block's resolution is the attitude floor's (the caller has added it); the
+    // other states are judged given the attitude: their pivots are those of the Schur
+    // complement `P_xx − P_xθ P_θθ⁻¹ P_θx`.
+    if !(variances_usable && is_usable_spd(covariance, usable_pivot::<T, N>(), 3)) {
         return Err(EskfError::CovarianceNotPositiveDefinite);
     }
     Ok(())
-}
-
-/// `P` with its attitude rows and columns in the world frame, `T P Tᵀ` with `T = diag(R, I)`:
-/// the right (body-frame) error `δθ` of the attitude `R` is `δθ_w = R δθ` in the world frame.
-///
-/// The start's usability ([`usable_pivot`]) is judged there. With the heading unknown and the
-/// tilt known, a body-frame attitude block has every entry of the heading's size and the tilt
-/// in their differences: singular to the pivot test however well the tilt is known, yet what
-/// the filters keep themselves (the attitude floor, [`attitude_floor`], keeps that block
-/// representable). In the world frame tilt and heading are separate rows, and the test sees
-/// only what the floor does not cover: states known, given the others, below the scalar's
-/// resolution.
-fn world_attitude<T: Real, const N: usize>(
-    p: &SMatrix<T, N, N>,
-    r: &Matrix3<T>,
-) -> SMatrix<T, N, N> {
-    let at =
-        |m: &SMatrix<T, N, N>, i: usize, j: usize| m.get((i, j)).copied().unwrap_or_else(T::zero);
-    let rot = |i: usize, k: usize| r.get((i, k)).copied().unwrap_or_else(T::zero);
-    // Rows first (`R P` on the attitude rows), then columns (`(R P) Rᵀ`).
-    let rows = SMatrix::<T, N, N>::from_fn(|i, j| {
-        if i < 3 {
-            (0..3).fold(T::zero(), |s, k| s + rot(i, k) * at(p, k, j))
-        } else {
-            at(p, i, j)
-        }
-    });
-    SMatrix::from_fn(|i, j| {
-        if j < 3 {
-            (0..3).fold(T::zero(), |s, k| s + at(&rows, i, k) * rot(j, k))
-        } else {
-            at(&rows, i, j)
-        }
-    })
 }
 
 /// `√max(P_ii, 0)` for each `i`: the 1-σ of each error-state component.

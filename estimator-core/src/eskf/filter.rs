@@ -124,9 +124,9 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
     ///
     /// # Errors
     /// A non-finite state, `P` not symmetric positive definite or singular to the scalar's
-    /// resolution (a state known, given the others, to less than `256 N ε` of its variance,
-    /// judged with the attitude error in the world frame, where tilt and heading are separate),
-    /// or an invalid configuration ([`FilterConfig::validate`]).
+    /// resolution (a state other than the attitude known, given the attitude and the states
+    /// before it, to less than `256 N ε` of its variance), or an invalid configuration
+    /// ([`FilterConfig::validate`]).
     pub fn new(
         state: S,
         covariance: SMatrix<T, N, N>,

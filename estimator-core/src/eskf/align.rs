@@ -173,20 +173,22 @@ impl<T: Real> Default for InitialSigmas<T> {
 
 impl<T: Real> InitialSigmas<T> {
     /// The attitude covariance in the body-frame error: the world-frame
-    /// `diag(σ_t², σ_t², σ_ψ²)` (z up) mapped by `δθ = Rᵀ δθ_w`: `Rᵀ Σ_w R`.
+    /// `Σ_w = σ_t² I + (σ_ψ² − σ_t²) u uᵀ` (`diag(σ_t², σ_t², σ_ψ²)` for `u` = z) mapped by
+    /// `δθ = Rᵀ δθ_w`: `Rᵀ Σ_w R = σ_t² I + (σ_ψ² − σ_t²) u_b u_bᵀ`, `u_b = Rᵀ u`, exactly
+    /// symmetric.
     ///
     /// A sigma is taken by its magnitude, and one above π as π: an attitude error of σ = π
     /// carries no information, and a larger variance only costs the filter its resolution (the
     /// tilt of a body-frame attitude block is the difference of entries of the heading's size).
     #[must_use]
     pub fn attitude_covariance(&self, attitude: &So3<T>, up: &Vector3<T>) -> Matrix3<T> {
-        let r = attitude.rotation_matrix();
         let (tilt, yaw) = (self.tilt.abs().min(T::pi()), self.yaw.abs().min(T::pi()));
         let t2 = tilt * tilt;
         let y2 = yaw * yaw;
-        // Σ_w = σ_t² I + (σ_ψ² − σ_t²) u uᵀ.
-        let sw = Matrix3::from_diagonal_element(t2) + up * up.transpose() * (y2 - t2);
-        mat3::mul(&mat3::mul(&r.transpose(), &sw), &r)
+        // Σ_w = σ_t² I + (σ_ψ² − σ_t²) u uᵀ, so Rᵀ Σ_w R = σ_t² I + (σ_ψ² − σ_t²) u_b u_bᵀ with
+        // u_b = Rᵀ u: exactly symmetric (u_i u_j = u_j u_i), at every magnitude.
+        let u_b = mat3::mul_vec(&attitude.rotation_matrix().transpose(), up);
+        Matrix3::from_diagonal_element(t2) + u_b * u_b.transpose() * (y2 - t2)
     }
 }
 

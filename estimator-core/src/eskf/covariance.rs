@@ -17,7 +17,7 @@ use nalgebra::{Matrix3, SMatrix, SVector};
 /// entries of an `A` symmetric only to `10⁻⁶` of its largest differ, the lower triangle can be
 /// definite and the symmetric part not.
 pub(crate) fn is_spd<T: Real, const M: usize>(a: &SMatrix<T, M, M>) -> bool {
-    is_usable_spd(a, T::zero(), 0)
+    is_usable_spd(a, T::zero())
 }
 
 /// The smallest fraction of a variable's variance, `256 N ε` for a filter of `N` states (the
@@ -29,18 +29,34 @@ pub(crate) fn usable_pivot<T: Real, const N: usize>() -> T {
     T::lit(256.0 * N as f64 * T::EPSILON_F64)
 }
 
-/// [`is_spd`], with every Cholesky pivot `d_j`, `j ≥ first_tested`, above
-/// `relative_pivot · A_jj` (each variable keeps that fraction of its variance unexplained by
-/// the variables before it).
+/// [`is_spd`], with every Cholesky pivot `d_j` above `relative_pivot · A_jj` (each variable
+/// keeps that fraction of its variance unexplained by the variables before it).
 pub(crate) fn is_usable_spd<T: Real, const M: usize>(
     a: &SMatrix<T, M, M>,
     relative_pivot: T,
-    first_tested: usize,
 ) -> bool {
     let mut l = *a;
     symmetrize(l.as_mut_slice(), M);
-    is_symmetric(a.as_slice(), M)
-        && factor_in_place(l.as_mut_slice(), M, relative_pivot, first_tested)
+    is_symmetric(a.as_slice(), M) && factor_in_place(l.as_mut_slice(), M, relative_pivot)
+}
+
+/// [`is_spd`] for a filter's start, and every Cholesky pivot after the attitude rows,
+/// `d_j = L_jj²` for `j ≥ 3`, above [`usable_pivot`] of `P_jj` (to the rounding of `L_jj²`, a
+/// few ε of a threshold of `256 N ε`). Those pivots are the ones of the Schur complement
+/// `P_xx − P_xθ P_θθ⁻¹ P_θx`: each state other than the attitude judged given the attitude,
+/// the same in any frame of the attitude error. The attitude block's own resolution is the
+/// attitude floor's ([`attitude_floor`]), which the caller has added.
+fn is_usable_start<T: Real, const N: usize>(p: &SMatrix<T, N, N>) -> bool {
+    let mut l = *p;
+    symmetrize(l.as_mut_slice(), N);
+    let pivot = usable_pivot::<T, N>();
+    let diagonal = |m: &SMatrix<T, N, N>, j: usize| m.get((j, j)).copied().unwrap_or_else(T::zero);
+    is_symmetric(p.as_slice(), N)
+        && factor_in_place(l.as_mut_slice(), N, T::zero())
+        && (3..N).all(|j| {
+            let l_jj = diagonal(&l, j);
+            l_jj * l_jj > pivot * diagonal(p, j)
+        })
 }
 
 /// The column-major `n × n` storage `a` is finite and symmetric to `10⁻⁶` of its largest entry
@@ -73,10 +89,7 @@ pub(crate) fn check_start<T: Real, S: ErrorState<T, N>, const N: usize>(
     }
     let variances_usable =
         (0..N).all(|k| covariance.get((k, k)).is_some_and(|d| usable_variance(*d)));
-    // The attitude block's resolution is the attitude floor's (the caller has added it); the
-    // other states are judged given the attitude: their pivots are those of the Schur
-    // complement `P_xx − P_xθ P_θθ⁻¹ P_θx`.
-    if !(variances_usable && is_usable_spd(covariance, usable_pivot::<T, N>(), 3)) {
+    if !(variances_usable && is_usable_start(covariance)) {
         return Err(EskfError::CovarianceNotPositiveDefinite);
     }
     Ok(())
@@ -258,5 +271,37 @@ fn scale_attitude<T: Real, const N: usize>(p: &mut SMatrix<T, N, N>) {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A start whose attitude block is singular to the pivot test but floored (heading unknown,
+    /// tilt known, body pitched) is usable; one whose velocity is the position's to a
+    /// correlation of `1 − 10⁻⁶` (a pivot of `2·10⁻⁶` of its variance, below `256·15·ε` =
+    /// `4.6·10⁻⁴` in `f32`) is not, whatever the attitude.
+    #[test]
+    fn start_is_judged_given_the_attitude() {
+        let mut p = SMatrix::<f32, 15, 15>::identity();
+        // Body-frame attitude block of a heading of σ = π about the body axis (1, 1, 0)/√2 and a
+        // tilt of σ = 10⁻³ rad: every entry of the heading's size.
+        let u = nalgebra::Vector3::new(1.0f32, 1.0, 0.0).normalize();
+        let heading = core::f32::consts::PI * core::f32::consts::PI;
+        let a = Matrix3::identity() * 1e-6 + u * u.transpose() * (heading - 1e-6);
+        let a = a + Matrix3::from_diagonal_element(attitude_floor(&a));
+        p.fixed_view_mut::<3, 3>(0, 0).copy_from(&a);
+        assert!(
+            !is_usable_spd(&p, usable_pivot::<f32, 15>()),
+            "the whole-P test refuses it"
+        );
+        assert!(is_usable_start(&p));
+        for k in 0..3 {
+            p[(3 + k, 6 + k)] = 1.0 - 1e-6;
+            p[(6 + k, 3 + k)] = 1.0 - 1e-6;
+        }
+        assert!(is_spd(&p), "positive definite");
+        assert!(!is_usable_start(&p), "velocity known given the position");
     }
 }

@@ -78,7 +78,7 @@ pub(crate) fn factor<T: Real>(a: &mut [T], n: usize) -> Result<(), SolveError> {
     }
     let tau = T::lit(const { PIVOT_TOLERANCE_EPS * T::EPSILON_F64 })
         * T::from_usize(n).unwrap_or_else(T::one);
-    if factor_in_place(a, n, tau, 0) {
+    if factor_in_place(a, n, tau) {
         Ok(())
     } else {
         Err(SolveError::NotPositiveDefinite)

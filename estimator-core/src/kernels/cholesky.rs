@@ -15,18 +15,12 @@ use crate::Real;
 
 /// `A = L Lᵀ` in place on the column-major `n × n` storage `a`: only the lower triangle is
 /// read, and it becomes `L`. `false` (with `a` partly overwritten) when an entry of the lower
-/// triangle is not finite, a pivot is not positive, or a pivot `d_j` with `j ≥ first_tested`
-/// is not above `relative_pivot · A_jj` (see the module docs; `relative_pivot = 0` refuses only
-/// pivots `≤ 0` and NaN).
+/// triangle is not finite or a pivot `d_j` is not above `relative_pivot · A_jj` (see the module
+/// docs; `relative_pivot = 0` refuses only pivots `≤ 0` and NaN).
 #[inline(never)]
 #[must_use]
-pub(crate) fn factor_in_place<T: Real>(
-    a: &mut [T],
-    n: usize,
-    relative_pivot: T,
-    first_tested: usize,
-) -> bool {
-    factor_inline(a, n, relative_pivot, first_tested)
+pub(crate) fn factor_in_place<T: Real>(a: &mut [T], n: usize, relative_pivot: T) -> bool {
+    factor_inline(a, n, relative_pivot)
 }
 
 /// `L ← S = L Lᵀ` for a symmetric positive-definite 3 × 3 `s` (column-major; `L` in the lower
@@ -37,13 +31,13 @@ pub(crate) fn factor_in_place<T: Real>(
 #[must_use]
 pub(crate) fn spd_factor_3<T: Real>(s: &[T; 9], l: &mut [T; 9]) -> bool {
     *l = *s;
-    factor_inline(l, 3, T::zero(), 0)
+    factor_inline(l, 3, T::zero())
 }
 
 /// The body of [`factor_in_place`], for it and [`spd_factor_3`].
 #[inline(always)]
 #[must_use]
-fn factor_inline<T: Real>(a: &mut [T], n: usize, relative_pivot: T, first_tested: usize) -> bool {
+fn factor_inline<T: Real>(a: &mut [T], n: usize, relative_pivot: T) -> bool {
     if a.len() != n * n {
         return false;
     }
@@ -69,13 +63,8 @@ fn factor_inline<T: Real>(a: &mut [T], n: usize, relative_pivot: T, first_tested
             return false;
         };
         let d = *diagonal;
-        let tau = if j >= first_tested {
-            relative_pivot
-        } else {
-            T::zero()
-        };
         // Written so that a NaN pivot (every comparison false) is refused.
-        if !(d > T::zero() && d > tau * a_jj) {
+        if !(d > T::zero() && d > relative_pivot * a_jj) {
             return false;
         }
         let l_jj = d.sqrt_rn();
@@ -211,7 +200,7 @@ mod tests {
             for _ in 0..50 {
                 let a = spd(&mut rng, n);
                 let mut l = a.clone();
-                assert!(factor_in_place(l.as_mut_slice(), n, 0.0, 0));
+                assert!(factor_in_place(l.as_mut_slice(), n, 0.0));
                 let l = l.lower_triangle();
                 let k = (n + 1) as f64 * f64::EPSILON;
                 let gamma = k / (1.0 - k);
@@ -229,7 +218,7 @@ mod tests {
         for n in 1..=8 {
             let a = spd(&mut rng, n);
             let mut l = a.clone();
-            assert!(factor_in_place(l.as_mut_slice(), n, 0.0, 0));
+            assert!(factor_in_place(l.as_mut_slice(), n, 0.0));
             let chol = a.clone().cholesky().expect("spd");
             let svd = a.clone().svd(false, false);
             let kappa = svd.singular_values.max() / svd.singular_values.min();
@@ -277,31 +266,18 @@ mod tests {
     #[test]
     fn factor_refuses_indefinite_singular_and_non_finite() {
         let indefinite = [1.0, 2.0, 2.0, 1.0];
-        assert!(!factor_in_place(&mut indefinite.clone(), 2, 0.0, 0));
+        assert!(!factor_in_place(&mut indefinite.clone(), 2, 0.0));
         // Rank one: the second pivot is zero up to rounding, below 16·2·ε of A_11.
         let singular = [1.0, 1.0, 1.0, 1.0 + 1e-17];
         assert!(!factor_in_place(
             &mut singular.clone(),
             2,
-            32.0 * f64::EPSILON,
-            0
+            32.0 * f64::EPSILON
         ));
         for bad in [f64::NAN, f64::INFINITY] {
-            assert!(!factor_in_place(&mut [1.0, bad, bad, 1.0], 2, 0.0, 0));
+            assert!(!factor_in_place(&mut [1.0, bad, bad, 1.0], 2, 0.0));
         }
-        assert!(!factor_in_place(&mut [f64::NAN], 1, 0.0, 0));
-        assert!(!factor_in_place(&mut [1.0, 0.0, 0.0], 2, 0.0, 0)); // wrong length
-    }
-
-    #[test]
-    fn factor_tests_the_relative_pivot_from_first_tested_on() {
-        // The second variable keeps 1e-10 of its variance given the first: positive, below a
-        // relative pivot of 1e-6.
-        let nearly_singular = [1.0, 1.0, 1.0, 1.0 + 1e-10];
-        assert!(!factor_in_place(&mut nearly_singular.clone(), 2, 1e-6, 0));
-        assert!(!factor_in_place(&mut nearly_singular.clone(), 2, 1e-6, 1));
-        assert!(factor_in_place(&mut nearly_singular.clone(), 2, 1e-6, 2));
-        // An untested pivot must still be positive (this one is 1 − 4 < 0).
-        assert!(!factor_in_place(&mut [1.0, 2.0, 2.0, 1.0], 2, 1e-6, 2));
+        assert!(!factor_in_place(&mut [f64::NAN], 1, 0.0));
+        assert!(!factor_in_place(&mut [1.0, 0.0, 0.0], 2, 0.0)); // wrong length
     }
 }

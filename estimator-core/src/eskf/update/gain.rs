@@ -118,7 +118,7 @@ fn gain_into<T: Real, const N: usize, const C: usize>(
         (Some(s3), Some(l3)) if C == 3 => spd_factor_3(s3, l3),
         _ => {
             *l = s;
-            factor_in_place(l.as_mut_slice(), C, T::zero(), 0)
+            factor_in_place(l.as_mut_slice(), C, T::zero())
         }
     };
     if !factored {

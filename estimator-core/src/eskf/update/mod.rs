@@ -159,7 +159,7 @@ where
 /// padded copy is not in the update's frame.
 #[inline(never)]
 fn noise_is_spd<T: Real, const C: usize, const N: usize>(noise: &[T], m: usize) -> bool {
-    is_usable_spd(&padded_noise::<T, C>(noise, m), noise_floor::<T, N>(), 0)
+    is_usable_spd(&padded_noise::<T, C>(noise, m), noise_floor::<T, N>())
 }
 
 /// Linearizes at `x̂ ⊕ δx` (`δx` = `w.dx`; at `x̂` when `first`) into `w.ht`, `w.r`, with the

@@ -183,8 +183,8 @@ done
 # opt-levels, CPU models and scalar types as above; the small functions (AUXILIARY: readouts,
 # value constructors, configurations, the models' own linearizations, trait methods; and the
 # Lie-group operations, GROUPS x GROUP_OPS) over the two builds firmware ships (opt "s" plain,
-# opt 3 Cortex-M4) in f32 and f64, and over the whole matrix with FIRMWARE_SINGLE_FULL=1 (about
-# 3,600 links, 40 minutes on two cores). The target dirs are those of the matrix above, so that
+# opt 3 Cortex-M4) in f32 and f64, and over the whole matrix with FIRMWARE_SINGLE_FULL=1 (3,600
+# links). The target dirs are those of the matrix above, so that
 # only the small binary is built again; f32 and f64 side by side, one per core.
 step "no-panic, one entry point per binary: src/bin/single.rs over the matrix"
 single_names() { # the names in the array constant $1 of src/bin/single.rs

@@ -3,6 +3,7 @@
 use super::config::FilterConfig;
 use super::error::EskfError;
 use super::state::ErrorState;
+use crate::kernels::block::{add_scaled_identity, block};
 use crate::kernels::cholesky::factor_in_place;
 use crate::kernels::slice::symmetrize;
 use crate::kernels::{all_finite, larger, usable_variance};
@@ -36,6 +37,16 @@ pub(crate) fn is_usable_spd<T: Real, const M: usize>(
     relative_pivot: T,
 ) -> bool {
     let mut l = *a;
+    is_usable_factor(a, &mut l, relative_pivot)
+}
+
+/// [`is_usable_spd`] with `l` a copy of `a` on entry, which becomes the Cholesky factor of the
+/// symmetric part of `a` when it passes.
+fn is_usable_factor<T: Real, const M: usize>(
+    a: &SMatrix<T, M, M>,
+    l: &mut SMatrix<T, M, M>,
+    relative_pivot: T,
+) -> bool {
     symmetrize(l.as_mut_slice(), M);
     is_symmetric(a.as_slice(), M) && factor_in_place(l.as_mut_slice(), M, relative_pivot)
 }
@@ -47,12 +58,10 @@ pub(crate) fn is_usable_spd<T: Real, const M: usize>(
 /// the same in any frame of the attitude error. The attitude block's own resolution is the
 /// attitude floor's ([`attitude_floor`]), which the caller has added.
 fn is_usable_start<T: Real, const N: usize>(p: &SMatrix<T, N, N>) -> bool {
-    let mut l = *p;
-    symmetrize(l.as_mut_slice(), N);
     let pivot = usable_pivot::<T, N>();
     let diagonal = |m: &SMatrix<T, N, N>, j: usize| m.get((j, j)).copied().unwrap_or_else(T::zero);
-    is_symmetric(p.as_slice(), N)
-        && factor_in_place(l.as_mut_slice(), N, T::zero())
+    let mut l = *p;
+    is_usable_factor(p, &mut l, T::zero())
         && (3..N).all(|j| {
             let l_jj = diagonal(&l, j);
             l_jj * l_jj > pivot * diagonal(p, j)
@@ -134,6 +143,14 @@ pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
     } else {
         T::zero()
     }
+}
+
+/// Adds [`attitude_floor`] of the attitude block `P_θθ` to its diagonal, as every prediction
+/// and a filter's start do.
+#[inline(always)]
+pub(crate) fn floor_attitude<T: Real, const N: usize>(p: &mut SMatrix<T, N, N>) {
+    let floor = attitude_floor(&block(p, 0, 0));
+    add_scaled_identity(p, 0, 0, floor);
 }
 
 /// `f tr A` ([`ATTITUDE_FLOOR`]): the attitude floor itself, whatever the block's smallest

@@ -3,7 +3,7 @@
 use super::align::{prior_attitude_covariance, Alignment, InitialSigmas};
 use super::config::{up_direction, FilterConfig, ImuSample};
 use super::covariance::{
-    attitude_floor, attitude_resolution, cap_attitude, check_start, is_spd, sigmas,
+    attitude_floor, attitude_resolution, cap_attitude, check_start, floor_attitude, is_spd, sigmas,
 };
 use super::error::{EskfError, UpdateOutcome};
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
@@ -137,8 +137,7 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
         cap_attitude(&mut covariance);
         // The attitude floor every prediction adds: a body-frame block with the heading unknown
         // is representable only with it (`check_start`).
-        let floor = attitude_floor(&block(&covariance, 0, 0));
-        add_scaled_identity(&mut covariance, 0, 0, floor);
+        floor_attitude(&mut covariance);
         check_start(&state, &covariance, &config)?;
         Ok(Self {
             state,

@@ -3,7 +3,7 @@
 
 use super::config::{check_dt, FilterConfig, ImuSample};
 use super::covariance::{
-    attitude_floor, cap_attitude, floor_growth, floor_mixing, leading_diagonal,
+    cap_attitude, floor_attitude, floor_growth, floor_mixing, leading_diagonal,
 };
 use super::error::EskfError;
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
@@ -177,8 +177,7 @@ pub(crate) fn predict_ins_finite<T: Real>(
     add_scaled_identity(p, 4, 4, q_ba);
     floor_growth(p, &before);
     floor_mixing(p, products, dt);
-    let floor = attitude_floor(&block(p, 0, 0));
-    add_scaled_identity(p, 0, 0, floor);
+    floor_attitude(p);
     cap_attitude(p);
     *x = new_x;
     Ok(())
@@ -279,8 +278,7 @@ fn predict_attitude<T: Real, const N: usize>(
     add_scaled_identity(p, 1, 1, q_bg);
     add_scaled_identity(p, 2, 2, q_ba);
     floor_growth(p, &before);
-    let floor = attitude_floor(&block(p, 0, 0));
-    add_scaled_identity(p, 0, 0, floor);
+    floor_attitude(p);
     cap_attitude(p);
     *attitude = next;
     Ok(())

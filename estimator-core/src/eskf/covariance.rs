@@ -37,16 +37,6 @@ pub(crate) fn is_usable_spd<T: Real, const M: usize>(
     relative_pivot: T,
 ) -> bool {
     let mut l = *a;
-    is_usable_factor(a, &mut l, relative_pivot)
-}
-
-/// [`is_usable_spd`] with `l` a copy of `a` on entry, which becomes the Cholesky factor of the
-/// symmetric part of `a` when it passes.
-fn is_usable_factor<T: Real, const M: usize>(
-    a: &SMatrix<T, M, M>,
-    l: &mut SMatrix<T, M, M>,
-    relative_pivot: T,
-) -> bool {
     symmetrize(l.as_mut_slice(), M);
     is_symmetric(a.as_slice(), M) && factor_in_place(l.as_mut_slice(), M, relative_pivot)
 }
@@ -58,10 +48,12 @@ fn is_usable_factor<T: Real, const M: usize>(
 /// the same in any frame of the attitude error. The attitude block's own resolution is the
 /// attitude floor's ([`attitude_floor`]), which the caller has added.
 fn is_usable_start<T: Real, const N: usize>(p: &SMatrix<T, N, N>) -> bool {
+    let mut l = *p;
+    symmetrize(l.as_mut_slice(), N);
     let pivot = usable_pivot::<T, N>();
     let diagonal = |m: &SMatrix<T, N, N>, j: usize| m.get((j, j)).copied().unwrap_or_else(T::zero);
-    let mut l = *p;
-    is_usable_factor(p, &mut l, T::zero())
+    is_symmetric(p.as_slice(), N)
+        && factor_in_place(l.as_mut_slice(), N, T::zero())
         && (3..N).all(|j| {
             let l_jj = diagonal(&l, j);
             l_jj * l_jj > pivot * diagonal(p, j)

@@ -12,8 +12,10 @@
 //! | `host-sim scenarios` | list the built-in scenarios |
 //!
 //! Every output folder is written beside its target and moved into place when the command
-//! succeeds; an existing folder is replaced only if it holds an earlier host-sim output and
-//! `--force` is given (`host_sim::output`).
+//! succeeds. An existing folder is written only if it holds an earlier host-sim output and
+//! `--force` is given, and then only the files that output listed are replaced: any other file
+//! or folder inside (a user's notes, another command's output nested in it) is kept
+//! (`host_sim::output`).
 //!
 //! Exit status 0 on success; bad input (a missing file, a malformed row, time going backwards)
 //! gives a one-line error naming the file and the line, and a non-zero exit status.
@@ -30,7 +32,8 @@ pub mod faults;
     version,
     about,
     after_help = "Without a command, runs `host-sim run`: 60 s of the `default` scenario into out/ \
-(refused if out/ exists and is not empty; an earlier host-sim output is replaced by `host-sim run --force`).\n\n\
+(refused if out/ exists and is not empty; `host-sim run --force` replaces the files of an earlier host-sim output \
+and keeps every other file or folder in it).\n\n\
 Examples:\n  host-sim scenarios\n  host-sim run --scenario car --seed 3 --out out/car\n  \
 host-sim simulate --scenario car --out data/car\n  host-sim replay data/car --out out/car\n  \
 host-sim bench ../shared/datasets --out out/bench\n  host-sim montecarlo --scenario matched_ins --runs 60 --check"
@@ -61,8 +64,9 @@ Example: host-sim run --scenario handheld_ahrs --seed 2 --out out/ahrs"
         /// Output folder.
         #[arg(long, default_value = "out")]
         out: PathBuf,
-        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
-        /// files is never replaced).
+        /// Replace the files of an earlier host-sim output in the output folder (the ones its
+        /// manifest lists; every other file or folder in it is kept; a folder host-sim did not
+        /// write is refused).
         #[arg(long)]
         force: bool,
     },
@@ -82,8 +86,9 @@ Example: host-sim simulate --scenario car --seed 3 --out data/car"
         /// Output dataset folder.
         #[arg(long)]
         out: PathBuf,
-        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
-        /// files is never replaced).
+        /// Replace the files of an earlier host-sim output in the output folder (the ones its
+        /// manifest lists; every other file or folder in it is kept; a folder host-sim did not
+        /// write is refused).
         #[arg(long)]
         force: bool,
     },
@@ -103,8 +108,9 @@ Example: host-sim replay data/car --out out/car"
         /// Filter configuration (TOML).
         #[arg(long)]
         config: Option<PathBuf>,
-        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
-        /// files is never replaced).
+        /// Replace the files of an earlier host-sim output in the output folder (the ones its
+        /// manifest lists; every other file or folder in it is kept; a folder host-sim did not
+        /// write is refused).
         #[arg(long)]
         force: bool,
     },
@@ -132,8 +138,9 @@ Example: host-sim bench ../shared/datasets --out out/bench"
         /// Filter configuration (TOML) for every dataset.
         #[arg(long)]
         config: Option<PathBuf>,
-        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
-        /// files is never replaced).
+        /// Replace the files of an earlier host-sim output in the output folder (the ones its
+        /// manifest lists; every other file or folder in it is kept; a folder host-sim did not
+        /// write is refused).
         #[arg(long)]
         force: bool,
     },
@@ -169,8 +176,9 @@ host-sim montecarlo --scenario matched_ahrs --runs 20 --seed 101 --out out/mc_ah
         /// Print montecarlo.json to stdout instead of the table.
         #[arg(long)]
         json: bool,
-        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
-        /// files is never replaced).
+        /// Replace the files of an earlier host-sim output in the output folder (the ones its
+        /// manifest lists; every other file or folder in it is kept; a folder host-sim did not
+        /// write is refused).
         #[arg(long, requires = "out")]
         force: bool,
         /// Exit non-zero when a band is missed.
@@ -209,8 +217,9 @@ Examples:\n  host-sim faults --out out/faults\n  host-sim faults --scenario faul
         /// Output folder for faults.csv and faults.json.
         #[arg(long)]
         out: PathBuf,
-        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
-        /// files is never replaced).
+        /// Replace the files of an earlier host-sim output in the output folder (the ones its
+        /// manifest lists; every other file or folder in it is kept; a folder host-sim did not
+        /// write is refused).
         #[arg(long)]
         force: bool,
         /// Print faults.json to stdout instead of the tables.
@@ -243,8 +252,9 @@ Example: host-sim calibrate data/bench_static --to 30 --out out/imu_noise"
         /// End of the static interval, seconds after the first IMU sample (default: the end).
         #[arg(long)]
         to: Option<f64>,
-        /// Replace the output folder if it holds an earlier host-sim output (a folder with other
-        /// files is never replaced).
+        /// Replace the files of an earlier host-sim output in the output folder (the ones its
+        /// manifest lists; every other file or folder in it is kept; a folder host-sim did not
+        /// write is refused).
         #[arg(long)]
         force: bool,
     },

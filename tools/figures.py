@@ -11,6 +11,7 @@ and is rendered here from the JSON that the command named above it writes. Two m
 
     python3 tools/figures.py write [--only NAME,...]   # run the commands, rewrite the blocks
     python3 tools/figures.py check [--only NAME,...]   # run them, compare with the blocks
+    python3 tools/figures.py selftest                  # the comparison's own checks
 
 `check` fails (exit 1, a diff of the lines that differ) when a block's text differs from what
 the tool gives now, numbers aside, or when a number differs from the fresh one by more than one
@@ -292,7 +293,31 @@ def compare(name, old, new):
     return problems
 
 
+def selftest():
+    """The comparison's own checks: within one unit of the last digit passes, more fails, a
+    changed word fails, a number inside a name is text."""
+    doc = "| `pitch90` | 0.245 | 2.43 / 2.70 | 84,574 / 2,084.6 |\n"
+    cases = [
+        (doc, True),
+        (doc.replace("0.245", "0.246"), True),
+        (doc.replace("0.245", "0.247"), False),
+        (doc.replace("84,574", "84,575"), True),
+        (doc.replace("84,574", "84,576"), False),
+        (doc.replace("2,084.6", "2,084.8"), False),
+        (doc.replace("pitch90", "pitch45"), False),
+        (doc.replace("2.70 |", "2.70 m |"), False),
+        (doc + "| extra |\n", False),
+    ]
+    bad = [now for now, ok in cases if (not compare("selftest", doc, now)) != ok]
+    for now in bad:
+        print(f"figures selftest: wrong verdict for {now!r}", file=sys.stderr)
+    print(f"figures selftest: {len(cases) - len(bad)} of {len(cases)} cases right", file=sys.stderr)
+    return 1 if bad else 0
+
+
 def main():
+    if sys.argv[1:2] == ["selftest"]:
+        return selftest()
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("mode", choices=["write", "check"])
     ap.add_argument("--only", default=",".join(SECTIONS), help="blocks, comma-separated")

@@ -40,9 +40,9 @@ use crate::dataset::write::simulate;
 use crate::metrics::trajectory::{Alignment, Stats};
 use crate::metrics::Metrics;
 use crate::montecarlo::{BandResult, DEFAULT_SETTLE_S};
+use crate::progress::{Mode, Progress};
 use crate::replay::{replay, ReplayConfig};
 use crate::scenario::Scenario;
-use indicatif::{ProgressBar, ProgressStyle};
 use score::{FalseValid, FaultRule, Tally, QUANTITIES};
 use serde_json::{json, Map, Value};
 use std::fmt::Write as _;
@@ -86,7 +86,8 @@ pub struct Options {
     /// A folder for the runs' datasets and outputs: each run writes into a subfolder of its
     /// own and removes it when scored.
     pub scratch: PathBuf,
-    /// Show progress bars on stderr.
+    /// Show progress on stderr ([`crate::progress`]: a bar on a terminal, a line every few
+    /// seconds off one).
     pub progress: bool,
 }
 
@@ -340,19 +341,6 @@ impl Job<'_> {
     }
 }
 
-fn bar(len: usize, progress: bool, what: &str) -> ProgressBar {
-    let bar = if progress {
-        ProgressBar::new(len as u64)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template(&format!("{{bar:40}} {{pos}}/{{len}} {what} ({{elapsed}})"))
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar
-}
-
 /// Runs `jobs` on `workers` threads, each job in `scratch/job-<i>` (removed after it); stops
 /// handing out jobs at the first failure, which it returns.
 fn run_pool(
@@ -361,7 +349,12 @@ fn run_pool(
     scratch: &Path,
     progress: bool,
 ) -> Result<Vec<JobOut>, String> {
-    let bar = bar(jobs.len(), progress, "runs");
+    let bar = Progress::new(
+        "faults",
+        "runs",
+        jobs.len() as u64,
+        Mode::for_stderr(progress),
+    );
     // Longest first, so that no worker is left with a long run at the end.
     let mut order: Vec<usize> = (0..jobs.len()).collect();
     order.sort_by(|&a, &b| jobs[b].duration_s().total_cmp(&jobs[a].duration_s()));
@@ -390,7 +383,7 @@ fn run_pool(
             });
         }
     });
-    bar.finish_and_clear();
+    bar.finish();
     let all = results
         .into_inner()
         .map_err(|_| "a worker panicked".to_string())?;

@@ -21,7 +21,12 @@
 //!   that expectation; outside 4σ a consistent filter is 0.0063 % of the time, and that count
 //!   is the check that the navigator never calls a wrong quantity valid. Errors are correlated
 //!   in time, so one excursion covers many consecutive epochs: the counts come in bursts.
-//! * **ATE**: the SE(3)-aligned ATE RMSE of the run ([`crate::metrics`]).
+//! * **ATE**: the SE(3)-aligned ATE RMSE of the run ([`crate::metrics`]). Through a GNSS
+//!   outage the navigator dead-reckons on the IMU alone and its position error grows without
+//!   bound, so the ATE of a run with an outage is mostly that drift; beside it the bench gives
+//!   the ATE outside the outages ([`ate_outside`]: the SE(3)-aligned ATE of the estimate–truth
+//!   pairs whose time is outside every `gnss outage` interval, aligned on those pairs alone),
+//!   the figure to set beside the other scenarios' ATE.
 //!
 //! **Latency** ([`LATENCY_SCENARIO`]): the scenario replayed (a) as it is, each fix fused at its
 //! validity time, through [`crate::montecarlo::run_from`], which also gives the position ANEES
@@ -37,11 +42,11 @@ pub mod score;
 
 use crate::dataset::read::{read_faults, FaultInterval};
 use crate::dataset::write::simulate;
-use crate::metrics::trajectory::{Alignment, Stats};
-use crate::metrics::Metrics;
+use crate::metrics::trajectory::{self, Alignment, PosePair, Stats};
+use crate::metrics::{Metrics, Scorer};
 use crate::montecarlo::{BandResult, DEFAULT_SETTLE_S};
 use crate::progress::{Mode, Progress};
-use crate::replay::{replay, ReplayConfig};
+use crate::replay::{replay, replay_scored, ReplayConfig};
 use crate::scenario::Scenario;
 use score::{FalseValid, FaultRule, Tally, QUANTITIES};
 use serde_json::{json, Map, Value};
@@ -123,6 +128,9 @@ pub struct RunResult {
     pub false_valid: FalseValid,
     /// SE(3)-aligned ATE RMSE, m.
     pub ate_m: Option<f64>,
+    /// With a GNSS outage among the faults: the SE(3)-aligned ATE RMSE of the samples outside
+    /// every outage ([`ate_outside`]), m; `None` without an outage (or no sample outside).
+    pub ate_outside_outage_m: Option<f64>,
     /// IMU epochs in `validity.csv`.
     pub epochs: usize,
 }
@@ -158,6 +166,11 @@ pub struct Summary {
     pub false_valid: FalseValid,
     /// ATE RMSE over the runs, m.
     pub ate: Option<Stats>,
+    /// Whether the scenario's runs hold a GNSS outage (their ATE includes the dead reckoning
+    /// through it).
+    pub gnss_outage: bool,
+    /// ATE RMSE outside the GNSS outages over the runs, m ([`RunResult::ate_outside_outage_m`]).
+    pub ate_outside_outage: Option<Stats>,
 }
 
 /// The latency comparison over the seeds.
@@ -250,6 +263,19 @@ fn ate_se3(m: &Metrics) -> Option<f64> {
         .map(|a| a.stats.rmse)
 }
 
+/// The SE(3)-aligned ATE RMSE (`√(Σ‖R p̂ᵢ + t − pᵢ‖²/n)` after Umeyama's alignment, as
+/// [`trajectory::ate`]) of the `pairs` whose time is outside every interval of `outside`
+/// (`[start, end)`, ns), the alignment made on those pairs alone; `None` when no pair is left.
+#[must_use]
+pub fn ate_outside(pairs: &[PosePair], outside: &[(u64, u64)]) -> Option<f64> {
+    let kept: Vec<PosePair> = pairs
+        .iter()
+        .filter(|p| !outside.iter().any(|&(a, b)| p.t_ns >= a && p.t_ns < b))
+        .copied()
+        .collect();
+    trajectory::ate(&kept, Alignment::Se3).map(|a| a.stats.rmse)
+}
+
 /// The replay configuration of a bench run: the scenario's, plots off.
 fn bench_config(sc: &Scenario) -> ReplayConfig {
     ReplayConfig {
@@ -276,10 +302,29 @@ fn simulate_and_replay(
 /// # Errors
 /// A failed simulation or replay, or outputs that cannot be read back.
 pub fn run_one(sc: &Scenario, seed: u64, dir: &Path) -> Result<RunResult, String> {
-    let m = simulate_and_replay(sc, seed, &bench_config(sc), dir)?;
     let ds = dir.join("dataset");
+    simulate(sc, seed, &ds).map_err(|e| e.to_string())?;
+    let scorer = replay_scored(
+        &ds,
+        &dir.join("replay"),
+        &bench_config(sc),
+        &sc.name,
+        Scorer::default(),
+    )
+    .map_err(|e| e.to_string())?;
+    let m = scorer.metrics();
     let eps = epochs::read_epochs(&dir.join("replay"), &ds)?;
     let faults = read_faults(&ds).map_err(|e| e.to_string())?;
+    let outages: Vec<(u64, u64)> = faults
+        .iter()
+        .filter(|f| FaultRule::of(f) == Some(FaultRule::GnssOutage))
+        .map(|f| (f.start_ns, f.end_ns))
+        .collect();
+    let ate_outside_outage_m = if outages.is_empty() {
+        None
+    } else {
+        ate_outside(scorer.pairs(), &outages)
+    };
     let secs = |ns: u64| ns.saturating_sub(sc.start_ns) as f64 * 1e-9;
     let faults = faults
         .into_iter()
@@ -302,6 +347,7 @@ pub fn run_one(sc: &Scenario, seed: u64, dir: &Path) -> Result<RunResult, String
         faults,
         false_valid: score::false_valid(&eps),
         ate_m: ate_se3(&m),
+        ate_outside_outage_m,
         epochs: eps.len(),
     })
 }
@@ -408,6 +454,12 @@ fn summarize(sc: &Scenario, runs: &[RunResult]) -> Vec<Summary> {
         fv.add(&r.false_valid);
     }
     let ates: Vec<f64> = runs.iter().filter_map(|r| r.ate_m).collect();
+    let outside: Vec<f64> = runs.iter().filter_map(|r| r.ate_outside_outage_m).collect();
+    let gnss_outage = runs.iter().any(|r| {
+        r.faults
+            .iter()
+            .any(|f| f.rule == Some(FaultRule::GnssOutage))
+    });
     let base = Summary {
         scenario: sc.name.clone(),
         precision: sc.replay.precision.clone(),
@@ -422,6 +474,8 @@ fn summarize(sc: &Scenario, runs: &[RunResult]) -> Vec<Summary> {
         over_target: Vec::new(),
         false_valid: fv,
         ate: Stats::of(&ates),
+        gnss_outage,
+        ate_outside_outage: Stats::of(&outside),
     };
     let faults = runs.first().map_or(0, |r| r.faults.len());
     if faults == 0 {
@@ -629,6 +683,26 @@ impl Summary {
 }
 
 impl FaultBench {
+    /// One line per scenario with a GNSS outage: its ATE includes the dead reckoning through
+    /// the outage; the ATE outside it beside it.
+    fn outage_lines(&self) -> Vec<String> {
+        let mut seen = std::collections::BTreeSet::new();
+        self.summaries
+            .iter()
+            .filter(|s| s.gnss_outage && seen.insert(s.scenario.clone()))
+            .map(|s| {
+                let outside = match &s.ate_outside_outage {
+                    Some(a) => format!("{:.3} / {:.3} m", a.mean, a.max),
+                    None => "not computed (no sample outside it)".into(),
+                };
+                format!(
+                    "{}: the ATE includes the IMU-only dead reckoning through the GNSS outage; ATE outside the outage (SE(3)-aligned on those samples), mean / max: {outside}",
+                    s.scenario
+                )
+            })
+            .collect()
+    }
+
     /// The seeds of each scenario's runs.
     #[must_use]
     pub fn seeds(&self) -> Vec<u64> {
@@ -713,6 +787,9 @@ recovery: s from its end until the sensor is fused and the quantity valid within
             );
         }
         let _ = writeln!(t, "  (times in s, ATE SE(3)-aligned RMSE in m; >3σ / >4σ: false-valid epoch-axes summed over the runs / what a consistent Gaussian filter shows)");
+        for s in self.outage_lines() {
+            let _ = writeln!(t, "  {s}");
+        }
         let mut notes = Vec::new();
         for s in &self.summaries {
             let name = &s.scenario;
@@ -849,7 +926,7 @@ recovery: s from its end until the sensor is fused and the quantity valid within
 
     /// `faults.csv`: one row per run and fault (one per run for a scenario without faults):
     /// scenario, seed, the fault, its detection and recovery time (empty: not measured or never
-    /// reached), the epochs alarmed before it, the recovery target, the ATE, and per quantity
+    /// reached), the epochs alarmed before it, the recovery target, the ATE and (with a GNSS outage) the ATE outside it, and per quantity
     /// the valid epoch-axes and those outside 3σ and 4σ.
     ///
     /// # Errors
@@ -869,6 +946,7 @@ recovery: s from its end until the sensor is fused and the quantity valid within
             "recovery_s",
             "recovery_target_s",
             "ate_m",
+            "ate_outside_gnss_outage_m",
         ]
         .iter()
         .map(|s| (*s).to_string())
@@ -881,7 +959,11 @@ recovery: s from its end until the sensor is fused and the quantity valid within
         w.write_record(&header).map_err(err)?;
         let cell = |x: Option<f64>| x.filter(|v| v.is_finite()).map_or(String::new(), seconds);
         for r in &self.per_run {
-            let mut tail = vec![r.ate_m.map_or(String::new(), |a| a.to_string())];
+            let mut tail = vec![
+                r.ate_m.map_or(String::new(), |a| a.to_string()),
+                r.ate_outside_outage_m
+                    .map_or(String::new(), |a| a.to_string()),
+            ];
             for t in &r.false_valid.quantities {
                 tail.push(t.valid_epoch_axes.to_string());
                 tail.push(t.outside_3sigma.to_string());
@@ -980,6 +1062,8 @@ recovery: s from its end until the sensor is fused and the quantity valid within
                     })),
                     "false_valid": Value::Object(fv),
                     "ate_se3_rmse_m": stats(&s.ate),
+                    "ate_note": s.gnss_outage.then_some("includes the IMU-only dead reckoning through the GNSS outage; ate_outside_gnss_outage_se3_rmse_m leaves the outage out"),
+                    "ate_outside_gnss_outage_se3_rmse_m": if s.gnss_outage { stats(&s.ate_outside_outage) } else { Value::Null },
                 })
             })
             .collect();

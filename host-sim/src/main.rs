@@ -370,6 +370,9 @@ fn print_summary(
     for w in &m.warnings {
         out!("  warning: {w}");
     }
+    for n in cli::notes::consistency_notes(cfg, m, seed.is_some()) {
+        out!("  note: {n}");
+    }
     for (name, v) in &m.baseline_attitude_rmse_deg {
         out!(
             "  {:<28} {:>12}",

@@ -22,6 +22,7 @@ use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
 pub mod faults;
+pub mod notes;
 
 /// Simulate, replay and score the estimator.
 #[derive(Debug, Parser)]

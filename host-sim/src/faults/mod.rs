@@ -1151,3 +1151,45 @@ fn fraction(t: &Tally) -> String {
         )
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::metrics::trajectory::Pose;
+    use estimator_core::lie::{LieGroup, So3};
+    use nalgebra::Vector3;
+
+    /// An estimate exact outside `[10, 20)` s and 5 m off inside: the ATE outside the interval
+    /// is 0 (to rounding), the whole run's is not.
+    #[test]
+    fn ate_outside_leaves_the_interval_out() {
+        let pairs: Vec<PosePair> = (0..30u64)
+            .map(|k| {
+                let t_ns = k * 1_000_000_000;
+                let truth = Pose {
+                    position: Vector3::new(k as f64, (k * k) as f64 * 0.1, 0.5 * k as f64),
+                    attitude: So3::identity(),
+                };
+                let off = if (10..20).contains(&k) { 5.0 } else { 0.0 };
+                let estimate = Pose {
+                    position: truth.position + Vector3::new(0.0, off, 0.0),
+                    ..truth
+                };
+                PosePair {
+                    t_ns,
+                    estimate,
+                    truth,
+                }
+            })
+            .collect();
+        let interval = [(10_000_000_000, 20_000_000_000)];
+        let outside = ate_outside(&pairs, &interval).expect("pairs left");
+        let whole = trajectory::ate(&pairs, Alignment::Se3)
+            .expect("ate")
+            .stats
+            .rmse;
+        assert!(outside < 1e-9, "{outside}");
+        assert!(whole > 0.5, "{whole}");
+        assert_eq!(ate_outside(&pairs[10..20], &interval), None);
+    }
+}

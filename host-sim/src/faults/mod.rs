@@ -362,7 +362,8 @@ enum Job<'a> {
 }
 
 enum JobOut {
-    Bench(RunResult),
+    // Boxed: a run's result is large beside an ATE.
+    Bench(Box<RunResult>),
     Ate(f64),
 }
 
@@ -370,7 +371,7 @@ impl Job<'_> {
     fn run(&self, dir: &Path) -> Result<JobOut, String> {
         match self {
             Job::Bench(sc, seed) => run_one(sc, *seed, dir)
-                .map(JobOut::Bench)
+                .map(|r| JobOut::Bench(Box::new(r)))
                 .map_err(|e| format!("{} seed {seed}: {e}", sc.name)),
             Job::Ate(_, sc, cfg, seed) => simulate_and_replay(sc, *seed, cfg, dir)
                 .and_then(|m| ate_se3(&m).ok_or_else(|| "no ATE".to_string()))
@@ -583,7 +584,7 @@ pub fn run(opts: &Options) -> Result<FaultBench, String> {
     let mut ate_variants: [Vec<f64>; 3] = Default::default();
     for (job, out) in jobs.iter().zip(outs) {
         match (job, out) {
-            (Job::Bench(..), JobOut::Bench(r)) => per_run.push(r),
+            (Job::Bench(..), JobOut::Bench(r)) => per_run.push(*r),
             (Job::Ate(k, ..), JobOut::Ate(a)) => ate_variants[*k].push(a),
             _ => return Err("a run returned the wrong kind of result".into()),
         }

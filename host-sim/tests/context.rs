@@ -101,7 +101,7 @@ fn faults_off_a_terminal_prints_progress_and_the_outage_ate_has_its_context() {
     assert!(done, "no closing progress line:\n{stderr}");
 
     assert!(
-        stdout.contains("short_outage: the ATE includes the IMU-only dead reckoning through the GNSS outage; ATE outside the outage"),
+        stdout.contains("short_outage: the ATE includes the IMU-only dead reckoning through the GNSS outage; ATE outside it"),
         "{stdout}"
     );
     assert!(!stdout.contains("no_outage: the ATE includes"), "{stdout}");

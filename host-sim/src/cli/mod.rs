@@ -195,7 +195,7 @@ median / max, against the target (7 s position, 5 s height);\n\
   ATE: the SE(3)-aligned ATE RMSE, mean / max.\n\
 With fault_gnss_latency among the scenarios, or --latency: the mean ATE with fixes fused at their validity time, taken as valid on arrival, \
 and simulated without latency, their ratio (target ≤ 1.1), and the position ANEES against its 95 % band as `montecarlo` computes it.\n\
-With a GNSS outage the ATE includes the IMU-only dead reckoning through it; the ATE outside the outage is given beside it.\n\
+With a GNSS outage the ATE includes the IMU-only dead reckoning through it; the ATE outside it (until the first fix fused after it) is given beside it.\n\
 The runs are simulated in a scratch folder beside --out, removed at the end.\n\
 Progress goes to stderr: a bar on a terminal, else a line every 5 s (HOST_SIM_PROGRESS_S sets the interval).\n\
 Writes into --out: faults.csv (one row per run and fault) and faults.json (the summary; --json prints it instead of the tables).\n\n\

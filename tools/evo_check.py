@@ -13,8 +13,9 @@ with --save_results, and compares every statistic evo saves (rmse, mean, median,
 sse) and the number of pairs with metrics.json's ate_by_alignment (none, se3, origin) and rpe,
 within a relative tolerance (default 1e-6; errors below 1e-9 m compare absolutely). evo has no
 delta in seconds: a delta of D seconds is passed as D x rate frames, which is the same pairing
-when the estimate is sampled uniformly (checked). Exits 1 on any disagreement, 2 on bad input.
-The evo commands are taken from the folder of this Python interpreter, else from PATH.
+when the estimate is sampled uniformly (checked). Exits 1 on any disagreement, 2 on bad input,
+3 when NumPy or evo is missing (one line saying what to install: `pip install evo`, which brings
+NumPy). The evo commands are taken from the folder of this Python interpreter, else from PATH.
 """
 
 import argparse
@@ -26,7 +27,13 @@ import sys
 import tempfile
 import zipfile
 
-import numpy as np
+INSTALL = "pip install evo (it brings NumPy), then run this script with that Python"
+MISSING = 3
+
+try:
+    import numpy as np
+except ImportError:
+    np = None
 
 STATS = ("rmse", "mean", "median", "std", "min", "max", "sse")
 APE_FLAGS = {"none": [], "se3": ["-a"], "origin": ["--align_origin"]}
@@ -38,7 +45,11 @@ def evo_command(name):
         return here
     found = shutil.which(name)
     if found is None:
-        sys.exit(f"evo_check: {name} not found beside {sys.executable} or on PATH")
+        print(
+            f"evo_check: evo's {name} is not beside {sys.executable} nor on PATH: {INSTALL}",
+            file=sys.stderr,
+        )
+        sys.exit(MISSING)
     return found
 
 
@@ -99,6 +110,9 @@ def main():
     parser.add_argument("out", nargs="?", default="out")
     parser.add_argument("--tol", type=float, default=1e-6)
     a = parser.parse_args()
+    if np is None:
+        print(f"evo_check: NumPy is not installed for {sys.executable}: {INSTALL}", file=sys.stderr)
+        return MISSING
     est = os.path.join(a.out, "estimate.tum")
     gt = os.path.join(a.out, "groundtruth.tum")
     try:

@@ -11,6 +11,8 @@
 //! * [`montecarlo`]: consistency over seeds against chi-square bands.
 //! * [`faults`]: the fault bench: detection and recovery times, false-valid epochs and ATE of
 //!   the INS navigator over the fault scenarios.
+//! * [`progress`]: progress of the long commands on stderr: a bar on a terminal, plain lines
+//!   off one.
 //! * [`replay`]: the filter over a dataset folder, with its outputs (trajectories, metrics, plots).
 //! * [`bench`](mod@bench): the filter over every dataset under a folder, against published references.
 //! * [`output`]: output folders written beside their target and moved into place on success;
@@ -26,6 +28,7 @@ pub mod metrics;
 pub mod montecarlo;
 pub mod output;
 pub mod plot;
+pub mod progress;
 pub mod replay;
 pub mod scenario;
 pub mod sensors;

@@ -17,6 +17,7 @@ use host_sim::dataset::write::simulate;
 use host_sim::metrics::trajectory::Alignment;
 use host_sim::metrics::{Metrics, Scorer, ATE_ALIGNMENT};
 use host_sim::output::Staging;
+use host_sim::progress::{Mode, Progress};
 use host_sim::replay::{replay, replay_scored, ReplayConfig};
 use host_sim::scenario::{builtin_scenarios, Scenario};
 use std::path::Path;
@@ -138,9 +139,23 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                 config,
                 force,
             };
+            let mut progress: Option<Progress> = None;
             let report = host_sim::bench::run(&opts, |i, n, dataset| {
-                eprintln!("bench [{}/{n}] {}", i + 1, dataset.display());
-            })?;
+                let p = progress.get_or_insert_with(|| {
+                    Progress::new("bench", "datasets", n as u64, Mode::for_stderr(true))
+                });
+                if i > 0 {
+                    p.inc(1);
+                }
+                p.note(&format!("bench [{}/{n}] {}", i + 1, dataset.display()));
+            });
+            if let Some(p) = progress {
+                if report.is_ok() {
+                    p.inc(1);
+                }
+                p.finish();
+            }
+            let report = report?;
             out!("{}", report.render().trim_start());
             out!("outputs in {}", opts.out.display());
             let failures = report.failures();
@@ -354,6 +369,9 @@ fn print_summary(
     }
     for w in &m.warnings {
         out!("  warning: {w}");
+    }
+    for n in cli::notes::consistency_notes(cfg, m, seed.is_some()) {
+        out!("  note: {n}");
     }
     for (name, v) in &m.baseline_attitude_rmse_deg {
         out!(

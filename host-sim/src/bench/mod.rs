@@ -10,8 +10,14 @@
 //! | `references.json` | table |
 //! |---|---|
 //! | `trials.{name}.{anchor}.{total,heading,inclination}` (BROAD) | BROAD's total / heading / inclination RMSE inside `movement.csv` ([`crate::metrics::broad`]), real-time VQF's and Madgwick's total, with the mean and the worst trial |
-//! | `datasets.{name}.{anchor}.attitude_rmse_deg` | the attitude RMSE from 2 s after the first ground-truth sample, the ANEES of the attitude, VQF's RMSE and ours / VQF |
+//! | `datasets.{name}.{anchor}.attitude_rmse_deg` | the sensors ours fuses, the attitude RMSE from 2 s after the first ground-truth sample, the ANEES of the attitude, VQF's RMSE and ours / VQF |
 //! | none | the same columns as the kind of data suggests (BROAD where every dataset has `movement.csv`), ours only |
+//!
+//! **Like with like.** Real-time VQF 9D fuses the IMU and the magnetometer. A dataset with GNSS
+//! (or a camera) replays through the INS navigator, which fuses those too: its row names the
+//! sensors and gets no ours / VQF ratio, which is printed only where ours fuses exactly VQF's
+//! sensors ([`VQF_SENSORS`]). The means of a BROAD table (ours, VQF, Madgwick) are computed
+//! only where every trial has the figure; a mean left out says which trials lack it.
 //!
 //! A figure that was not computed (no reference, nothing scored, a failed run) is printed `–`
 //! and written `null`, never as a number. `OUT/bench.json` holds every figure of the tables.
@@ -29,6 +35,30 @@ use std::path::{Path, PathBuf};
 pub const VQF: &str = "vqf_9d";
 /// BROAD's published Madgwick at its trial-agnostic good parameter.
 pub const MADGWICK: &str = "madgwick_tagp_published";
+
+/// The sensors real-time VQF 9D fuses, as [`sensors_of`] names them.
+pub const VQF_SENSORS: &[&str] = &["IMU", "mag"];
+
+/// The sensors a replay of `dataset` fuses, by the files it holds: always `IMU`, then `mag`
+/// (`mag0/data.csv`), `GNSS` (`gnss0/data.csv`), `camera` (`cam0/observations.csv`) and
+/// `baro` (`baro0/data.csv`, fused by the INS navigator only).
+#[must_use]
+pub fn sensors_of(dataset: &Path) -> Vec<&'static str> {
+    let mut out = vec!["IMU"];
+    let ins =
+        dataset.join("gnss0/data.csv").is_file() || dataset.join("cam0/observations.csv").is_file();
+    for (file, name, needs_ins) in [
+        ("mag0/data.csv", "mag", false),
+        ("gnss0/data.csv", "GNSS", false),
+        ("cam0/observations.csv", "camera", false),
+        ("baro0/data.csv", "baro", true),
+    ] {
+        if dataset.join(file).is_file() && (ins || !needs_ins) {
+            out.push(name);
+        }
+    }
+    out
+}
 
 /// What to bench.
 #[derive(Clone, Debug)]
@@ -192,6 +222,8 @@ pub struct BroadSummary {
     pub ours: BroadFigures,
     /// Real-time VQF 9D's total RMSE, degrees.
     pub vqf_total_deg: Option<f64>,
+    /// BROAD's published Madgwick's total RMSE, degrees.
+    pub madgwick_total_deg: Option<f64>,
 }
 
 /// One row of a table of attitude RMSEs.
@@ -199,6 +231,11 @@ pub struct BroadSummary {
 pub struct AttitudeRow {
     /// The dataset folder name.
     pub dataset: String,
+    /// The sensors ours fuses ([`sensors_of`]).
+    pub sensors: Vec<String>,
+    /// The navigator the replay runs: `attitude` (IMU and magnetometer) or `ins` (with GNSS or
+    /// a camera).
+    pub navigator: String,
     /// Why the run failed, if it did.
     pub error: Option<String>,
     /// Attitude RMSE from 2 s after the first ground-truth sample, degrees.
@@ -207,8 +244,10 @@ pub struct AttitudeRow {
     pub anees_attitude: Option<f64>,
     /// Real-time VQF 9D's attitude RMSE from `references.json`, degrees.
     pub vqf_attitude_rmse_deg: Option<f64>,
-    /// Ours / VQF.
+    /// Ours / VQF, only where ours fuses exactly VQF's sensors ([`VQF_SENSORS`]).
     pub ratio_to_vqf: Option<f64>,
+    /// Why there is no ratio although both RMSEs are there (different sensors).
+    pub ratio_to_vqf_absent: Option<String>,
 }
 
 /// The rows of one table.
@@ -223,6 +262,9 @@ pub enum Rows {
         mean: BroadSummary,
         /// The worst trial per column.
         max: BroadSummary,
+        /// The trials without a Madgwick figure in `references.json` (the Madgwick mean and
+        /// maximum are left out when any is).
+        madgwick_missing: Vec<String>,
     },
     /// Attitude RMSE from 2 s after the start.
     Attitude {
@@ -353,6 +395,12 @@ fn broad_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Value>
     let heading = column(&|r| r.ours.heading_deg);
     let inclination = column(&|r| r.ours.inclination_deg);
     let vqf = column(&|r| r.vqf_total_deg);
+    let madgwick = column(&|r| r.madgwick_total_deg);
+    let madgwick_missing = rows
+        .iter()
+        .filter(|r| r.madgwick_total_deg.is_none())
+        .map(|r| r.dataset.clone())
+        .collect();
     let summary = |pick: fn(MeanMax) -> Option<f64>| BroadSummary {
         ours: BroadFigures {
             total_deg: pick(total),
@@ -360,18 +408,22 @@ fn broad_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Value>
             inclination_deg: pick(inclination),
         },
         vqf_total_deg: pick(vqf),
+        madgwick_total_deg: pick(madgwick),
     };
     Rows::Broad {
         mean: summary(|(mean, _)| mean),
         max: summary(|(_, max)| max),
         rows,
+        madgwick_missing,
     }
 }
 
 fn attitude_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Value>>) -> Rows {
     let rows = runs
         .iter()
-        .map(|(_, o)| {
+        .map(|(dataset, o)| {
+            let sensors = sensors_of(dataset);
+            let alike = sensors == VQF_SENSORS;
             let vqf = refs.and_then(|m| reference(m, &o.name, &[VQF, "attitude_rmse_deg"]));
             let (rmse, anees, error) = match &o.result {
                 Ok(m) => (
@@ -381,17 +433,33 @@ fn attitude_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Val
                 ),
                 Err(e) => (None, None, Some(e.clone())),
             };
-            let ratio = match (rmse, vqf) {
-                (Some(a), Some(b)) if b > 0.0 => finite(a / b),
-                _ => None,
+            let (ratio, ratio_absent) = match (rmse, vqf) {
+                (Some(_), Some(_)) if !alike => (
+                    None,
+                    Some(format!(
+                        "ours fuses {}, VQF 9D {}: not the same sensors",
+                        sensors.join("+"),
+                        VQF_SENSORS.join("+")
+                    )),
+                ),
+                (Some(a), Some(b)) if b > 0.0 => (finite(a / b), None),
+                _ => (None, None),
+            };
+            let navigator = if sensors.contains(&"GNSS") || sensors.contains(&"camera") {
+                "ins"
+            } else {
+                "attitude"
             };
             AttitudeRow {
                 dataset: o.name.clone(),
+                sensors: sensors.iter().map(|s| (*s).to_string()).collect(),
+                navigator: navigator.into(),
                 error,
                 attitude_rmse_after_2s_deg: rmse,
                 anees_attitude: anees,
                 vqf_attitude_rmse_deg: vqf,
                 ratio_to_vqf: ratio,
+                ratio_to_vqf_absent: ratio_absent,
             }
         })
         .collect();
@@ -598,7 +666,12 @@ impl Report {
                 (None, None) => "no references.json".to_string(),
             };
             match &t.rows {
-                Rows::Broad { rows, mean, max } => {
+                Rows::Broad {
+                    rows,
+                    mean,
+                    max,
+                    madgwick_missing,
+                } => {
                     let w = rows
                         .iter()
                         .map(|r| r.dataset.chars().count())
@@ -645,7 +718,14 @@ impl Report {
                             cell(a.ours.heading_deg, 3),
                             cell(a.ours.inclination_deg, 3),
                             cell(a.vqf_total_deg, 3),
-                            DASH,
+                            cell(a.madgwick_total_deg, 3),
+                        );
+                    }
+                    if !madgwick_missing.is_empty() {
+                        let _ = writeln!(
+                            s,
+                            "(no Madgwick mean or max: references.json has no Madgwick figure for {})",
+                            madgwick_missing.join(", ")
                         );
                     }
                 }
@@ -663,25 +743,39 @@ impl Report {
                     );
                     let _ = writeln!(
                         s,
-                        "{:<w$}  {:>9} {:>11}  {:>9}  {:>8}",
-                        "dataset", "ours RMSE", "ours ANEES", "VQF RMSE", "ours/VQF"
+                        "{:<w$}  {:<14} {:>9} {:>11}  {:>9}  {:>8}",
+                        "dataset", "ours fuses", "ours RMSE", "ours ANEES", "VQF RMSE", "ours/VQF"
                     );
                     for r in rows {
                         if let Some(e) = &r.error {
                             let _ = writeln!(s, "{:<w$}  failed: {e}", r.dataset);
                             continue;
                         }
+                        let ratio = if r.ratio_to_vqf_absent.is_some() {
+                            format!("{DASH} ¹")
+                        } else {
+                            cell(r.ratio_to_vqf, 2)
+                        };
                         let _ = writeln!(
                             s,
-                            "{:<w$}  {:>9} {:>11}  {:>9}  {:>8}",
+                            "{:<w$}  {:<14} {:>9} {:>11}  {:>9}  {:>8}",
                             r.dataset,
+                            r.sensors.join("+"),
                             cell(r.attitude_rmse_after_2s_deg, 3),
                             cell(r.anees_attitude, 2),
                             cell(r.vqf_attitude_rmse_deg, 3),
-                            cell(r.ratio_to_vqf, 2),
+                            ratio,
                         );
                     }
                     let _ = writeln!(s, "(ANEES: mean NEES of the attitude, 3 when consistent)");
+                    if rows.iter().any(|r| r.ratio_to_vqf_absent.is_some()) {
+                        let _ = writeln!(
+                            s,
+                            "¹ no ratio: ours replays this dataset through the INS navigator with the sensors named, VQF 9D fuses {} only; \
+a ratio is printed only where both fuse the same sensors",
+                            VQF_SENSORS.join("+")
+                        );
+                    }
                 }
             }
         }

@@ -24,6 +24,7 @@ use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
 pub mod faults;
+pub mod notes;
 
 /// Simulate, replay and score the estimator.
 #[derive(Debug, Parser)]
@@ -121,9 +122,11 @@ Example: host-sim replay data/car --out out/car"
 replays each (plots off; --config, else the dataset's replay.toml, else the defaults) and prints one table per parent folder, \
 against that folder's references.json when present:\n\
   BROAD (references.json with \"trials\"): BROAD's total / heading / inclination RMSE [deg] inside movement.csv, \
-real-time VQF's and Madgwick's total, the mean and the worst trial;\n\
-  otherwise (\"datasets\", or none): the attitude RMSE [deg] from 2 s after the first ground-truth sample, \
-the attitude ANEES, VQF's RMSE and ours/VQF.\n\
+real-time VQF's and Madgwick's total, the mean and the worst trial (each only where every trial has the figure);\n\
+  otherwise (\"datasets\", or none): the sensors ours fuses, the attitude RMSE [deg] from 2 s after the first ground-truth sample, \
+the attitude ANEES, VQF's RMSE and ours/VQF, the ratio only where ours fuses VQF 9D's sensors (IMU+mag): \
+a dataset with GNSS replays through the INS navigator and is not divided by attitude-only VQF.\n\
+Progress goes to stderr: a bar on a terminal, else a line every 5 s (HOST_SIM_PROGRESS_S sets the interval).\n\
 A figure not computed is printed '–' (null in bench.json).\n\
 Writes into --out: one folder per dataset (estimate.tum, estimate.csv, groundtruth.tum, metrics.json) and bench.json (every figure of the tables).\n\
 Exit status non-zero when a dataset fails to run (its error is in its row; the others still run) or a references.json cannot be read.\n\n\
@@ -156,7 +159,8 @@ ANEES per block, mean NIS and accepted / gated-out / refused updates per sensor,
 an empty cell where not estimated), \
 bands.csv (the printed table: statistic, value, expected, lower, upper, fraction_inside, holds) and montecarlo.json \
 (both, with the command line, scenario, precision, seeds, runs, settle time and host-sim version).\n\
-Exit status non-zero with --check when a band is missed (the outputs are still written).\n\n\
+Exit status non-zero with --check when a band is missed (the outputs are still written).\n\
+Progress goes to stderr: a bar on a terminal, else a line every 5 s (HOST_SIM_PROGRESS_S sets the interval).\n\n\
 Examples:\n  host-sim montecarlo --scenario matched_ins --runs 60 --check\n  \
 host-sim montecarlo --scenario matched_ahrs --runs 20 --seed 101 --out out/mc_ahrs"
     )]
@@ -199,7 +203,9 @@ median / max, against the target (7 s position, 5 s height);\n\
   ATE: the SE(3)-aligned ATE RMSE, mean / max.\n\
 With fault_gnss_latency among the scenarios, or --latency: the mean ATE with fixes fused at their validity time, taken as valid on arrival, \
 and simulated without latency, their ratio (target ≤ 1.1), and the position ANEES against its 95 % band as `montecarlo` computes it.\n\
+With a GNSS outage the ATE includes the IMU-only dead reckoning through it; the ATE outside it (until the first fix fused after it) is given beside it.\n\
 The runs are simulated in a scratch folder beside --out, removed at the end.\n\
+Progress goes to stderr: a bar on a terminal, else a line every 5 s (HOST_SIM_PROGRESS_S sets the interval).\n\
 Writes into --out: faults.csv (one row per run and fault) and faults.json (the summary; --json prints it instead of the tables).\n\n\
 Examples:\n  host-sim faults --out out/faults\n  host-sim faults --scenario fault_gnss_step --scenario fault_accel_clip --runs 5 --out out/faults_short"
     )]

@@ -21,7 +21,13 @@
 //!   that expectation; outside 4σ a consistent filter is 0.0063 % of the time, and that count
 //!   is the check that the navigator never calls a wrong quantity valid. Errors are correlated
 //!   in time, so one excursion covers many consecutive epochs: the counts come in bursts.
-//! * **ATE**: the SE(3)-aligned ATE RMSE of the run ([`crate::metrics`]).
+//! * **ATE**: the SE(3)-aligned ATE RMSE of the run ([`crate::metrics`]). Through a GNSS
+//!   outage the navigator dead-reckons on the IMU alone and its position error grows without
+//!   bound, so the ATE of a run with an outage is mostly that drift; beside it the bench gives
+//!   the ATE outside the outages ([`ate_outside`]: the SE(3)-aligned ATE of the estimate–truth
+//!   pairs whose time is outside every `gnss outage` interval, each extended to the first epoch
+//!   where the GNSS is fused again, aligned on those pairs alone), the figure to set beside the
+//!   other scenarios' ATE.
 //!
 //! **Latency** ([`LATENCY_SCENARIO`]): the scenario replayed (a) as it is, each fix fused at its
 //! validity time, through [`crate::montecarlo::run_from`], which also gives the position ANEES
@@ -37,12 +43,12 @@ pub mod score;
 
 use crate::dataset::read::{read_faults, FaultInterval};
 use crate::dataset::write::simulate;
-use crate::metrics::trajectory::{Alignment, Stats};
-use crate::metrics::Metrics;
+use crate::metrics::trajectory::{self, Alignment, PosePair, Stats};
+use crate::metrics::{Metrics, Scorer};
 use crate::montecarlo::{BandResult, DEFAULT_SETTLE_S};
-use crate::replay::{replay, ReplayConfig};
+use crate::progress::{Mode, Progress};
+use crate::replay::{replay, replay_scored, ReplayConfig};
 use crate::scenario::Scenario;
-use indicatif::{ProgressBar, ProgressStyle};
 use score::{FalseValid, FaultRule, Tally, QUANTITIES};
 use serde_json::{json, Map, Value};
 use std::fmt::Write as _;
@@ -86,7 +92,8 @@ pub struct Options {
     /// A folder for the runs' datasets and outputs: each run writes into a subfolder of its
     /// own and removes it when scored.
     pub scratch: PathBuf,
-    /// Show progress bars on stderr.
+    /// Show progress on stderr ([`crate::progress`]: a bar on a terminal, a line every few
+    /// seconds off one).
     pub progress: bool,
 }
 
@@ -122,6 +129,9 @@ pub struct RunResult {
     pub false_valid: FalseValid,
     /// SE(3)-aligned ATE RMSE, m.
     pub ate_m: Option<f64>,
+    /// With a GNSS outage among the faults: the SE(3)-aligned ATE RMSE of the samples outside
+    /// every outage, each up to the first epoch with the GNSS fused again ([`ate_outside`]), m; `None` without an outage (or no sample outside).
+    pub ate_outside_outage_m: Option<f64>,
     /// IMU epochs in `validity.csv`.
     pub epochs: usize,
 }
@@ -157,6 +167,11 @@ pub struct Summary {
     pub false_valid: FalseValid,
     /// ATE RMSE over the runs, m.
     pub ate: Option<Stats>,
+    /// Whether the scenario's runs hold a GNSS outage (their ATE includes the dead reckoning
+    /// through it).
+    pub gnss_outage: bool,
+    /// ATE RMSE outside the GNSS outages over the runs, m ([`RunResult::ate_outside_outage_m`]).
+    pub ate_outside_outage: Option<Stats>,
 }
 
 /// The latency comparison over the seeds.
@@ -249,6 +264,28 @@ fn ate_se3(m: &Metrics) -> Option<f64> {
         .map(|a| a.stats.rmse)
 }
 
+/// The SE(3)-aligned ATE RMSE (`√(Σ‖R p̂ᵢ + t − pᵢ‖²/n)` after Umeyama's alignment, as
+/// [`trajectory::ate`]) of the `pairs` whose time is outside every interval of `outside`
+/// (`[start, end)`, ns), the alignment made on those pairs alone; `None` when no pair is left.
+#[must_use]
+pub fn ate_outside(pairs: &[PosePair], outside: &[(u64, u64)]) -> Option<f64> {
+    let kept: Vec<PosePair> = pairs
+        .iter()
+        .filter(|p| !outside.iter().any(|&(a, b)| p.t_ns >= a && p.t_ns < b))
+        .copied()
+        .collect();
+    trajectory::ate(&kept, Alignment::Se3).map(|a| a.stats.rmse)
+}
+
+/// The end of the dead reckoning through a GNSS outage ending at `end_ns`: the first epoch at
+/// or after it where the GNSS is fused again (`u64::MAX` when none is), so that the samples
+/// dead-reckoned while the first fix after the outage is awaited count with the outage.
+fn dead_reckoning_end(eps: &[epochs::Epoch], end_ns: u64) -> u64 {
+    eps.iter()
+        .find(|e| e.t_ns >= end_ns && e.gnss == epochs::AidStatus::Fused)
+        .map_or(u64::MAX, |e| e.t_ns)
+}
+
 /// The replay configuration of a bench run: the scenario's, plots off.
 fn bench_config(sc: &Scenario) -> ReplayConfig {
     ReplayConfig {
@@ -275,10 +312,29 @@ fn simulate_and_replay(
 /// # Errors
 /// A failed simulation or replay, or outputs that cannot be read back.
 pub fn run_one(sc: &Scenario, seed: u64, dir: &Path) -> Result<RunResult, String> {
-    let m = simulate_and_replay(sc, seed, &bench_config(sc), dir)?;
     let ds = dir.join("dataset");
+    simulate(sc, seed, &ds).map_err(|e| e.to_string())?;
+    let scorer = replay_scored(
+        &ds,
+        &dir.join("replay"),
+        &bench_config(sc),
+        &sc.name,
+        Scorer::default(),
+    )
+    .map_err(|e| e.to_string())?;
+    let m = scorer.metrics();
     let eps = epochs::read_epochs(&dir.join("replay"), &ds)?;
     let faults = read_faults(&ds).map_err(|e| e.to_string())?;
+    let outages: Vec<(u64, u64)> = faults
+        .iter()
+        .filter(|f| FaultRule::of(f) == Some(FaultRule::GnssOutage))
+        .map(|f| (f.start_ns, dead_reckoning_end(&eps, f.end_ns)))
+        .collect();
+    let ate_outside_outage_m = if outages.is_empty() {
+        None
+    } else {
+        ate_outside(scorer.pairs(), &outages)
+    };
     let secs = |ns: u64| ns.saturating_sub(sc.start_ns) as f64 * 1e-9;
     let faults = faults
         .into_iter()
@@ -301,6 +357,7 @@ pub fn run_one(sc: &Scenario, seed: u64, dir: &Path) -> Result<RunResult, String
         faults,
         false_valid: score::false_valid(&eps),
         ate_m: ate_se3(&m),
+        ate_outside_outage_m,
         epochs: eps.len(),
     })
 }
@@ -315,7 +372,8 @@ enum Job<'a> {
 }
 
 enum JobOut {
-    Bench(RunResult),
+    // Boxed: a run's result is large beside an ATE.
+    Bench(Box<RunResult>),
     Ate(f64),
 }
 
@@ -323,7 +381,7 @@ impl Job<'_> {
     fn run(&self, dir: &Path) -> Result<JobOut, String> {
         match self {
             Job::Bench(sc, seed) => run_one(sc, *seed, dir)
-                .map(JobOut::Bench)
+                .map(|r| JobOut::Bench(Box::new(r)))
                 .map_err(|e| format!("{} seed {seed}: {e}", sc.name)),
             Job::Ate(_, sc, cfg, seed) => simulate_and_replay(sc, *seed, cfg, dir)
                 .and_then(|m| ate_se3(&m).ok_or_else(|| "no ATE".to_string()))
@@ -340,19 +398,6 @@ impl Job<'_> {
     }
 }
 
-fn bar(len: usize, progress: bool, what: &str) -> ProgressBar {
-    let bar = if progress {
-        ProgressBar::new(len as u64)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template(&format!("{{bar:40}} {{pos}}/{{len}} {what} ({{elapsed}})"))
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar
-}
-
 /// Runs `jobs` on `workers` threads, each job in `scratch/job-<i>` (removed after it); stops
 /// handing out jobs at the first failure, which it returns.
 fn run_pool(
@@ -361,7 +406,12 @@ fn run_pool(
     scratch: &Path,
     progress: bool,
 ) -> Result<Vec<JobOut>, String> {
-    let bar = bar(jobs.len(), progress, "runs");
+    let bar = Progress::new(
+        "faults",
+        "runs",
+        jobs.len() as u64,
+        Mode::for_stderr(progress),
+    );
     // Longest first, so that no worker is left with a long run at the end.
     let mut order: Vec<usize> = (0..jobs.len()).collect();
     order.sort_by(|&a, &b| jobs[b].duration_s().total_cmp(&jobs[a].duration_s()));
@@ -390,7 +440,7 @@ fn run_pool(
             });
         }
     });
-    bar.finish_and_clear();
+    bar.finish();
     let all = results
         .into_inner()
         .map_err(|_| "a worker panicked".to_string())?;
@@ -415,6 +465,12 @@ fn summarize(sc: &Scenario, runs: &[RunResult]) -> Vec<Summary> {
         fv.add(&r.false_valid);
     }
     let ates: Vec<f64> = runs.iter().filter_map(|r| r.ate_m).collect();
+    let outside: Vec<f64> = runs.iter().filter_map(|r| r.ate_outside_outage_m).collect();
+    let gnss_outage = runs.iter().any(|r| {
+        r.faults
+            .iter()
+            .any(|f| f.rule == Some(FaultRule::GnssOutage))
+    });
     let base = Summary {
         scenario: sc.name.clone(),
         precision: sc.replay.precision.clone(),
@@ -429,6 +485,8 @@ fn summarize(sc: &Scenario, runs: &[RunResult]) -> Vec<Summary> {
         over_target: Vec::new(),
         false_valid: fv,
         ate: Stats::of(&ates),
+        gnss_outage,
+        ate_outside_outage: Stats::of(&outside),
     };
     let faults = runs.first().map_or(0, |r| r.faults.len());
     if faults == 0 {
@@ -536,7 +594,7 @@ pub fn run(opts: &Options) -> Result<FaultBench, String> {
     let mut ate_variants: [Vec<f64>; 3] = Default::default();
     for (job, out) in jobs.iter().zip(outs) {
         match (job, out) {
-            (Job::Bench(..), JobOut::Bench(r)) => per_run.push(r),
+            (Job::Bench(..), JobOut::Bench(r)) => per_run.push(*r),
             (Job::Ate(k, ..), JobOut::Ate(a)) => ate_variants[*k].push(a),
             _ => return Err("a run returned the wrong kind of result".into()),
         }
@@ -636,6 +694,26 @@ impl Summary {
 }
 
 impl FaultBench {
+    /// One line per scenario with a GNSS outage: its ATE includes the dead reckoning through
+    /// the outage; the ATE outside it beside it.
+    fn outage_lines(&self) -> Vec<String> {
+        let mut seen = std::collections::BTreeSet::new();
+        self.summaries
+            .iter()
+            .filter(|s| s.gnss_outage && seen.insert(s.scenario.clone()))
+            .map(|s| {
+                let outside = match &s.ate_outside_outage {
+                    Some(a) => format!("{:.3} / {:.3} m", a.mean, a.max),
+                    None => "not computed (no sample outside it)".into(),
+                };
+                format!(
+                    "{}: the ATE includes the IMU-only dead reckoning through the GNSS outage; ATE outside it (until the first fix fused after it; SE(3)-aligned on those samples), mean / max: {outside}",
+                    s.scenario
+                )
+            })
+            .collect()
+    }
+
     /// The seeds of each scenario's runs.
     #[must_use]
     pub fn seeds(&self) -> Vec<u64> {
@@ -720,6 +798,9 @@ recovery: s from its end until the sensor is fused and the quantity valid within
             );
         }
         let _ = writeln!(t, "  (times in s, ATE SE(3)-aligned RMSE in m; >3σ / >4σ: false-valid epoch-axes summed over the runs / what a consistent Gaussian filter shows)");
+        for s in self.outage_lines() {
+            let _ = writeln!(t, "  {s}");
+        }
         let mut notes = Vec::new();
         for s in &self.summaries {
             let name = &s.scenario;
@@ -856,7 +937,7 @@ recovery: s from its end until the sensor is fused and the quantity valid within
 
     /// `faults.csv`: one row per run and fault (one per run for a scenario without faults):
     /// scenario, seed, the fault, its detection and recovery time (empty: not measured or never
-    /// reached), the epochs alarmed before it, the recovery target, the ATE, and per quantity
+    /// reached), the epochs alarmed before it, the recovery target, the ATE and (with a GNSS outage) the ATE outside it, and per quantity
     /// the valid epoch-axes and those outside 3σ and 4σ.
     ///
     /// # Errors
@@ -876,6 +957,7 @@ recovery: s from its end until the sensor is fused and the quantity valid within
             "recovery_s",
             "recovery_target_s",
             "ate_m",
+            "ate_outside_gnss_outage_m",
         ]
         .iter()
         .map(|s| (*s).to_string())
@@ -888,7 +970,11 @@ recovery: s from its end until the sensor is fused and the quantity valid within
         w.write_record(&header).map_err(err)?;
         let cell = |x: Option<f64>| x.filter(|v| v.is_finite()).map_or(String::new(), seconds);
         for r in &self.per_run {
-            let mut tail = vec![r.ate_m.map_or(String::new(), |a| a.to_string())];
+            let mut tail = vec![
+                r.ate_m.map_or(String::new(), |a| a.to_string()),
+                r.ate_outside_outage_m
+                    .map_or(String::new(), |a| a.to_string()),
+            ];
             for t in &r.false_valid.quantities {
                 tail.push(t.valid_epoch_axes.to_string());
                 tail.push(t.outside_3sigma.to_string());
@@ -987,6 +1073,8 @@ recovery: s from its end until the sensor is fused and the quantity valid within
                     })),
                     "false_valid": Value::Object(fv),
                     "ate_se3_rmse_m": stats(&s.ate),
+                    "ate_note": s.gnss_outage.then_some("includes the IMU-only dead reckoning through the GNSS outage; ate_outside_gnss_outage_se3_rmse_m leaves out the outage and the samples until the first fix fused after it"),
+                    "ate_outside_gnss_outage_se3_rmse_m": if s.gnss_outage { stats(&s.ate_outside_outage) } else { Value::Null },
                 })
             })
             .collect();
@@ -1072,5 +1160,67 @@ fn fraction(t: &Tally) -> String {
             "{:.3} %",
             100.0 * t.outside_3sigma as f64 / t.valid_epoch_axes as f64
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::metrics::trajectory::Pose;
+    use estimator_core::lie::{LieGroup, So3};
+    use nalgebra::Vector3;
+
+    /// An estimate exact outside `[10, 20)` s and 5 m off inside: the ATE outside the interval
+    /// is 0 (to rounding), the whole run's is not.
+    #[test]
+    fn ate_outside_leaves_the_interval_out() {
+        let pairs: Vec<PosePair> = (0..30u64)
+            .map(|k| {
+                let t_ns = k * 1_000_000_000;
+                let truth = Pose {
+                    position: Vector3::new(k as f64, (k * k) as f64 * 0.1, 0.5 * k as f64),
+                    attitude: So3::identity(),
+                };
+                let off = if (10..20).contains(&k) { 5.0 } else { 0.0 };
+                let estimate = Pose {
+                    position: truth.position + Vector3::new(0.0, off, 0.0),
+                    ..truth
+                };
+                PosePair {
+                    t_ns,
+                    estimate,
+                    truth,
+                }
+            })
+            .collect();
+        let interval = [(10_000_000_000, 20_000_000_000)];
+        let outside = ate_outside(&pairs, &interval).expect("pairs left");
+        let whole = trajectory::ate(&pairs, Alignment::Se3)
+            .expect("ate")
+            .stats
+            .rmse;
+        assert!(outside < 1e-9, "{outside}");
+        assert!(whole > 0.5, "{whole}");
+        assert_eq!(ate_outside(&pairs[10..20], &interval), None);
+    }
+
+    /// The dead reckoning lasts until the first epoch at or after the outage's end with the
+    /// GNSS fused, or to the end of the run.
+    #[test]
+    fn dead_reckoning_ends_at_the_first_fused_fix() {
+        let eps: Vec<epochs::Epoch> = (0..10u64)
+            .map(|k| {
+                let mut e = epochs::Epoch::nominal(k * 100);
+                e.gnss = if k == 2 || k >= 7 {
+                    epochs::AidStatus::Fused
+                } else {
+                    epochs::AidStatus::Stale
+                };
+                e
+            })
+            .collect();
+        assert_eq!(dead_reckoning_end(&eps, 500), 700);
+        assert_eq!(dead_reckoning_end(&eps, 700), 700);
+        assert_eq!(dead_reckoning_end(&eps, 1_000), u64::MAX);
     }
 }

@@ -1,7 +1,7 @@
 //! `host-sim montecarlo`: filter consistency over seeds.
 //!
 //! Each run simulates the scenario with its own seed and replays it (in parallel with `rayon`,
-//! with an `indicatif` progress bar). Two tests, each against its 95 % chi-square band:
+//! with progress on stderr, [`crate::progress`]). Two tests, each against its 95 % chi-square band:
 //!
 //! * **NEES per block** (attitude, velocity, position, biases). At each sample `k` the average
 //!   over the `N` runs, `ε̄_k = (1/N) Σ εᵢ_k`, has `N ε̄_k ~ χ²(3N)` for a consistent filter
@@ -21,10 +21,10 @@
 
 use crate::dataset::write::simulate;
 use crate::metrics::{Metrics, Scorer, BLOCKS};
+use crate::progress::{Mode, Progress};
 use crate::replay::{replay_scored, ReplayConfig};
 use crate::scenario::Scenario;
 use crate::stats::chi2_quantile;
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde_json::{json, Map, Value};
 use std::collections::BTreeSet;
@@ -415,15 +415,7 @@ pub fn run_from(
         std::process::id(),
         scenario.name.replace('/', "_")
     ));
-    let bar = if progress {
-        ProgressBar::new(runs)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} runs ({elapsed})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = Progress::new("montecarlo", "runs", runs, Mode::for_stderr(progress));
     let cfg = ReplayConfig {
         plots: false,
         ..scenario.replay.clone()
@@ -446,7 +438,7 @@ pub fn run_from(
             r
         })
         .collect();
-    bar.finish_and_clear();
+    bar.finish();
     let _ = std::fs::remove_dir_all(&base);
     let scorers: Vec<Scorer> = results.into_iter().collect::<Result<_, _>>()?;
     let n = scorers.len();

@@ -273,8 +273,10 @@ else
     || { cat "$OUT/nopanic-selftest.log"; fail "no-panic self-test failed for another reason"; }
 fi
 
-# The starter (src/bin/starter.rs): the attitude and INS navigators in a main loop, the file
-# a user copies. It must build and pass its own check under QEMU.
+# The starter: src/starter.rs (the attitude and INS navigators in a main loop, the file a user
+# copies as a fresh cortex-m-rt crate's src/main.rs) inside src/bin/starter.rs (the QEMU board's
+# vector table). It must build and pass its own check under QEMU. That it builds as a fresh
+# crate is checked by firmware/tools/starter-check.sh (needs crates.io).
 step "starter firmware: builds, runs under QEMU, passes its check"
 if cargo build-m4 --release --bin starter 2> "$OUT/starter.log" \
   && timeout 120 qemu-system-arm -machine mps2-an386 -cpu cortex-m4 -nographic -monitor none \

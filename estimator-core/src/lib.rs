@@ -20,6 +20,25 @@
 //! The crate re-exports the [`nalgebra`] it is built with, so a user's matrices are always of
 //! the same version: `use estimator_core::nalgebra::Vector3;`.
 //!
+//! # Where to start
+//!
+//! * A firmware main loop calls a navigator ([`nav`]), one timestamped sample at a time:
+//!   [`nav::AttitudeNavigator`] (attitude and gyro bias from gyro, accelerometer and an optional
+//!   magnetometer: an AHRS) or [`nav::InsNavigator`] (position, velocity, attitude and IMU
+//!   biases from an IMU and GNSS, with delayed and out-of-order measurements and fault
+//!   handling). The [`nav`] module docs are the tuning guide.
+//! * For a Cortex-M firmware crate: `firmware/src/starter.rs` in the repository is a main loop
+//!   with both navigators, to copy unchanged as the `src/main.rs` of a fresh `cortex-m-rt`
+//!   crate; `firmware/README.md`, "Starting your own firmware", gives every step (the crate is
+//!   not on a registry: depend by path or git; minimum Rust 1.89).
+//! * The examples: `examples/main_loop.rs` (both navigators in a firmware-style loop on the
+//!   host: `cargo run --release -p estimator-core --example main_loop`) and
+//!   `examples/lie_tour.rs` (the Lie groups at work).
+//! * Below the navigators: the filters ([`eskf::Ins`], [`eskf::Ahrs`]) for your own sensor
+//!   policy, and [`gn`] for batch problems such as [`gn::solve_pnp`].
+//!
+//! The crate's README (a first example) is compiled as a doctest.
+//!
 //! Where things go: a new measurement model is one file in `eskf/models/` (plus its Jacobian
 //! test in `tests/eskf_jacobians.rs`), a new Lie group one file in `lie/` (plus its entry in the
 //! battery of `tests/lie_battery.rs`), a new kernel one file in `kernels/` with its reference
@@ -43,3 +62,8 @@ mod test_support;
 
 pub use nalgebra;
 pub use scalar::Real;
+
+// The README's example is compiled and run with the doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

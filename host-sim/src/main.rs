@@ -82,6 +82,7 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             scorer.provenance.seed = Some(seed);
             scorer.provenance.dataset = Some(out.join("dataset").display().to_string());
             let m = replay_scored(&dataset, staging.dir(), &cfg, &sc.name, scorer)?.metrics();
+            print_data_warnings(&m);
             staging.commit()?;
             print_summary(&sc.name, Some(seed), &cfg, &m, &out, None);
             Ok(())
@@ -115,6 +116,7 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                 .map_or("dataset".into(), |n| n.to_string_lossy().into_owned());
             let staging = Staging::new(&out, force, "replay")?;
             let m = replay(&dataset, staging.dir(), &cfg, &title)?;
+            print_data_warnings(&m);
             let truth = dataset.join("state_groundtruth_estimate0/data.csv");
             if m.samples_scored == 0 && truth.is_file() {
                 return Err(format!(
@@ -156,6 +158,9 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                 p.finish();
             }
             let report = report?;
+            for w in &report.data_warnings {
+                eprintln!("warning: {w}");
+            }
             out!("{}", report.render().trim_start());
             out!("outputs in {}", opts.out.display());
             let failures = report.failures();
@@ -184,6 +189,9 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             }
             let staging = Staging::new(&out, force, "calibrate")?;
             let cal = host_sim::calibrate::calibrate(&dir, from, to)?;
+            for w in &cal.data_warnings {
+                eprintln!("warning: {w}");
+            }
             cal.write(staging.dir())?;
             staging.commit()?;
             out!("{}", cal.table());
@@ -224,6 +232,9 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             };
             let settle = host_sim::montecarlo::DEFAULT_SETTLE_S;
             let report = host_sim::montecarlo::run_from(&sc, seed, runs, settle, true)?;
+            for line in report.data_warning_lines() {
+                eprintln!("{line}");
+            }
             let command_line: Vec<String> = std::env::args_os()
                 .map(|a| a.to_string_lossy().into_owned())
                 .collect();
@@ -247,6 +258,14 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             }
             Ok(())
         }
+    }
+}
+
+/// What the data had wrong that the run survived, one `warning: FILE:LINE: message` line each
+/// on stderr.
+fn print_data_warnings(m: &Metrics) {
+    for w in &m.data_warnings {
+        eprintln!("warning: {w}");
     }
 }
 
@@ -369,6 +388,12 @@ fn print_summary(
     }
     for w in &m.warnings {
         out!("  warning: {w}");
+    }
+    if !m.data_warnings.is_empty() {
+        let n = m.data_warnings.len();
+        out!(
+            "  warning: {n} about the data (gaps, a cut line, unused samples), each on stderr and in metrics.json (data_warnings)"
+        );
     }
     for n in cli::notes::consistency_notes(cfg, m, seed.is_some()) {
         out!("  note: {n}");

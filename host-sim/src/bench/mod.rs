@@ -22,6 +22,7 @@
 //! A figure that was not computed (no reference, nothing scored, a failed run) is printed `–`
 //! and written `null`, never as a number. `OUT/bench.json` holds every figure of the tables.
 
+use crate::dataset::check::DataWarning;
 use crate::metrics::Metrics;
 use crate::output::{OutputError, Staging};
 use crate::replay::{replay_scored, ReplayConfig};
@@ -298,6 +299,9 @@ pub struct Report {
     pub config: Option<PathBuf>,
     /// One table per parent folder.
     pub tables: Vec<Table>,
+    /// What the datasets had wrong that their runs survived, dataset by dataset
+    /// ([`crate::dataset::check`]); each dataset's `metrics.json` holds its own.
+    pub data_warnings: Vec<DataWarning>,
 }
 
 /// One dataset's run.
@@ -608,11 +612,17 @@ pub fn run(
             rows,
         });
     }
+    let data_warnings = outcomes
+        .iter()
+        .filter_map(|o| o.result.as_ref().ok())
+        .flat_map(|m| m.data_warnings.iter().cloned())
+        .collect();
     let report = Report {
         dir: opts.dir.clone(),
         out: opts.out.clone(),
         config: opts.config.clone(),
         tables,
+        data_warnings,
     };
     let json_path = staging.dir().join("bench.json");
     let json = serde_json::to_string_pretty(&report).map_err(|e| BenchError::Write {

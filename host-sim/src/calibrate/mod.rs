@@ -85,6 +85,7 @@
 //!   Methods", *35th Annual Symposium on Frequency Control*, 1981 (degrees of freedom of the
 //!   overlapping estimator).
 
+use crate::dataset::check::DataWarning;
 use crate::dataset::read::Rows;
 use crate::dataset::DatasetError;
 use serde::Serialize;
@@ -556,6 +557,9 @@ pub struct Calibration {
     pub mag: Option<Recording>,
     /// The magnetometer, when present.
     pub magnetometer: Option<SensorCalibration>,
+    /// What the files had wrong that the calibration survived (a last line cut short and
+    /// skipped), each with its file and line.
+    pub data_warnings: Vec<DataWarning>,
 }
 
 /// Why calibration failed.
@@ -589,6 +593,8 @@ pub enum CalibrateError {
 struct Series {
     t_ns: Vec<u64>,
     axes: Vec<Vec<f64>>,
+    /// What the reader skipped or doubts (a last line cut short).
+    warnings: Vec<DataWarning>,
 }
 
 /// Reads the rows of `path` whose time is in `[from, to]` ns (absolute), keeping the
@@ -598,6 +604,7 @@ fn read_interval(path: &Path, columns: usize, from: u64, to: u64) -> Result<Seri
     let mut series = Series {
         t_ns: Vec::new(),
         axes: vec![Vec::new(); columns - 1],
+        warnings: Vec::new(),
     };
     while let Some((_, t, v)) = rows.next_row()? {
         if t > to {
@@ -610,6 +617,7 @@ fn read_interval(path: &Path, columns: usize, from: u64, to: u64) -> Result<Seri
             }
         }
     }
+    series.warnings = rows.warnings().to_vec();
     Ok(series)
 }
 
@@ -740,9 +748,11 @@ pub fn calibrate(
         &imu_path,
     )?;
 
+    let mut data_warnings = imu.warnings.clone();
     let mag_path = dir.join("mag0/data.csv");
     let (mag, magnetometer) = if mag_path.is_file() {
         let s = read_interval(&mag_path, 4, from_ns, to_ns)?;
+        data_warnings.extend(s.warnings.iter().cloned());
         let rec = recording("mag0/data.csv", &mag_path, &s, origin)?;
         let cal = sensor(
             "magnetometer",
@@ -764,6 +774,7 @@ pub fn calibrate(
         accelerometer,
         mag,
         magnetometer,
+        data_warnings,
     })
 }
 

@@ -62,6 +62,9 @@ pub fn execute(a: Args) -> Result<(), Box<dyn std::error::Error>> {
     };
     let bench = host_sim::faults::run(&opts)?;
     drop(scratch);
+    for line in bench.data_warning_lines() {
+        eprintln!("{line}");
+    }
     let command_line: Vec<String> = std::env::args_os()
         .map(|x| x.to_string_lossy().into_owned())
         .collect();

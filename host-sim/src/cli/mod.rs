@@ -97,7 +97,9 @@ Example: host-sim simulate --scenario car --seed 3 --out data/car"
     #[command(
         after_help = "Reads DATASET (EuRoC layout: imu0/ required; mag0/, gnss0/, cam0/, baro0/, \
 state_groundtruth_estimate0/ when present) and its replay.toml unless --config is given.\n\
-Writes into --out the same files as `run` (without dataset/).\n\n\
+Writes into --out the same files as `run` (without dataset/).\n\
+What the data has wrong that the replay survives (a last line cut short, gaps, a sensor starting late or stopping early, \
+samples the navigator refused) is printed on stderr as `warning: FILE:LINE: message` and kept in metrics.json (data_warnings).\n\n\
 Example: host-sim replay data/car --out out/car"
     )]
     Replay {

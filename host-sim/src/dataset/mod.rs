@@ -29,7 +29,10 @@
 //! IMU alone. `leica0/`, `body.yaml` and other files are not read.
 //!
 //! Errors name the file and the line, in one line: `imu0/data.csv:17: expected 7 columns, got 6`.
+//! What the reader survives is a warning, named the same way ([`check::DataWarning`]): a last
+//! line cut short, gaps, sensors that start late or stop early, refused samples.
 
+pub mod check;
 pub mod read;
 pub mod write;
 pub mod yaml;

@@ -1,12 +1,14 @@
 //! Reading a dataset folder as one time-ordered stream of sensor events, holding one row of
 //! look-ahead per file (memory does not grow with the run).
 
+use super::check::{DataCheck, DataWarning, Sensor};
 use super::yaml::SensorYaml;
 use super::DatasetError;
 use estimator_core::lie::{LieGroup, Se3, So3};
 use nalgebra::{Matrix4, Vector2, Vector3};
 use std::collections::HashMap;
 use std::fs::File;
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
 /// IMU noise parameters from `imu0/sensor.yaml` (continuous time, Kalibr units).
@@ -85,6 +87,9 @@ pub struct Dataset {
     pub movement: Option<Vec<(u64, u64)>>,
     /// What a missing optional file made the reader assume (printed in the summary).
     pub warnings: Vec<String>,
+    /// What the files read on opening (`cam0/landmarks.csv`, `movement.csv`) had wrong that
+    /// was survived (a cut last line).
+    pub data_warnings: Vec<DataWarning>,
 }
 
 /// One sensor event.
@@ -151,106 +156,134 @@ impl Event {
 
 /// A CSV file read row by row, with its header skipped and every row checked for its column
 /// count, numbers and strictly (or, for camera frames, weakly) increasing timestamps.
+///
+/// A last line without its newline may have been cut short (a recording stopped while
+/// writing): when it does not parse, it is skipped with a warning rather than refused; when it
+/// parses, it is used, with a warning. Any other malformed line is an error.
 pub struct Rows {
     path: PathBuf,
-    reader: csv::Reader<File>,
-    record: csv::StringRecord,
+    reader: BufReader<File>,
+    buf: Vec<u8>,
+    line: u64,
     columns: usize,
     last_t: Option<u64>,
     allow_equal: bool,
+    warnings: Vec<DataWarning>,
 }
 
 impl Rows {
     /// Opens `path`, expecting `columns` columns.
     pub fn open(path: &Path, columns: usize, allow_equal: bool) -> Result<Self, DatasetError> {
         let file = File::open(path).map_err(|e| DatasetError::file(path, e))?;
-        let reader = csv::ReaderBuilder::new()
-            .has_headers(false)
-            .flexible(true)
-            .trim(csv::Trim::All)
-            .from_reader(file);
         Ok(Self {
             path: path.to_path_buf(),
-            reader,
-            record: csv::StringRecord::new(),
+            reader: BufReader::new(file),
+            buf: Vec::new(),
+            line: 0,
             columns,
             last_t: None,
             allow_equal,
+            warnings: Vec::new(),
         })
+    }
+
+    /// What was skipped or may be wrong so far (a cut last line).
+    #[must_use]
+    pub fn warnings(&self) -> &[DataWarning] {
+        &self.warnings
     }
 
     /// The next data row as `(line, timestamp, values)`; `None` at the end.
     pub fn next_row(&mut self) -> Result<Option<(u64, u64, Vec<f64>)>, DatasetError> {
         loop {
-            let more = self.reader.read_record(&mut self.record).map_err(|e| {
-                let line = e.position().map_or(0, |p| p.line());
-                DatasetError::at(&self.path, line, e.to_string())
-            })?;
-            if !more {
+            self.buf.clear();
+            let n = self
+                .reader
+                .read_until(b'\n', &mut self.buf)
+                .map_err(|e| DatasetError::at(&self.path, self.line + 1, e.to_string()))?;
+            if n == 0 {
                 return Ok(None);
             }
-            let line = self.record.position().map_or(0, |p| p.line());
-            let first = self.record.get(0).unwrap_or("");
-            // The header: the first line, starting with '#' or not a number.
-            if line == 1 && (first.starts_with('#') || first.parse::<u64>().is_err()) {
-                continue;
-            }
-            if first.is_empty() && self.record.len() <= 1 {
-                continue; // blank line
-            }
-            if self.record.len() != self.columns {
-                return Err(DatasetError::at(
-                    &self.path,
-                    line,
-                    format!(
-                        "expected {} columns, got {}",
-                        self.columns,
-                        self.record.len()
-                    ),
-                ));
-            }
-            let t: u64 = first.parse().map_err(|_| {
-                DatasetError::at(
-                    &self.path,
-                    line,
-                    format!("timestamp '{first}' is not an integer number of ns"),
-                )
-            })?;
-            if let Some(last) = self.last_t {
-                if t < last || (t == last && !self.allow_equal) {
-                    let what = if t == last {
-                        "duplicated"
-                    } else {
-                        "non-monotonic"
-                    };
-                    return Err(DatasetError::at(
-                        &self.path,
-                        line,
-                        format!("{what} timestamp {t} (previous {last})"),
-                    ));
+            self.line += 1;
+            let line = self.line;
+            // Only the last line can lack its newline.
+            let cut = self.buf.last() != Some(&b'\n');
+            match self.parse(line) {
+                Ok(None) => {}
+                Ok(Some((t, values))) => {
+                    self.last_t = Some(t);
+                    if cut {
+                        self.warnings.push(DataWarning::new(
+                            &self.path,
+                            Some(line),
+                            "the file ends inside this line (no newline): it may be cut short; it parses, so it is used",
+                        ));
+                    }
+                    return Ok(Some((line, t, values)));
                 }
-            }
-            self.last_t = Some(t);
-            let mut values = Vec::with_capacity(self.columns - 1);
-            for (i, field) in self.record.iter().enumerate().skip(1) {
-                let v: f64 = field.parse().map_err(|_| {
-                    DatasetError::at(
+                Err(message) if cut => {
+                    self.warnings.push(DataWarning::new(
                         &self.path,
-                        line,
-                        format!("column {}: '{field}' is not a number", i + 1),
-                    )
-                })?;
-                if !v.is_finite() {
-                    return Err(DatasetError::at(
-                        &self.path,
-                        line,
-                        format!("column {}: '{field}' is not finite", i + 1),
+                        Some(line),
+                        format!("the file ends inside this line (no newline) and it does not parse ({message}): taken as cut off and skipped"),
                     ));
+                    return Ok(None);
                 }
-                values.push(v);
+                Err(message) => return Err(DatasetError::at(&self.path, line, message)),
             }
-            return Ok(Some((line, t, values)));
         }
+    }
+
+    /// The row in the buffer: `None` for the header or a blank line, else its timestamp and
+    /// values; what is wrong with it otherwise.
+    fn parse(&self, line: u64) -> Result<Option<(u64, Vec<f64>)>, String> {
+        let text = std::str::from_utf8(&self.buf).map_err(|_| "not UTF-8 text".to_string())?;
+        // A byte-order mark some tools write first.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text).trim();
+        if text.is_empty() {
+            return Ok(None); // blank line
+        }
+        let mut fields = text.split(',').map(|f| {
+            let f = f.trim();
+            // A quoted field, as a CSV writer may quote it.
+            f.strip_prefix('"')
+                .and_then(|g| g.strip_suffix('"'))
+                .map_or(f, str::trim)
+        });
+        let first = fields.next().unwrap_or("");
+        // The header: the first line, starting with '#' or not a number.
+        if line == 1 && (first.starts_with('#') || first.parse::<u64>().is_err()) {
+            return Ok(None);
+        }
+        let count = text.split(',').count();
+        if count != self.columns {
+            return Err(format!("expected {} columns, got {count}", self.columns));
+        }
+        let t: u64 = first
+            .parse()
+            .map_err(|_| format!("timestamp '{first}' is not an integer number of ns"))?;
+        if let Some(last) = self.last_t {
+            if t < last || (t == last && !self.allow_equal) {
+                let what = if t == last {
+                    "duplicated"
+                } else {
+                    "non-monotonic"
+                };
+                return Err(format!("{what} timestamp {t} (previous {last})"));
+            }
+        }
+        let mut values = Vec::with_capacity(self.columns - 1);
+        for (i, field) in fields.enumerate() {
+            let column = i + 2;
+            let v: f64 = field
+                .parse()
+                .map_err(|_| format!("column {column}: '{field}' is not a number"))?;
+            if !v.is_finite() {
+                return Err(format!("column {column}: '{field}' is not finite"));
+            }
+            values.push(v);
+        }
+        Ok(Some((t, values)))
     }
 }
 
@@ -270,6 +303,7 @@ impl Dataset {
         }
         let y = SensorYaml::read(&imu_yaml)?;
         let mut warnings = Vec::new();
+        let mut data_warnings = Vec::new();
         // Kalibr's sensor.yaml gives the IMU's pose in the body frame; the filter's body is the
         // IMU, and the ground truth is taken to be of the IMU.
         if let Ok(t) = y.list("T_BS", 16) {
@@ -357,6 +391,7 @@ impl Dataset {
                     ));
                 }
             }
+            data_warnings.extend_from_slice(rows.warnings());
             Some(CameraParams {
                 intrinsics: [k[0], k[1], k[2], k[3]],
                 body_from_camera,
@@ -384,11 +419,17 @@ impl Dataset {
             baro,
             has_groundtruth: dir.join("state_groundtruth_estimate0/data.csv").is_file(),
             warnings,
-            movement: movement(dir)?,
+            movement: {
+                let (m, w) = movement_checked(dir)?;
+                data_warnings.extend(w);
+                m
+            },
+            data_warnings,
         })
     }
 
-    /// The merged, time-ordered event stream.
+    /// The merged, time-ordered event stream, its data checked for a navigator whose largest
+    /// IMU step is 0.1 s ([`EventStream::with_max_dt`] sets another).
     pub fn events(&self) -> Result<EventStream, DatasetError> {
         let open = |rel: &str, cols: usize, eq: bool| -> Result<Option<Source>, DatasetError> {
             let p = self.dir.join(rel);
@@ -423,6 +464,9 @@ impl Dataset {
             } else {
                 None
             },
+            dir: self.dir.clone(),
+            check: DataCheck::new(0.1),
+            last: None,
         })
     }
 }
@@ -474,18 +518,80 @@ impl Source {
     }
 }
 
+/// The row an event came from.
+#[derive(Clone, Copy, Debug)]
+struct Origin {
+    sensor: Sensor,
+    t_ns: u64,
+    line: u64,
+}
+
 /// The merged stream: at equal timestamps the IMU comes first (the filter predicts to the
 /// measurement time, then updates).
+///
+/// It records the timing of every file as it goes; [`EventStream::refused`] adds what the
+/// navigator refused, and [`EventStream::finish`] turns both into warnings.
 pub struct EventStream {
     imu: Option<Source>,
     mag: Option<Source>,
     gnss: Option<Source>,
     cam: Option<Source>,
     baro: Option<Source>,
+    dir: PathBuf,
+    check: DataCheck,
+    last: Option<Origin>,
 }
 
 impl EventStream {
-    fn step(&mut self) -> Result<Option<Event>, DatasetError> {
+    /// This stream checked for a navigator whose largest IMU step is `max_dt_s` (an IMU
+    /// interval above it is a gap).
+    #[must_use]
+    pub fn with_max_dt(mut self, max_dt_s: f64) -> Self {
+        self.check = DataCheck::new(max_dt_s);
+        self
+    }
+
+    /// Records that the navigator refused the event last returned, counted under `key` in
+    /// `updates_refused`, for `reason`.
+    pub fn refused(&mut self, key: &str, reason: &dyn std::fmt::Display) {
+        if let Some(o) = self.last {
+            self.check
+                .refused(o.sensor, o.t_ns, o.line, key, &reason.to_string());
+        }
+    }
+
+    /// Ends the stream: the warnings of its files (a cut last line) and of its data (gaps,
+    /// sensors starting late or stopping early, refused samples, [`super::check`]), in file
+    /// and line order; `imu_gap_effect` says what the navigator does after an IMU gap.
+    ///
+    /// # Errors
+    /// No IMU sample at all: nothing to replay.
+    pub fn finish(self, imu_gap_effect: &str) -> Result<Vec<DataWarning>, DatasetError> {
+        let mut warnings: Vec<DataWarning> =
+            [&self.imu, &self.mag, &self.gnss, &self.cam, &self.baro]
+                .into_iter()
+                .flatten()
+                .flat_map(|s| s.rows.warnings().iter().cloned())
+                .collect();
+        if !self.check.has_imu() {
+            let path = self.dir.join(Sensor::Imu.file());
+            let cut = warnings
+                .iter()
+                .find(|w| w.file == path.display().to_string())
+                .map_or_else(String::new, |w| {
+                    format!(" (line {}: {})", w.line.unwrap_or(0), w.message)
+                });
+            return Err(DatasetError::file(
+                &path,
+                format!("no IMU sample: the file has no data row that parses{cut}"),
+            ));
+        }
+        warnings.extend(self.check.warnings(&self.dir, imu_gap_effect));
+        warnings.sort();
+        Ok(warnings)
+    }
+
+    fn step(&mut self) -> Result<Option<(Event, Origin)>, DatasetError> {
         let mut best: Option<(u64, usize)> = None;
         for (i, src) in [
             &mut self.imu,
@@ -509,28 +615,38 @@ impl EventStream {
             return Ok(None);
         };
         let take = |s: &mut Option<Source>| s.as_mut().and_then(|s| s.ahead.take());
-        Ok(match which {
-            0 => take(&mut self.imu).map(|(_, t, v)| Event::Imu {
-                t_ns: t,
-                gyro: v3(&v, 0),
-                accel: v3(&v, 3),
+        let origin = |sensor, line, t_ns| Origin { sensor, t_ns, line };
+        let produced = match which {
+            0 => take(&mut self.imu).map(|(line, t, v)| {
+                let e = Event::Imu {
+                    t_ns: t,
+                    gyro: v3(&v, 0),
+                    accel: v3(&v, 3),
+                };
+                (e, origin(Sensor::Imu, line, t))
             }),
-            1 => take(&mut self.mag).map(|(_, t, v)| Event::Mag {
-                t_ns: t,
-                field: v3(&v, 0),
+            1 => take(&mut self.mag).map(|(line, t, v)| {
+                let e = Event::Mag {
+                    t_ns: t,
+                    field: v3(&v, 0),
+                };
+                (e, origin(Sensor::Mag, line, t))
             }),
-            2 => take(&mut self.gnss).map(|(_, t, v)| Event::Gnss {
-                t_ns: t,
-                position: v3(&v, 0),
-                velocity: v3(&v, 3),
-                sigma_p: v[6],
-                sigma_v: v[7],
+            2 => take(&mut self.gnss).map(|(line, t, v)| {
+                let e = Event::Gnss {
+                    t_ns: t,
+                    position: v3(&v, 0),
+                    velocity: v3(&v, 3),
+                    sigma_p: v[6],
+                    sigma_v: v[7],
+                };
+                (e, origin(Sensor::Gnss, line, t))
             }),
             3 => {
                 let Some(src) = self.cam.as_mut() else {
                     return Ok(None);
                 };
-                let Some((_, t, v)) = src.ahead.take() else {
+                let Some((line, t, v)) = src.ahead.take() else {
                     return Ok(None);
                 };
                 let mut observations = vec![(v[0] as u64, Vector2::new(v[1], v[2]))];
@@ -539,23 +655,38 @@ impl EventStream {
                         observations.push((v[0] as u64, Vector2::new(v[1], v[2])));
                     }
                 }
-                Some(Event::Camera {
+                let e = Event::Camera {
                     t_ns: t,
                     observations,
-                })
+                };
+                Some((e, origin(Sensor::Camera, line, t)))
             }
-            _ => take(&mut self.baro).map(|(_, t, v)| Event::Baro {
-                t_ns: t,
-                altitude: v[0],
+            _ => take(&mut self.baro).map(|(line, t, v)| {
+                let e = Event::Baro {
+                    t_ns: t,
+                    altitude: v[0],
+                };
+                (e, origin(Sensor::Baro, line, t))
             }),
-        })
+        };
+        if let Some((_, o)) = &produced {
+            self.check.row(o.sensor, o.t_ns, o.line);
+        }
+        Ok(produced)
     }
 }
 
 impl Iterator for EventStream {
     type Item = Result<Event, DatasetError>;
     fn next(&mut self) -> Option<Self::Item> {
-        self.step().transpose()
+        match self.step() {
+            Ok(Some((event, origin))) => {
+                self.last = Some(origin);
+                Some(Ok(event))
+            }
+            Ok(None) => None,
+            Err(e) => Some(Err(e)),
+        }
     }
 }
 
@@ -589,6 +720,12 @@ impl TruthStream {
         })
     }
 
+    /// What was skipped or may be wrong so far (a cut last line).
+    #[must_use]
+    pub fn warnings(&self) -> &[DataWarning] {
+        self.rows.warnings()
+    }
+
     /// The next row.
     pub fn next_truth(&mut self) -> Result<Option<Truth>, DatasetError> {
         let Some((line, t, v)) = self.rows.next_row()? else {
@@ -607,22 +744,62 @@ impl TruthStream {
     }
 }
 
+/// Time intervals `[start, end]`, ns.
+pub type Intervals = Vec<(u64, u64)>;
+
 /// The intervals of `DIR/movement.csv`, or `None` when the file is absent.
 ///
 /// The file holds one interval a line, `start [ns],end [ns]`, both inclusive (BROAD's scored
 /// movement phases); lines starting with `#`, blank lines and a first line that is not a number
 /// (a header) are skipped. The intervals must be ordered and disjoint, each with `start ≤ end`.
+/// A last line without its newline that does not parse is taken as cut off and skipped
+/// ([`movement_checked`] gives the warning).
 ///
 /// # Errors
 /// An unreadable file, or a line that is not two integers in order, naming the file and line.
 pub fn movement(dir: &Path) -> Result<Option<Vec<(u64, u64)>>, DatasetError> {
+    movement_checked(dir).map(|(m, _)| m)
+}
+
+/// As [`movement`], with the warning of a last line cut short (no newline, not parsing: it is
+/// skipped).
+///
+/// # Errors
+/// As [`movement`].
+pub fn movement_checked(dir: &Path) -> Result<(Option<Intervals>, Vec<DataWarning>), DatasetError> {
     let path = dir.join("movement.csv");
     let text = match std::fs::read_to_string(&path) {
         Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok((None, Vec::new())),
         Err(e) => return Err(DatasetError::file(&path, e)),
     };
-    parse_movement(&path, &text).map(Some)
+    let (m, w) = without_cut_last_line(&path, &text, parse_movement)?;
+    Ok((Some(m), w))
+}
+
+/// `parse(path, text)`, except that a last line without its newline on which it fails is taken
+/// as cut off: `text` without it is parsed instead, with a warning.
+fn without_cut_last_line<R>(
+    path: &Path,
+    text: &str,
+    parse: impl Fn(&Path, &str) -> Result<R, DatasetError>,
+) -> Result<(R, Vec<DataWarning>), DatasetError> {
+    match parse(path, text) {
+        Ok(r) => Ok((r, Vec::new())),
+        Err(DatasetError::At { line, message, .. })
+            if !text.is_empty() && !text.ends_with('\n') && line == text.lines().count() as u64 =>
+        {
+            let start = text.rfind('\n').map_or(0, |i| i + 1);
+            let r = parse(path, &text[..start])?;
+            let warning = DataWarning::new(
+                path,
+                Some(line),
+                format!("the file ends inside this line (no newline) and it does not parse ({message}): taken as cut off and skipped"),
+            );
+            Ok((r, vec![warning]))
+        }
+        Err(e) => Err(e),
+    }
 }
 
 /// Parses the text of a `movement.csv` (see [`movement`]); `path` names it in errors.
@@ -706,18 +883,31 @@ pub struct FaultInterval {
 ///
 /// The file holds one interval a line, `start [ns],end [ns],sensor,kind` (see
 /// [`FaultInterval`]); lines starting with `#`, blank lines and a first line that is not a number
-/// (a header) are skipped. Intervals may overlap and come in any order.
+/// (a header) are skipped. Intervals may overlap and come in any order. A last line without its
+/// newline that does not parse is taken as cut off and skipped ([`read_faults_checked`] gives
+/// the warning).
 ///
 /// # Errors
 /// An unreadable file, or a malformed line, naming the file and line.
 pub fn read_faults(dir: &Path) -> Result<Vec<FaultInterval>, DatasetError> {
+    read_faults_checked(dir).map(|(f, _)| f)
+}
+
+/// As [`read_faults`], with the warning of a last line cut short (no newline, not parsing: it
+/// is skipped).
+///
+/// # Errors
+/// As [`read_faults`].
+pub fn read_faults_checked(
+    dir: &Path,
+) -> Result<(Vec<FaultInterval>, Vec<DataWarning>), DatasetError> {
     let path = dir.join("faults.csv");
     let text = match std::fs::read_to_string(&path) {
         Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok((Vec::new(), Vec::new())),
         Err(e) => return Err(DatasetError::file(&path, e)),
     };
-    parse_faults(&path, &text)
+    without_cut_last_line(&path, &text, parse_faults)
 }
 
 /// Parses the text of a `faults.csv` (see [`read_faults`]); `path` names it in errors.
@@ -959,6 +1149,78 @@ mod tests {
         std::fs::write(dir.join("faults.csv"), "#h\n1,2,gnss,frozen\nbad\n").expect("write");
         let err = read_faults(&dir).expect_err("malformed").to_string();
         assert!(err.contains("faults.csv:3:"), "{err}");
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn rows_count_lines_as_written_and_a_cut_last_line_is_a_warning() {
+        let dir = std::env::temp_dir().join(format!("host-sim-rows-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("tmp");
+        let p = dir.join("d.csv");
+        let read_all = |text: &str| {
+            std::fs::write(&p, text).expect("write");
+            let mut r = Rows::open(&p, 2, false).expect("open");
+            let mut rows = Vec::new();
+            while let Some(row) = r.next_row().expect("rows") {
+                rows.push(row);
+            }
+            (rows, r.warnings().to_vec())
+        };
+        // A byte-order mark, CRLF and a blank line: lines numbered as an editor shows them.
+        std::fs::write(&p, "\u{feff}#t,a\r\n1,0.5\r\n\r\n2,x\r\n").expect("write");
+        let mut r = Rows::open(&p, 2, false).expect("open");
+        assert_eq!(r.next_row().expect("row"), Some((2, 1, vec![0.5])));
+        let err = r.next_row().expect_err("x").to_string();
+        assert!(
+            err.ends_with("d.csv:4: column 2: 'x' is not a number"),
+            "{err}"
+        );
+
+        // Cut inside the last row: skipped, with a warning; a quoted number is a number.
+        let (rows, w) = read_all("#t,a\n1,0.5\n2,\"0.25\"\n3");
+        assert_eq!(rows, vec![(2, 1, vec![0.5]), (3, 2, vec![0.25])]);
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert_eq!(w[0].line, Some(4));
+        assert!(
+            w[0].message
+                .contains("does not parse (expected 2 columns, got 1)"),
+            "{}",
+            w[0].message
+        );
+        // Cut inside its timestamp (smaller than the one before): skipped too.
+        let (rows, w) = read_all("#t,a\n15,0.5\n1");
+        assert_eq!((rows.len(), w.len()), (1, 1));
+        let (rows, w) = read_all("#t,a\n15,0.5\n1,0.5");
+        assert_eq!(rows.len(), 1);
+        assert!(w[0].message.contains("non-monotonic"), "{w:?}");
+        // Cut after a number that parses: used, with a warning.
+        let (rows, w) = read_all("#t,a\n1,0.5\n2,0.2");
+        assert_eq!(rows.len(), 2);
+        assert!(w[0].message.contains("it parses, so it is used"), "{w:?}");
+        // A header alone, or a file ending with its newline: nothing to say.
+        assert_eq!(read_all("#t,a"), (Vec::new(), Vec::new()));
+        assert_eq!(read_all("#t,a\n1,0.5\n").1, Vec::new());
+        // The same short row with its newline was written whole: an error.
+        std::fs::write(&p, "#t,a\n1,0.5\n3\n").expect("write");
+        let mut r = Rows::open(&p, 2, false).expect("open");
+        assert!(r.next_row().is_ok());
+        let err = r.next_row().expect_err("short row").to_string();
+        assert!(err.ends_with("d.csv:3: expected 2 columns, got 1"), "{err}");
+
+        // movement.csv and faults.csv, read as text, alike.
+        std::fs::write(dir.join("movement.csv"), "#s,e\n1,2\n5,").expect("write");
+        let (m, w) = movement_checked(&dir).expect("cut line skipped");
+        assert_eq!(m, Some(vec![(1, 2)]));
+        assert_eq!(w.len(), 1);
+        assert!(w[0]
+            .to_string()
+            .contains("movement.csv:3: the file ends inside this line"));
+        std::fs::write(dir.join("movement.csv"), "#s,e\n1,2\n5,\n").expect("write");
+        assert!(movement_checked(&dir).is_err());
+        std::fs::write(dir.join("faults.csv"), "#h\n1,2,gnss,step\n3,4,gn").expect("write");
+        let (f, w) = read_faults_checked(&dir).expect("cut line skipped");
+        assert_eq!((f.len(), w.len()), (1, 1));
+        assert_eq!(w[0].line, Some(3));
         let _ = std::fs::remove_dir_all(dir);
     }
 

@@ -41,6 +41,7 @@
 pub mod epochs;
 pub mod score;
 
+use crate::dataset::check::{collate, DataWarning};
 use crate::dataset::read::{read_faults, FaultInterval};
 use crate::dataset::write::simulate;
 use crate::metrics::trajectory::{self, Alignment, PosePair, Stats};
@@ -134,6 +135,10 @@ pub struct RunResult {
     pub ate_outside_outage_m: Option<f64>,
     /// IMU epochs in `validity.csv`.
     pub epochs: usize,
+    /// What the simulated data had wrong that the replay survived (a GNSS outage is a gap),
+    /// each file named inside the dataset folder (`gnss0/data.csv`): the run's folder is
+    /// scratch.
+    pub data_warnings: Vec<DataWarning>,
 }
 
 /// One line of the bench: one fault of one scenario (or the scenario, without faults) over the
@@ -211,6 +216,31 @@ pub struct FaultBench {
     pub latency: Option<LatencyResult>,
     /// Wall time of the whole bench, s.
     pub elapsed_s: f64,
+}
+
+impl FaultBench {
+    /// The data warnings of the runs, once per scenario and warning: `warning: SCENARIO, N of M
+    /// runs (first seed S): FILE:LINE: message`, the file named inside the dataset folder.
+    #[must_use]
+    pub fn data_warning_lines(&self) -> Vec<String> {
+        let mut scenarios: Vec<&str> = Vec::new();
+        for r in &self.per_run {
+            if !scenarios.contains(&r.scenario.as_str()) {
+                scenarios.push(&r.scenario);
+            }
+        }
+        let mut out = Vec::new();
+        for sc in scenarios {
+            let runs: Vec<&RunResult> = self.per_run.iter().filter(|r| r.scenario == sc).collect();
+            for (w, seed, n) in collate(runs.iter().map(|r| (r.seed, &r.data_warnings[..]))) {
+                out.push(format!(
+                    "warning: {sc}, {n} of {} runs (first seed {seed}): {w}",
+                    runs.len()
+                ));
+            }
+        }
+        out
+    }
 }
 
 /// A folder beside an output target for the bench's runs, created fresh and removed (with
@@ -359,6 +389,11 @@ pub fn run_one(sc: &Scenario, seed: u64, dir: &Path) -> Result<RunResult, String
         ate_m: ate_se3(&m),
         ate_outside_outage_m,
         epochs: eps.len(),
+        data_warnings: m
+            .data_warnings
+            .iter()
+            .map(|w| w.clone().relocated(&ds, Path::new("")))
+            .collect(),
     })
 }
 

@@ -20,6 +20,7 @@
 pub mod broad;
 pub mod trajectory;
 
+use crate::dataset::check::DataWarning;
 use crate::dataset::read::{Dataset, Truth};
 use crate::dataset::DatasetError;
 use broad::{broad_error, in_intervals, BroadAccumulator, BroadRmse};
@@ -230,6 +231,8 @@ pub struct Scorer {
     pub baselines: BTreeMap<String, (f64, u64)>,
     /// What the run assumed for want of an optional file (copied to `metrics.json`).
     pub warnings: Vec<String>,
+    /// What the data had wrong that the run survived (copied to `metrics.json`).
+    pub data_warnings: Vec<DataWarning>,
     /// BROAD's movement intervals (ns, inclusive); `None`: BROAD's metric is not computed.
     movement: Option<Vec<(u64, u64)>>,
     /// BROAD's errors inside the movement intervals.
@@ -355,6 +358,10 @@ pub struct Metrics {
     pub baseline_attitude_rmse_deg: BTreeMap<String, f64>,
     /// What the run assumed for want of an optional file.
     pub warnings: Vec<String>,
+    /// What the data had wrong that the run survived, each with its file and line: a last line
+    /// cut short, gaps, sensors that start late or stop early, refused samples
+    /// ([`crate::dataset::check`]).
+    pub data_warnings: Vec<DataWarning>,
     /// Where the run comes from.
     pub provenance: Provenance,
 }
@@ -379,20 +386,40 @@ impl Scorer {
     /// A malformed `movement.csv` or first ground-truth row, naming the file and line.
     pub fn for_dataset(mut self, dir: &Path) -> Result<Self, DatasetError> {
         if self.movement.is_none() {
-            self.movement = crate::dataset::read::movement(dir)?;
+            let (movement, warnings) = crate::dataset::read::movement_checked(dir)?;
+            self.movement = movement;
+            self.data_warnings.extend(warnings);
         }
         if self.truth_start_ns.is_none() {
             self.truth_start_ns = crate::dataset::read::first_truth_ns(dir)?;
         }
-        self.faults = crate::dataset::read::read_faults(dir)?;
+        let (faults, warnings) = crate::dataset::read::read_faults_checked(dir)?;
+        self.faults = faults;
+        self.data_warnings.extend(warnings);
         Ok(self)
     }
 
-    /// Records what the dataset holds and the precision of the run: the reader's warnings, the
-    /// presence of a heading reference, the dataset folder (unless already set) and the
-    /// precision.
+    /// Adds `warnings` about the files of the dataset folder `dir`, then names every file as
+    /// the run's provenance names the folder (the folder as the user gave it), in file and
+    /// line order, each once.
+    pub fn add_data_warnings(&mut self, dir: &Path, warnings: Vec<DataWarning>) {
+        self.data_warnings.extend(warnings);
+        if let Some(shown) = self.provenance.dataset.clone() {
+            self.data_warnings = std::mem::take(&mut self.data_warnings)
+                .into_iter()
+                .map(|w| w.relocated(dir, Path::new(&shown)))
+                .collect();
+        }
+        self.data_warnings.sort();
+        self.data_warnings.dedup();
+    }
+
+    /// Records what the dataset holds and the precision of the run: the reader's warnings and
+    /// data warnings, the presence of a heading reference, the dataset folder (unless already
+    /// set) and the precision.
     pub fn note_run(&mut self, ds: &Dataset, precision: &str) {
         self.warnings.extend(ds.warnings.iter().cloned());
+        self.data_warnings.extend(ds.data_warnings.iter().cloned());
         self.heading_reference = Some(ds.mag.is_some() || ds.gnss.is_some() || ds.camera.is_some());
         if self.provenance.dataset.is_none() {
             self.provenance.dataset = Some(ds.dir.display().to_string());
@@ -591,6 +618,7 @@ impl Scorer {
                 .map(|(k, (sq, n))| (k.clone(), (sq / (*n).max(1) as f64).sqrt().to_degrees()))
                 .collect(),
             warnings: self.warnings.clone(),
+            data_warnings: self.data_warnings.clone(),
             provenance: self.provenance.clone(),
         }
     }

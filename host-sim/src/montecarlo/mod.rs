@@ -19,6 +19,7 @@
 //! how they were made). A figure a run did not estimate is an empty cell (`null` in the JSON),
 //! never 0.
 
+use crate::dataset::check::collate;
 use crate::dataset::write::simulate;
 use crate::metrics::{Metrics, Scorer, BLOCKS};
 use crate::progress::{Mode, Progress};
@@ -104,6 +105,26 @@ fn number(x: Option<f64>) -> Value {
 }
 
 impl Report {
+    /// The data warnings of the runs, once per warning: `warning: SCENARIO, N of M runs (first
+    /// seed S): FILE:LINE: message`, the file named inside the dataset folder (each run's is
+    /// scratch).
+    #[must_use]
+    pub fn data_warning_lines(&self) -> Vec<String> {
+        collate(
+            self.per_run
+                .iter()
+                .map(|r| (r.seed, &r.metrics.data_warnings[..])),
+        )
+        .into_iter()
+        .map(|(w, seed, n)| {
+            format!(
+                "warning: {}, {n} of {} runs (first seed {seed}): {w}",
+                self.scenario, self.runs
+            )
+        })
+        .collect()
+    }
+
     /// `true` when every band holds.
     #[must_use]
     pub fn holds(&self) -> bool {
@@ -432,6 +453,14 @@ pub fn run_from(
                     scorer.keep_nees = true;
                     replay_scored(&ds, &dir, &cfg, &scenario.name, scorer)
                         .map_err(|e| e.to_string())
+                        .map(|mut s| {
+                            // The run's folder is scratch: files named inside the dataset.
+                            s.data_warnings = std::mem::take(&mut s.data_warnings)
+                                .into_iter()
+                                .map(|w| w.relocated(&ds, Path::new("")))
+                                .collect();
+                            s
+                        })
                 });
             let _ = std::fs::remove_dir_all(&dir);
             bar.inc(1);

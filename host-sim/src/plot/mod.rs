@@ -6,11 +6,14 @@
 //!   shorter than 1 m), with start and end markers;
 //! * `errors.png`: per-axis errors inside their ±3σ bands;
 //! * `biases.png`: bias estimates against the truth;
-//! * `nis.png`: NIS per update and sensor against its 95 % chi-square bounds and expected mean;
-//!   a point above the scale is drawn at its top edge with a marker of its own, never dropped.
-//!   The scorer's history ([`crate::metrics::SensorStats::history`]) holds the accepted and the
-//!   gated-out updates together, without telling them apart, so the points are drawn alike and
-//!   the panel's caption gives both counts.
+//! * `nis.png`: NIS per update and sensor against its 95 % chi-square bounds and expected mean:
+//!   accepted updates as dots, gated-out ones as hollow squares; a point above the scale is
+//!   drawn at its top edge with a marker of its own, never dropped. The panel's caption gives
+//!   the counts.
+//!
+//! Lines and bands over time break where the data do ([`split_at_gaps`]: an interval longer
+//! than [`GAP_FACTOR`] median intervals, an IMU gap or the navigator's restart after one)
+//! rather than drawing a straight line across what was never estimated.
 //!
 //! Text needs a TrueType font: DejaVu Sans from the system (Debian's `fonts-dejavu-core`), Arial on
 //! macOS and Windows, or the file named by `HOST_SIM_FONT`. Without one the plots are skipped with a warning.
@@ -21,6 +24,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{register_font, FontStyle};
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -111,6 +115,48 @@ pub fn write_all(
         written.push(f);
     }
     Ok(written)
+}
+
+/// An interval between two plotted points longer than this many median intervals is a gap:
+/// lines and bands stop at it. Decimation keeps the points evenly spaced in samples, so the
+/// median is the plotting step; jitter and a lost sample stay well below five of them.
+pub const GAP_FACTOR: f64 = 5.0;
+
+/// The index ranges of `t` (times in increasing order) between its gaps: intervals longer
+/// than [`GAP_FACTOR`] times the median of the positive intervals. One range over everything
+/// when there is no positive interval; none for no times.
+#[must_use]
+pub fn split_at_gaps(t: &[f64]) -> Vec<Range<usize>> {
+    if t.is_empty() {
+        return Vec::new();
+    }
+    let mut steps: Vec<f64> = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| d.is_finite() && *d > 0.0)
+        .collect();
+    if steps.is_empty() {
+        return std::iter::once(0..t.len()).collect();
+    }
+    let mid = (steps.len() - 1) / 2;
+    let (_, median, _) = steps.select_nth_unstable_by(mid, f64::total_cmp);
+    let limit = GAP_FACTOR * *median;
+    let mut out = Vec::new();
+    let mut start = 0;
+    for i in 1..t.len() {
+        if t[i] - t[i - 1] > limit {
+            out.push(start..i);
+            start = i;
+        }
+    }
+    out.push(start..t.len());
+    out
+}
+
+/// The ranges of the history's points between time gaps ([`split_at_gaps`]).
+fn segments(pts: &[HistoryPoint]) -> Vec<Range<usize>> {
+    let t: Vec<f64> = pts.iter().map(|p| p.t).collect();
+    split_at_gaps(&t)
 }
 
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -303,7 +349,8 @@ fn trajectory(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
             .map(|p| (p.est_position.x, p.est_position.y))
             .collect(),
     ];
-    draw_tracks(&mut chart, &top_view)?;
+    let parts = segments(pts);
+    draw_tracks(&mut chart, &top_view, &parts)?;
 
     // Side view: height against the distance along the true track (time when it stays put).
     let right = right.titled("side view", ("sans-serif", 18))?;
@@ -345,7 +392,7 @@ fn trajectory(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
         .x_desc(x_desc)
         .y_desc("up z [m] (own scale)")
         .draw()?;
-    draw_tracks(&mut chart, &side)?;
+    draw_tracks(&mut chart, &side, &parts)?;
     root.present()?;
     Ok(())
 }
@@ -356,11 +403,20 @@ type Chart<'a, 'b> = ChartContext<
     Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
 >;
 
-/// The truth and the estimate (in that order) with their start and end markers.
-fn draw_tracks(chart: &mut Chart<'_, '_>, tracks: &[Vec<(f64, f64)>; 2]) -> PlotResult {
+/// The truth and the estimate (in that order) with their start and end markers, each line
+/// broken between the `parts` (index ranges between time gaps).
+fn draw_tracks(
+    chart: &mut Chart<'_, '_>,
+    tracks: &[Vec<(f64, f64)>; 2],
+    parts: &[Range<usize>],
+) -> PlotResult {
     let styles = [TRUTH.stroke_width(2), ESTIMATE.into()];
     for (track, style) in tracks.iter().zip(styles) {
-        chart.draw_series(LineSeries::new(track.iter().copied(), style))?;
+        for part in parts {
+            if let Some(points) = track.get(part.clone()) {
+                chart.draw_series(LineSeries::new(points.iter().copied(), style))?;
+            }
+        }
     }
     for track in tracks {
         if let (Some(&first), Some(&last)) = (track.first(), track.last()) {
@@ -434,6 +490,7 @@ fn errors(path: &Path, pts: &[HistoryPoint], faults: &[(f64, f64)], title: &str)
     let units = ["deg", "m/s", "m", "deg/s", "m/s²"];
     let scale = [57.295_779_5, 1.0, 1.0, 57.295_779_5, 1.0];
     let t1 = pts.last().map_or(1.0, |p| p.t.max(1e-3));
+    let parts = segments(pts);
     for (row, &b) in blocks.iter().enumerate() {
         for axis in 0..3 {
             let i = 3 * b + axis;
@@ -465,13 +522,15 @@ fn errors(path: &Path, pts: &[HistoryPoint], faults: &[(f64, f64)], title: &str)
                 .y_desc(units[b])
                 .label_style(("sans-serif", 12))
                 .draw()?;
-            let upper: Vec<(f64, f64)> = pts
-                .iter()
-                .map(|p| (p.t, (3.0 * p.sigma[i] * k).min(lim)))
-                .collect();
-            let mut band_pts = upper.clone();
-            band_pts.extend(upper.iter().rev().map(|(t, v)| (*t, -v)));
-            chart.draw_series(std::iter::once(Polygon::new(band_pts, band)))?;
+            for part in &parts {
+                let upper: Vec<(f64, f64)> = pts[part.clone()]
+                    .iter()
+                    .map(|p| (p.t, (3.0 * p.sigma[i] * k).min(lim)))
+                    .collect();
+                let mut band_pts = upper.clone();
+                band_pts.extend(upper.iter().rev().map(|(t, v)| (*t, -v)));
+                chart.draw_series(std::iter::once(Polygon::new(band_pts, band)))?;
+            }
             chart.draw_series(
                 faults
                     .iter()
@@ -482,10 +541,14 @@ fn errors(path: &Path, pts: &[HistoryPoint], faults: &[(f64, f64)], title: &str)
                     .into_iter()
                     .map(|(a, z)| Rectangle::new([(a, -lim), (z, -0.9 * lim)], invalid_fill)),
             )?;
-            chart.draw_series(LineSeries::new(
-                pts.iter().map(|p| (p.t, (p.error[i] * k).clamp(-lim, lim))),
-                ESTIMATE,
-            ))?;
+            for part in &parts {
+                chart.draw_series(LineSeries::new(
+                    pts[part.clone()]
+                        .iter()
+                        .map(|p| (p.t, (p.error[i] * k).clamp(-lim, lim))),
+                    ESTIMATE,
+                ))?;
+            }
         }
     }
     root.present()?;
@@ -510,6 +573,7 @@ fn biases(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
     )?;
     let cells = body.split_evenly((2, 3));
     let t1 = pts.last().map_or(1.0, |p| p.t.max(1e-3));
+    let parts = segments(pts);
     for (i, cell) in cells.iter().enumerate() {
         let (k, unit) = if i < 3 {
             (57.295_779_5, "deg/s")
@@ -536,14 +600,17 @@ fn biases(path: &Path, pts: &[HistoryPoint], title: &str) -> PlotResult {
             .y_desc(unit)
             .label_style(("sans-serif", 12))
             .draw()?;
-        chart.draw_series(LineSeries::new(
-            pts.iter().map(|p| (p.t, p.true_bias[i] * k)),
-            TRUTH.stroke_width(2),
-        ))?;
-        chart.draw_series(LineSeries::new(
-            pts.iter().map(|p| (p.t, p.est_bias[i] * k)),
-            ESTIMATE,
-        ))?;
+        for part in &parts {
+            let part = &pts[part.clone()];
+            chart.draw_series(LineSeries::new(
+                part.iter().map(|p| (p.t, p.true_bias[i] * k)),
+                TRUTH.stroke_width(2),
+            ))?;
+            chart.draw_series(LineSeries::new(
+                part.iter().map(|p| (p.t, p.est_bias[i] * k)),
+                ESTIMATE,
+            ))?;
+        }
     }
     root.present()?;
     Ok(())
@@ -656,7 +723,8 @@ fn nis_panel(
     for (v, style) in [(lo, bound), (hi, bound), (dof as f64, expected)] {
         chart.draw_series(LineSeries::new([(0.0, v), (t1, v)], style))?;
     }
-    // Accepted updates as dots; gated-out ones as larger squares of their own colour.
+    // Accepted updates as dots; gated-out ones as hollow squares of their own colour, drawn
+    // over the dots (a square the size of the marker in pixels, whatever the scale).
     let (accepted, gated): (Vec<&(f64, f64, usize, bool)>, Vec<_>) =
         inside.iter().copied().partition(|p| p.3);
     chart.draw_series(
@@ -665,10 +733,11 @@ fn nis_panel(
             .map(|p| Circle::new((p.0, p.1), 2, POINT.filled())),
     )?;
     chart.draw_series(gated.iter().map(|p| {
-        Rectangle::new(
-            [(p.0, p.1), (p.0, p.1)],
-            GATED.stroke_width(u32::try_from(MARKER).unwrap_or(6)),
-        )
+        EmptyElement::at((p.0, p.1))
+            + Rectangle::new(
+                [(-MARKER + 1, -MARKER + 1), (MARKER - 1, MARKER - 1)],
+                GATED.stroke_width(2),
+            )
     }))?;
     chart.draw_series(
         above
@@ -684,7 +753,7 @@ fn nis_panel(
         entries.insert(
             1,
             Entry::new(
-                Mark::Square(GATED.filled()),
+                Mark::Square(GATED.stroke_width(2)),
                 format!("NIS, gated out: {}", gated.len()),
             ),
         );
@@ -762,6 +831,66 @@ mod tests {
             s.measurement("gnss_position", t_ns, outcome);
         }
         s
+    }
+
+    #[test]
+    fn lines_break_at_gaps_of_more_than_five_median_intervals() {
+        assert!(split_at_gaps(&[]).is_empty());
+        assert_eq!(split_at_gaps(&[3.0]), vec![0..1]);
+        // Equal times: no interval to judge by, one piece.
+        assert_eq!(split_at_gaps(&[1.0, 1.0, 1.0]), vec![0..3]);
+        // 0.1 s steps with a 10 s hole after the fourth point.
+        let t = [0.0, 0.1, 0.2, 0.3, 10.3, 10.4, 10.5];
+        assert_eq!(split_at_gaps(&t), vec![0..4, 4..7]);
+        // Five intervals exactly is not a gap; a little more is, and jitter is not.
+        assert_eq!(split_at_gaps(&[0.0, 1.0, 2.0, 7.0, 8.0]), vec![0..5]);
+        assert_eq!(split_at_gaps(&[0.0, 1.0, 2.0, 7.01, 8.0]), vec![0..3, 3..5]);
+        let jitter: Vec<f64> = (0..100)
+            .map(|k| f64::from(k) * 0.01 + if k % 2 == 0 { 0.004 } else { 0.0 })
+            .collect();
+        assert_eq!(split_at_gaps(&jitter), vec![0..100]);
+        // Several gaps, one at each end.
+        let t = [0.0, 5.0, 5.1, 5.2, 5.3, 9.0, 9.1, 9.2, 20.0];
+        assert_eq!(split_at_gaps(&t), vec![0..1, 1..5, 5..8, 8..9]);
+    }
+
+    /// The gated-out updates the legend lists are drawn: hollow squares of their colour, in
+    /// the plotting area (not markers of no size).
+    #[test]
+    fn gated_out_nis_points_are_drawn_as_hollow_squares() {
+        if !font_ready() {
+            eprintln!("no font: the plots are skipped, nothing to check");
+            return;
+        }
+        let count = |gated: bool| {
+            let mut stats = SensorStats::default();
+            for k in 0..100_u32 {
+                let t = f64::from(k) * 0.1;
+                stats
+                    .history
+                    .push((t, f64::from(k % 5), 3, !(gated && k % 25 == 7)));
+            }
+            let (w, h) = (1400_u32, 300_u32);
+            let mut buf = vec![0_u8; (w * h * 3) as usize];
+            {
+                let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+                root.fill(&WHITE).expect("fill");
+                let (plot, legend) = root.split_horizontally(w - NIS_LEGEND_W);
+                nis_panel(&plot, &legend, "gnss_position", &stats, 10.0).expect("panel");
+                root.present().expect("present");
+            }
+            // Pixels of the gated colour in the plotting area, left of the legend.
+            buf.chunks(3)
+                .enumerate()
+                .filter(|(i, px)| {
+                    (*i as u32 % w) < w - NIS_LEGEND_W && px == &[GATED.0, GATED.1, GATED.2]
+                })
+                .count()
+        };
+        assert_eq!(count(false), 0);
+        let drawn = count(true);
+        // Four squares of 10 px a side, 2 px wide: about 70 px each.
+        assert!(drawn >= 4 * 40, "{drawn} px of gated-out markers");
     }
 
     #[test]

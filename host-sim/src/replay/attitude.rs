@@ -5,7 +5,7 @@
 use super::output::{EstimateFiles, Partials};
 use super::{lit3, up3, ReplayConfig, ReplayError};
 use crate::baseline::{Madgwick, Mahony};
-use crate::dataset::read::{Dataset, Event};
+use crate::dataset::read::{Dataset, Event, EventStream};
 use crate::metrics::{Estimate, Outcome, Scorer};
 use estimator_core::eskf::{FilterConfig, ImuNoise};
 use estimator_core::nav::{
@@ -86,9 +86,14 @@ fn score_fusion<T: Real>(
     }
 }
 
+/// What the attitude navigator does after an IMU gap, for the data warnings.
+const GAP_EFFECT: &str = "the attitude navigator starts again after it (its start-up, keeping the bias estimate and the magnetic reference)";
+
+/// Scores the updates a call made, or a refused sample (noted in `events`, with its reason).
 fn score_report<T: Real>(
     mag_dof: usize,
     scorer: &mut Scorer,
+    events: &mut EventStream,
     r: &Result<AttitudeReport<T>, NavError>,
     sensor: &str,
     t_ns: u64,
@@ -99,7 +104,10 @@ fn score_report<T: Real>(
             score_fusion(scorer, "mag", t_ns, r.fused.heading, mag_dof);
             score_fusion(scorer, "zero_rate", t_ns, r.fused.zero_rate, 3);
         }
-        Err(_) => scorer.measurement(sensor, t_ns, Outcome::Refused),
+        Err(e) => {
+            scorer.measurement(sensor, t_ns, Outcome::Refused);
+            events.refused(sensor, e);
+        }
     }
 }
 
@@ -122,7 +130,8 @@ pub(super) fn replay_attitude<T: Real>(
     // The heading is one number; the whole field three.
     let mag_dof = if cfg.magnetometer_vector { 3 } else { 1 };
     let mut last_imu: Option<u64> = None;
-    for ev in ds.events()? {
+    let mut events = ds.events()?.with_max_dt(cfg.max_dt);
+    while let Some(ev) = events.next() {
         let started = Instant::now();
         match ev? {
             Event::Imu { t_ns, gyro, accel } => {
@@ -131,7 +140,7 @@ pub(super) fn replay_attitude<T: Real>(
                 });
                 last_imu = Some(t_ns);
                 let r = nav.imu(t_ns, &lit3(&gyro), &lit3(&accel));
-                score_report(mag_dof, &mut scorer, &r, "imu", t_ns);
+                score_report(mag_dof, &mut scorer, &mut events, &r, "imu", t_ns);
                 scorer.filter_ns += started.elapsed().as_nanos();
                 scorer.imu_samples += 1;
                 let Some(e) = estimate(&nav, t_ns) else {
@@ -159,14 +168,16 @@ pub(super) fn replay_attitude<T: Real>(
                     mh.mag(&field);
                 }
                 let r = nav.magnetometer(t_ns, &lit3(&field));
-                score_report(mag_dof, &mut scorer, &r, "mag", t_ns);
+                score_report(mag_dof, &mut scorer, &mut events, &r, "mag", t_ns);
                 scorer.filter_ns += started.elapsed().as_nanos();
             }
             // Without GNSS and camera, the other sensors have nothing to aid.
             _ => {}
         }
     }
-    files.finish()?;
+    let mut warnings = events.finish(GAP_EFFECT)?;
+    warnings.extend(files.finish()?);
+    scorer.add_data_warnings(dir, warnings);
     super::finish(out, cfg, title, ds, &scorer)?;
     partials.commit()?;
     Ok(scorer)

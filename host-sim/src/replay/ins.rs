@@ -7,7 +7,7 @@ use super::attitude::navigator_config;
 use super::output::{open_partial, EstimateFiles, Partials};
 use super::{lit3, out_err, up3, ReplayConfig, ReplayError};
 use crate::baseline::{Madgwick, Mahony};
-use crate::dataset::read::{Dataset, Event};
+use crate::dataset::read::{Dataset, Event, EventStream};
 use crate::faults::epochs;
 use crate::metrics::{Estimate, Outcome, Scorer};
 use estimator_core::nav::{
@@ -99,9 +99,13 @@ fn write_validity<T: Real>(f: &mut impl Write, r: &InsReport<T>) -> std::io::Res
     )
 }
 
-/// Scores the update a call made, or a refused sample.
+/// What the INS navigator does after an IMU gap, for the data warnings.
+const GAP_EFFECT: &str = "the INS navigator starts its alignment again after it (`realigned` in validity.csv) and has no estimate until it has started again at a GNSS fix";
+
+/// Scores the update a call made, or a refused sample (noted in `events`, with its reason).
 fn score<T: Real>(
     scorer: &mut Scorer,
+    events: &mut EventStream,
     r: &Result<InsReport<T>, NavError>,
     sensor: &str,
     t_ns: u64,
@@ -124,7 +128,10 @@ fn score<T: Real>(
                 scorer.measurement(name, t_ns, outcome);
             }
         }
-        Err(_) => scorer.measurement(sensor, t_ns, Outcome::Refused),
+        Err(e) => {
+            scorer.measurement(sensor, t_ns, Outcome::Refused);
+            events.refused(sensor, e);
+        }
     }
 }
 
@@ -165,7 +172,8 @@ pub(super) fn replay_ins<T: Real>(
     writeln!(validity, "{VALIDITY_HEADER}").map_err(out_err(&validity_path))?;
     let mut baselines: Option<(Madgwick, Mahony)> = None;
     let mut last_imu: Option<u64> = None;
-    for ev in ds.events()? {
+    let mut events = ds.events()?.with_max_dt(cfg.max_dt);
+    while let Some(ev) = events.next() {
         let started = Instant::now();
         match ev? {
             Event::Imu { t_ns, gyro, accel } => {
@@ -174,7 +182,7 @@ pub(super) fn replay_ins<T: Real>(
                 });
                 last_imu = Some(t_ns);
                 let r = nav.imu(t_ns, &lit3(&gyro), &lit3(&accel));
-                score(&mut scorer, &r, "imu", t_ns);
+                score(&mut scorer, &mut events, &r, "imu", t_ns);
                 if let Ok(report) = &r {
                     write_validity(&mut validity, report).map_err(out_err(&validity_path))?;
                 }
@@ -205,7 +213,7 @@ pub(super) fn replay_ins<T: Real>(
                     mh.mag(&field);
                 }
                 let r = nav.magnetometer(t_ns, &lit3(&field));
-                score(&mut scorer, &r, "mag", t_ns);
+                score(&mut scorer, &mut events, &r, "mag", t_ns);
             }
             Event::Gnss {
                 t_ns,
@@ -221,18 +229,20 @@ pub(super) fn replay_ins<T: Real>(
                     T::lit(sigma_v),
                 );
                 let r = nav.gnss(t_ns.saturating_sub(latency_ns), &fix);
-                score(&mut scorer, &r, "gnss_position", t_ns);
+                score(&mut scorer, &mut events, &r, "gnss_position", t_ns);
             }
             Event::Baro { t_ns, altitude } => {
                 let r = nav.barometer(t_ns, T::lit(altitude));
-                score(&mut scorer, &r, "baro", t_ns);
+                score(&mut scorer, &mut events, &r, "baro", t_ns);
             }
             // The camera is the other replay's.
             Event::Camera { .. } => {}
         }
         scorer.filter_ns += started.elapsed().as_nanos();
     }
-    files.finish()?;
+    let mut warnings = events.finish(GAP_EFFECT)?;
+    warnings.extend(files.finish()?);
+    scorer.add_data_warnings(dir, warnings);
     validity.flush().map_err(out_err(&validity_path))?;
     if nav.estimate().is_none() {
         return Err(ReplayError::Start(format!(

@@ -11,7 +11,12 @@
 //!
 //! The navigator configures itself from the dataset's `sensor.yaml` files and starts itself from
 //! the data, at rest or moving; it never reads the ground truth to start or to run, the truth is
-//! only scored against. With GNSS, every sample goes to [`estimator_core::nav::InsNavigator`]
+//! only scored against.
+//!
+//! What the data has wrong that the run survives (a last line cut short, IMU and aiding gaps,
+//! sensors starting late or stopping early, refused samples with the navigator's reason) is
+//! collected as [`crate::dataset::check::DataWarning`]s into `metrics.json` (`data_warnings`),
+//! the files named from the dataset folder as the caller gave it. With GNSS, every sample goes to [`estimator_core::nav::InsNavigator`]
 //! (`ins`), each fix stamped with the time it was valid; with an IMU and a magnetometer alone, to
 //! [`estimator_core::nav::AttitudeNavigator`] (`attitude`). A camera dataset without GNSS runs the
 //! 15-state filter here, started from a window at rest and a PnP pose of the first frame.
@@ -334,6 +339,9 @@ pub fn replay_scored(
     }
 }
 
+/// What the camera replay's filter does after an IMU gap, for the data warnings.
+const GAP_EFFECT: &str = "the filter refuses the step over it (an `imu` refusal) and goes on from its state before the gap";
+
 fn replay_in<T: Real>(
     dir: &Path,
     out: &Path,
@@ -361,7 +369,7 @@ fn replay_in<T: Real>(
         gravity: lit3(&gravity),
         max_dt: T::lit(cfg.max_dt),
     };
-    let mut events = ds.events()?.peekable();
+    let mut events = ds.events()?.with_max_dt(cfg.max_dt);
 
     // --- Start-up: a window at rest, then the first camera frame, solved for the pose. ---
     let window_ns = (cfg.align_window_s * 1e9) as u64;
@@ -369,20 +377,15 @@ fn replay_in<T: Real>(
     let mut t_first: Option<u64> = None;
     let mut last_imu: Option<u64> = None;
     let mut first_frame: Option<Vec<(u64, Vector2<f64>)>> = None;
-    while let Some(ev) = events.peek() {
-        let ev = match ev {
-            Ok(e) => e.clone(),
-            Err(_) => {
-                return Err(events.next().and_then(Result::err).map_or_else(
-                    || ReplayError::Start("read error".into()),
-                    ReplayError::from,
-                ))
-            }
-        };
+    // The event that ends the start-up, left for the run.
+    let mut carried: Option<Event> = None;
+    for ev in events.by_ref() {
+        let ev = ev?;
         let t0 = *t_first.get_or_insert(ev.t_ns());
         let in_window = ev.t_ns() < t0 + window_ns;
         let need_fix = first_frame.is_none();
         if !in_window && !need_fix {
+            carried = Some(ev);
             break;
         }
         match &ev {
@@ -402,7 +405,6 @@ fn replay_in<T: Real>(
             }
             _ => {}
         }
-        events.next();
         if !in_window && first_frame.is_some() {
             break;
         }
@@ -470,7 +472,7 @@ fn replay_in<T: Real>(
     // Projections are strongly nonlinear near the camera: re-linearize (iterated update).
     let camera_options = UpdateOptions::<T>::iterated(ekf.gate, 3, T::lit(1e-6));
     let mut last_sample: Option<(Vector3<f64>, Vector3<f64>)> = None;
-    for ev in events {
+    while let Some(ev) = carried.take().map(Ok).or_else(|| events.next()) {
         let ev = ev?;
         let started = Instant::now();
         match ev {
@@ -491,8 +493,9 @@ fn replay_in<T: Real>(
                     mw.imu(&g_mid, &a_mid, dt);
                     mh.imu(&g_mid, &a_mid, dt);
                 }
-                if filter.predict(&g_mid, &a_mid, dt).is_err() {
+                if let Err(e) = filter.predict(&g_mid, &a_mid, dt) {
                     scorer.measurement("imu", t_ns, Outcome::Refused);
+                    events.refused("imu", &e);
                 }
                 scorer.filter_ns += started.elapsed().as_nanos();
                 scorer.imu_samples += 1;
@@ -509,6 +512,9 @@ fn replay_in<T: Real>(
                     let model =
                         Magnetometer::new(lit3(&field), lit3(&m.reference_field), T::lit(m.sigma));
                     let r = filter.0.update(&model, &ekf);
+                    if let Err(e) = &r {
+                        events.refused("mag", e);
+                    }
                     scorer.measurement("mag", t_ns, outcome(r, 3));
                 }
             }
@@ -517,6 +523,9 @@ fn replay_in<T: Real>(
             Event::Baro { t_ns, altitude } => {
                 if let (Filter(f), Some(b)) = (&mut filter, &ds.baro) {
                     let r = f.update(&BaroAltitude::new(T::lit(altitude), T::lit(b.sigma)), &ekf);
+                    if let Err(e) = &r {
+                        events.refused("baro", e);
+                    }
                     scorer.measurement("baro", t_ns, outcome(r, 1));
                 }
             }
@@ -533,6 +542,7 @@ fn replay_in<T: Real>(
                     for (id, pixel) in &observations {
                         let Some(landmark) = cam.landmarks.get(id) else {
                             scorer.measurement("camera", t_ns, Outcome::Refused);
+                            events.refused("camera", &"landmark id not in cam0/landmarks.csv");
                             continue;
                         };
                         let model = CameraLandmark::new(
@@ -543,6 +553,9 @@ fn replay_in<T: Real>(
                             T::lit(cam.sigma_px),
                         );
                         let r = f.update(&model, &camera_options);
+                        if let Err(e) = &r {
+                            events.refused("camera", e);
+                        }
                         scorer.measurement("camera", t_ns, outcome(r, 2));
                     }
                 }
@@ -550,7 +563,9 @@ fn replay_in<T: Real>(
         }
         scorer.filter_ns += started.elapsed().as_nanos();
     }
-    files.finish()?;
+    let mut warnings = events.finish(GAP_EFFECT)?;
+    warnings.extend(files.finish()?);
+    scorer.add_data_warnings(dir, warnings);
     finish(out, cfg, title, &ds, &scorer)?;
     partials.commit()?;
     Ok(scorer)

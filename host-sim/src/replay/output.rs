@@ -3,6 +3,7 @@
 
 use super::{out_err, ReplayError};
 use crate::baseline::{Madgwick, Mahony};
+use crate::dataset::check::DataWarning;
 use crate::dataset::read::{Truth, TruthStream};
 use crate::metrics::{interpolate_truth, Estimate, Scorer};
 use estimator_core::lie::So3;
@@ -231,13 +232,15 @@ impl EstimateFiles {
         Ok(())
     }
 
-    /// Flushes the files and copies the rest of the truth.
-    pub(super) fn finish(mut self) -> Result<(), ReplayError> {
+    /// Flushes the files and copies the rest of the truth; returns the truth file's warnings
+    /// (a cut last line).
+    pub(super) fn finish(mut self) -> Result<Vec<DataWarning>, ReplayError> {
         self.tum.flush().map_err(out_err(&self.tum_path))?;
         self.csv.flush().map_err(out_err(&self.csv_path))?;
         if let Some(tr) = self.truth.as_mut() {
             tr.finish()?;
+            return Ok(tr.stream.warnings().to_vec());
         }
-        Ok(())
+        Ok(Vec::new())
     }
 }

@@ -406,6 +406,33 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
         sigma_velocity: T,
         sigma_position: T,
     ) -> Result<(), EskfError> {
+        self.restart_from_attitude_filter_per_axis(
+            attitude,
+            carry,
+            velocity,
+            position,
+            sigma_velocity,
+            &Vector3::repeat(sigma_position),
+        )
+    }
+
+    /// [`Filter::restart_from_attitude_filter`] with a position 1σ per world axis
+    /// (`sigma_position = [σ_e, σ_n, σ_u]`: the position block of `P` is
+    /// `diag(σ_e², σ_n², σ_u²)`, still decoupled from the rest, so `P` stays positive
+    /// definite).
+    ///
+    /// # Errors
+    /// As [`Filter::restart_from_attitude_filter`]; the filter is then unchanged.
+    #[inline(never)] // once at start-up: its matrices stay out of the caller's frame
+    pub(crate) fn restart_from_attitude_filter_per_axis(
+        &mut self,
+        attitude: &AhrsAccelBias<T>,
+        carry: &So3<T>,
+        velocity: Vector3<T>,
+        position: Vector3<T>,
+        sigma_velocity: T,
+        sigma_position: &Vector3<T>,
+    ) -> Result<(), EskfError> {
         let a = attitude.state();
         let state = InsState {
             attitude: a.attitude.compose(carry).renormalize(),
@@ -417,8 +444,9 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
         if !state.is_finite() {
             return Err(EskfError::NonFinite);
         }
+        let position_variance = sigma_position.component_mul(sigma_position);
         if !(positive_finite(sigma_velocity * sigma_velocity)
-            && positive_finite(sigma_position * sigma_position))
+            && position_variance.iter().all(|v| positive_finite(*v)))
         {
             return Err(EskfError::CovarianceNotPositiveDefinite);
         }
@@ -442,7 +470,7 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
             }
         }
         add_scaled_identity(p, 1, 1, sigma_velocity * sigma_velocity);
-        add_scaled_identity(p, 2, 2, sigma_position * sigma_position);
+        set_block(p, 2, 2, &Matrix3::from_diagonal(&position_variance));
         Ok(())
     }
 
@@ -457,6 +485,20 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
     /// positive or is above the variance ceiling ([`crate::Real::VARIANCE_CEILING_F64`]); the
     /// filter is then unchanged.
     pub fn reset_position(&mut self, position: Vector3<T>, sigma: T) -> Result<(), EskfError> {
+        self.reset_block(2, position, &Vector3::repeat(sigma))
+    }
+
+    /// [`Filter::reset_position`] with a 1σ per world axis, `sigma = [σ_e, σ_n, σ_u]`: the
+    /// position block becomes `diag(σ_e², σ_n², σ_u²)` (a GNSS fix's horizontal and vertical
+    /// accuracy), decoupled from the rest.
+    ///
+    /// # Errors
+    /// As [`Filter::reset_position`], for any of the three sigmas.
+    pub(crate) fn reset_position_per_axis(
+        &mut self,
+        position: Vector3<T>,
+        sigma: &Vector3<T>,
+    ) -> Result<(), EskfError> {
         self.reset_block(2, position, sigma)
     }
 
@@ -465,7 +507,7 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
     /// # Errors
     /// As [`Filter::reset_position`].
     pub fn reset_velocity(&mut self, velocity: Vector3<T>, sigma: T) -> Result<(), EskfError> {
-        self.reset_block(1, velocity, sigma)
+        self.reset_block(1, velocity, &Vector3::repeat(sigma))
     }
 
     /// Adds `σ² I` to the velocity block of `P`: a velocity change the IMU did not measure
@@ -508,17 +550,28 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
         Ok(())
     }
 
-    /// Block `b` (1: velocity, 2: position) set to `value` with covariance `σ² I`, decoupled.
-    fn reset_block(&mut self, b: usize, value: Vector3<T>, sigma: T) -> Result<(), EskfError> {
-        let variance = sigma * sigma;
-        if !(all_finite(value.as_slice()) && usable_variance(variance)) {
+    /// Block `b` (1: velocity, 2: position) set to `value` with covariance
+    /// `diag(σ₁², σ₂², σ₃²)`, decoupled.
+    fn reset_block(
+        &mut self,
+        b: usize,
+        value: Vector3<T>,
+        sigma: &Vector3<T>,
+    ) -> Result<(), EskfError> {
+        let variance = sigma.component_mul(sigma);
+        if !(all_finite(value.as_slice()) && variance.iter().all(|v| usable_variance(*v))) {
             return Err(EskfError::NonFinite);
         }
         for k in 0..5 {
             set_block(&mut self.covariance, b, k, &Matrix3::zeros());
             set_block(&mut self.covariance, k, b, &Matrix3::zeros());
         }
-        add_scaled_identity(&mut self.covariance, b, b, variance);
+        set_block(
+            &mut self.covariance,
+            b,
+            b,
+            &Matrix3::from_diagonal(&variance),
+        );
         if b == 1 {
             self.state.velocity = value;
         } else {

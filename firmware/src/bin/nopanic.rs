@@ -250,6 +250,12 @@ fn eskf<T: Real>(x: &Seed<T>) {
         }};
     }
     ins_update!(GnssPosition::new(v, w, a));
+    match GnssPosition::with_sigmas(w, v, b, c) {
+        Ok(fix) => {
+            ins_update!(fix);
+        }
+        Err(e) => keep(&e),
+    }
     ins_update!(GnssVelocity::new(w, b));
     ins_update!(ZeroVelocity::new(c));
     ins_update!(BaroAltitude::new(h, d));
@@ -419,6 +425,7 @@ fn ins_nav<T: Real>(x: &Seed<T>, config: &FilterConfig<T>) {
     keep(&nav.imu(t, &v, &w));
     let fix = GnssFix::new(w, bb(Some(v)), a, b);
     keep(&nav.gnss(t, &fix));
+    keep(&nav.gnss(t, &fix.with_vertical_sigma(c)));
     keep(&nav.magnetometer(t, &w));
     keep(&nav.barometer(t, h));
     keep(&nav.estimate());

@@ -90,7 +90,7 @@ fn read(root: &Path, data: &[u8]) -> Outcome {
         } else if *columns == 0 {
             yaml(&mut input, keys).into_bytes()
         } else {
-            csv(&mut input, *columns).into_bytes()
+            csv(&mut input, *columns, *path == "gnss0/data.csv").into_bytes()
         };
         let file = dir.join(path);
         if let Some(parent) = file.parent() {
@@ -159,11 +159,18 @@ fn number(input: &mut Input<'_>, out: &mut String) {
 }
 
 /// A CSV file of `columns` columns: an optional header, rows with timestamps (increasing,
-/// equal, decreasing or anything) and numbers, with the column count sometimes wrong.
-fn csv(input: &mut Input<'_>, columns: usize) -> String {
+/// equal, decreasing or anything) and numbers, with the column count sometimes wrong. For the
+/// GNSS file (`gnss`) the second header is the geodetic form's, with its ten columns.
+fn csv(input: &mut Input<'_>, columns: usize, gnss: bool) -> String {
     let mut out = String::new();
+    let mut columns = columns;
     match input.byte() % 4 {
         0 => {}
+        1 if gnss => {
+            out.push_str(host_sim::dataset::read::GEODETIC_HEADER);
+            out.push('\n');
+            columns = 10;
+        }
         1 => out.push_str("#timestamp [ns],a,b,c\n"),
         2 => out.push_str("timestamp,a,b,c\n"),
         _ => out.push_str("# a comment, with \"quotes\n"),

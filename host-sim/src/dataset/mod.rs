@@ -9,8 +9,9 @@
 //! | `imu0/sensor.yaml` | `rate_hz`, `gyroscope_noise_density`, `gyroscope_random_walk`, `accelerometer_noise_density`, `accelerometer_random_walk` (continuous time, Kalibr units) |
 //! | `mag0/data.csv` | `#timestamp [ns]`, `m_x/y/z [uT]` (body frame) |
 //! | `mag0/sensor.yaml` | `rate_hz`, `sigma` (white noise per sample and axis, µT), `reference_field` (`[x, y, z]`, world frame, µT) |
-//! | `gnss0/data.csv` | `#timestamp [ns]`, `p_x/y/z [m]`, `v_x/y/z [m s^-1]` (world frame), `sigma_p [m]`, `sigma_v [m s^-1]` |
-//! | `gnss0/sensor.yaml` | optional: `lever_arm` (`[x, y, z]`, body frame, m; zero when absent) |
+//! | `gnss0/data.csv`, ENU form | `#timestamp [ns]`, `p_x/y/z [m]`, `v_x/y/z [m s^-1]` (world frame), `sigma_p [m]`, `sigma_v [m s^-1]`, optionally a 10th column `sigma_p_up [m]` (then `sigma_p` is the horizontal 1σ and `sigma_p_up` the vertical) |
+//! | `gnss0/data.csv`, geodetic form | told apart by a header naming `lat`: `#timestamp [ns]`, `lat [deg]`, `lon [deg]`, `h [m]` (WGS-84, height above the ellipsoid), `v_e/v_n/v_u [m s^-1]` (east-north-up at the fix; optional), `sigma_h [m]`, `sigma_v_up [m]`, `sigma_vel [m s^-1]` (with the velocity); columns found by name, in any order after the timestamp, others ignored ([`read::GeodeticColumns`]); converted to the world frame by [`geodesy`] |
+//! | `gnss0/sensor.yaml` | optional: `lever_arm` (`[x, y, z]`, body frame, m; zero when absent), `latency_s` (s; 0 when absent), `rate_hz`; `origin: [lat, lon, h]` (the geodetic form's world-frame origin, degrees and m; the first fix when absent, with a note on stderr); `sigma_p_horizontal`, `sigma_p_up` (m: the 9-column ENU form's horizontal and vertical 1σ, replacing the rows' `sigma_p`) |
 //! | `baro0/data.csv`, `baro0/sensor.yaml` | `#timestamp [ns]`, `altitude [m]`; `sigma` (m) |
 //! | `cam0/sensor.yaml` | `intrinsics: [fu, fv, cu, cv]`, `resolution: [w, h]`, `T_BS` (body from camera, 4×4 row-major `data:` list as in EuRoC), `sigma_px` |
 //! | `cam0/landmarks.csv` | `id`, `x/y/z [m]` (world frame) |
@@ -33,6 +34,7 @@
 //! line cut short, gaps, sensors that start late or stop early, refused samples.
 
 pub mod check;
+pub mod geodesy;
 pub mod read;
 pub mod write;
 pub mod yaml;

@@ -2,6 +2,7 @@
 //! look-ahead per file (memory does not grow with the run).
 
 use super::check::{DataCheck, DataWarning, Sensor};
+use super::geodesy::{Geodetic, LocalEnu};
 use super::yaml::SensorYaml;
 use super::DatasetError;
 use estimator_core::lie::{LieGroup, Se3, So3};
@@ -37,13 +38,212 @@ pub struct MagParams {
     pub reference_field: Vector3<f64>,
 }
 
-/// GNSS parameters from `gnss0/sensor.yaml` (optional file: defaults to no lever arm).
+/// GNSS parameters from `gnss0/sensor.yaml` (optional file: defaults to no lever arm) and the
+/// form of `gnss0/data.csv`, told by its header.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GnssParams {
     /// Antenna lever arm in the body frame, m.
     pub lever_arm: Vector3<f64>,
     /// The fix was valid this long before its row's timestamp, s (`latency_s`; 0 when absent).
     pub latency_s: f64,
+    /// How `gnss0/data.csv` gives its fixes.
+    pub format: GnssFormat,
+    /// The geodetic form's world frame: ENU at `origin: [lat, lon, h]` of `sensor.yaml`, else
+    /// at the first fix (`None` for the ENU form, or a file without fixes).
+    pub frame: Option<LocalEnu>,
+    /// The geodetic form's origin is the first fix (`sensor.yaml` has no `origin`).
+    pub origin_from_first_fix: bool,
+    /// The ENU form without a `sigma_p_up` column: `sensor.yaml`'s `sigma_p_horizontal`, m,
+    /// which replaces the rows' `sigma_p` on east and north.
+    pub sigma_p_horizontal: Option<f64>,
+    /// The ENU form without a `sigma_p_up` column: `sensor.yaml`'s `sigma_p_up`, m, the
+    /// vertical 1σ of every fix.
+    pub sigma_p_up: Option<f64>,
+}
+
+/// The two forms of `gnss0/data.csv` (module docs of [`crate::dataset`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum GnssFormat {
+    /// Local ENU metres, 9 columns (`sigma_p` on every axis), or 10 with a trailing
+    /// `sigma_p_up [m]` (`sigma_p` then horizontal only).
+    Enu {
+        /// The 10-column form.
+        sigma_up_column: bool,
+    },
+    /// WGS-84 latitude, longitude and ellipsoidal height, the columns found by name.
+    Geodetic(GeodeticColumns),
+}
+
+impl GnssFormat {
+    /// The number of columns of a row, the timestamp included.
+    #[must_use]
+    pub fn columns(&self) -> usize {
+        match self {
+            Self::Enu { sigma_up_column } => 9 + usize::from(*sigma_up_column),
+            Self::Geodetic(c) => c.columns,
+        }
+    }
+}
+
+/// Where the geodetic form's values are: indices into a row's values after the timestamp
+/// (column `k + 1` of the file is value `k`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GeodeticColumns {
+    /// Columns of a row, the timestamp included.
+    pub columns: usize,
+    /// `lat [deg]`.
+    pub lat: usize,
+    /// `lon [deg]`.
+    pub lon: usize,
+    /// `h [m]`, above the ellipsoid.
+    pub height: usize,
+    /// `v_e`, `v_n`, `v_u [m s^-1]`, east-north-up at the fix, when given.
+    pub velocity: Option<[usize; 3]>,
+    /// `sigma_h [m]`.
+    pub sigma_h: usize,
+    /// `sigma_v_up [m]`.
+    pub sigma_up: usize,
+    /// `sigma_vel [m s^-1]`, with the velocity.
+    pub sigma_vel: Option<usize>,
+}
+
+/// A header cell's name: lower case, without a leading `#` and without its `[unit]`.
+fn column_name(cell: &str) -> String {
+    let cell = cell.trim().trim_start_matches('#');
+    let name = cell.split('[').next().unwrap_or(cell);
+    name.trim().to_ascii_lowercase()
+}
+
+/// The names a geodetic header may give each quantity (the first is the one written).
+const LAT_NAMES: [&str; 2] = ["lat", "latitude"];
+const LON_NAMES: [&str; 2] = ["lon", "longitude"];
+const HEIGHT_NAMES: [&str; 3] = ["h", "height", "ellipsoidal_height"];
+const VE_NAMES: [&str; 2] = ["v_e", "v_east"];
+const VN_NAMES: [&str; 2] = ["v_n", "v_north"];
+const VU_NAMES: [&str; 2] = ["v_u", "v_up"];
+const SIGMA_H_NAMES: [&str; 2] = ["sigma_h", "sigma_horizontal"];
+const SIGMA_UP_NAMES: [&str; 4] = ["sigma_v_up", "sigma_p_up", "sigma_up", "sigma_vertical"];
+const SIGMA_VEL_NAMES: [&str; 2] = ["sigma_vel", "sigma_velocity"];
+
+impl GeodeticColumns {
+    /// The columns of a geodetic header (`names` from [`column_name`], the timestamp first);
+    /// other names are ignored.
+    fn from_header(path: &Path, names: &[String]) -> Result<Self, DatasetError> {
+        let err = |m: String| DatasetError::at(path, 1, m);
+        let find = |aliases: &[&str]| -> Result<Option<usize>, DatasetError> {
+            let mut found = None;
+            for (i, n) in names.iter().enumerate().skip(1) {
+                if aliases.contains(&n.as_str()) {
+                    if found.is_some() {
+                        return Err(err(format!("geodetic header names '{}' twice", aliases[0])));
+                    }
+                    found = Some(i - 1);
+                }
+            }
+            Ok(found)
+        };
+        if names.iter().skip(1).any(|n| n == "sigma_v") {
+            return Err(err(
+                "'sigma_v' is ambiguous in the geodetic form: name the vertical position 1σ \
+                 'sigma_v_up [m]' and the velocity 1σ 'sigma_vel [m s^-1]'"
+                    .into(),
+            ));
+        }
+        let required = |aliases: &[&str]| -> Result<usize, DatasetError> {
+            find(aliases)?.ok_or_else(|| {
+                err(format!(
+                    "geodetic header has no '{}' column (expected {GEODETIC_HEADER})",
+                    aliases[0]
+                ))
+            })
+        };
+        let (lat, lon, height) = (
+            required(&LAT_NAMES)?,
+            required(&LON_NAMES)?,
+            required(&HEIGHT_NAMES)?,
+        );
+        let (sigma_h, sigma_up) = (required(&SIGMA_H_NAMES)?, required(&SIGMA_UP_NAMES)?);
+        let velocity = match (find(&VE_NAMES)?, find(&VN_NAMES)?, find(&VU_NAMES)?) {
+            (Some(e), Some(n), Some(u)) => Some([e, n, u]),
+            (None, None, None) => None,
+            _ => {
+                return Err(err(
+                    "geodetic header has some of v_e, v_n, v_u but not all three".into(),
+                ))
+            }
+        };
+        let sigma_vel = find(&SIGMA_VEL_NAMES)?;
+        if velocity.is_some() && sigma_vel.is_none() {
+            return Err(err(
+                "geodetic header has a velocity but no 'sigma_vel [m s^-1]' column".into(),
+            ));
+        }
+        Ok(Self {
+            columns: names.len(),
+            lat,
+            lon,
+            height,
+            velocity,
+            sigma_h,
+            sigma_up,
+            sigma_vel,
+        })
+    }
+}
+
+/// The header the simulator's geodetic form would write, and the error messages quote.
+pub const GEODETIC_HEADER: &str = "#timestamp [ns],lat [deg],lon [deg],h [m],v_e [m s^-1],v_n [m s^-1],v_u [m s^-1],sigma_h [m],sigma_v_up [m],sigma_vel [m s^-1]";
+
+/// The form of `gnss0/data.csv` from its first line: a header naming a latitude is the
+/// geodetic form; otherwise the ENU form, with the 10th column `sigma_p_up` when the header
+/// (or, without a header, the first row) has ten.
+fn gnss_format(path: &Path) -> Result<GnssFormat, DatasetError> {
+    let file = File::open(path).map_err(|e| DatasetError::file(path, e))?;
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .from_reader(file);
+    let mut record = csv::StringRecord::new();
+    loop {
+        let more = reader.read_record(&mut record).map_err(|e| {
+            let line = e.position().map_or(0, |p| p.line());
+            DatasetError::at(path, line, e.to_string())
+        })?;
+        if !more {
+            return Ok(GnssFormat::Enu {
+                sigma_up_column: false,
+            });
+        }
+        if !(record.len() <= 1 && record.get(0).unwrap_or("").is_empty()) {
+            break;
+        }
+    }
+    let line = record.position().map_or(0, |p| p.line());
+    let first = record.get(0).unwrap_or("");
+    let header = line == 1 && (first.starts_with('#') || first.parse::<u64>().is_err());
+    if !header {
+        return Ok(GnssFormat::Enu {
+            sigma_up_column: record.len() == 10,
+        });
+    }
+    let names: Vec<String> = record.iter().map(column_name).collect();
+    if names.iter().any(|n| LAT_NAMES.contains(&n.as_str())) {
+        return GeodeticColumns::from_header(path, &names).map(GnssFormat::Geodetic);
+    }
+    if names.len() == 10 {
+        let last = names.get(9).map_or("", String::as_str);
+        if !SIGMA_UP_NAMES.contains(&last) {
+            return Err(DatasetError::at(
+                path,
+                1,
+                format!("column 10 '{last}' of the ENU form must be 'sigma_p_up [m]'"),
+            ));
+        }
+    }
+    Ok(GnssFormat::Enu {
+        sigma_up_column: names.len() == 10,
+    })
 }
 
 /// Camera parameters from `cam0/sensor.yaml` and the landmark map from `cam0/landmarks.csv`.
@@ -83,6 +283,9 @@ pub struct Dataset {
     pub baro: Option<BaroParams>,
     /// Whether ground truth is present.
     pub has_groundtruth: bool,
+    /// What the reader decided for the user to know, not a problem (the replay prints them on
+    /// stderr): the geodetic form's origin taken from the first fix.
+    pub notes: Vec<String>,
     /// The scored intervals of `movement.csv` (`[start, end]` ns, inclusive), if present.
     pub movement: Option<Vec<(u64, u64)>>,
     /// What a missing optional file made the reader assume (printed in the summary).
@@ -111,17 +314,19 @@ pub enum Event {
         /// µT, body frame.
         field: Vector3<f64>,
     },
-    /// A GNSS fix.
+    /// A GNSS fix (the geodetic form converted to the world frame).
     Gnss {
         /// ns.
         t_ns: u64,
-        /// m, world.
+        /// m, world (ENU).
         position: Vector3<f64>,
-        /// m/s, world.
-        velocity: Vector3<f64>,
-        /// m.
+        /// m/s, world (ENU), when the receiver gives one.
+        velocity: Option<Vector3<f64>>,
+        /// Horizontal (east, north) position 1σ, m.
         sigma_p: f64,
-        /// m/s.
+        /// Vertical (up) position 1σ, m (`sigma_p` where the file gives one σ).
+        sigma_p_up: f64,
+        /// Velocity 1σ, m/s (0 without a velocity).
         sigma_v: f64,
     },
     /// The observations of one camera frame.
@@ -291,6 +496,88 @@ fn v3(v: &[f64], i: usize) -> Vector3<f64> {
     Vector3::new(v[i], v[i + 1], v[i + 2])
 }
 
+/// What turns a row of `gnss0/data.csv` into an [`Event::Gnss`].
+#[derive(Clone, Debug)]
+struct GnssDecode {
+    format: GnssFormat,
+    frame: Option<LocalEnu>,
+    sigma_p_horizontal: Option<f64>,
+    sigma_p_up: Option<f64>,
+}
+
+impl GnssDecode {
+    fn new(p: &GnssParams) -> Self {
+        Self {
+            format: p.format.clone(),
+            frame: p.frame,
+            sigma_p_horizontal: p.sigma_p_horizontal,
+            sigma_p_up: p.sigma_p_up,
+        }
+    }
+
+    /// The event of the row `(line, t, values)` of `path` (values checked finite, one per
+    /// column after the timestamp).
+    fn event(&self, path: &Path, line: u64, t: u64, v: &[f64]) -> Result<Event, DatasetError> {
+        match &self.format {
+            GnssFormat::Enu { sigma_up_column } => {
+                let (sigma_p, sigma_p_up) = if *sigma_up_column {
+                    (v[6], v[8])
+                } else {
+                    (
+                        self.sigma_p_horizontal.unwrap_or(v[6]),
+                        self.sigma_p_up.unwrap_or(v[6]),
+                    )
+                };
+                Ok(Event::Gnss {
+                    t_ns: t,
+                    position: v3(v, 0),
+                    velocity: Some(v3(v, 3)),
+                    sigma_p,
+                    sigma_p_up,
+                    sigma_v: v[7],
+                })
+            }
+            GnssFormat::Geodetic(c) => {
+                let g = Geodetic::new(v[c.lat], v[c.lon], v[c.height]);
+                g.check().map_err(|m| DatasetError::at(path, line, m))?;
+                let frame = self.frame.ok_or_else(|| {
+                    DatasetError::at(path, line, "no origin for the geodetic fixes")
+                })?;
+                let velocity = c
+                    .velocity
+                    .map(|[e, n, u]| frame.vector_to_enu(&g, &Vector3::new(v[e], v[n], v[u])));
+                Ok(Event::Gnss {
+                    t_ns: t,
+                    position: frame.to_enu(&g),
+                    velocity,
+                    sigma_p: v[c.sigma_h],
+                    sigma_p_up: v[c.sigma_up],
+                    sigma_v: c.sigma_vel.map_or(0.0, |i| v[i]),
+                })
+            }
+        }
+    }
+}
+
+/// The geodetic form's world frame: ENU at `origin` (from `sensor.yaml`), else at the first
+/// fix of `data` (then `true`); `None` for a file without fixes.
+fn geodetic_frame(
+    data: &Path,
+    columns: &GeodeticColumns,
+    origin: Option<Geodetic>,
+) -> Result<(Option<LocalEnu>, bool), DatasetError> {
+    if let Some(o) = origin {
+        return Ok((Some(LocalEnu::new(o)), false));
+    }
+    let mut rows = Rows::open(data, columns.columns, false)?;
+    let Some((line, _, v)) = rows.next_row()? else {
+        return Ok((None, false));
+    };
+    let first = Geodetic::new(v[columns.lat], v[columns.lon], v[columns.height]);
+    first.check().map_err(|m| DatasetError::at(data, line, m))?;
+    Ok((Some(LocalEnu::new(first)), true))
+}
+
 impl Dataset {
     /// Reads the folder's `sensor.yaml` files and the landmark map.
     pub fn open(dir: &Path) -> Result<Self, DatasetError> {
@@ -336,9 +623,14 @@ impl Dataset {
         } else {
             None
         };
+        let mut notes = Vec::new();
         let gnss = if dir.join("gnss0/data.csv").is_file() {
             let path = dir.join("gnss0/sensor.yaml");
+            let data = dir.join("gnss0/data.csv");
+            let format = gnss_format(&data)?;
             let mut latency_s = 0.0;
+            let mut origin = None;
+            let (mut sigma_p_horizontal, mut sigma_p_up) = (None, None);
             let lever_arm = if path.is_file() {
                 let y = SensorYaml::read(&path)?;
                 latency_s = y.f64_or("latency_s", 0.0)?;
@@ -347,6 +639,28 @@ impl Dataset {
                         &path,
                         "latency_s must be a number of seconds, 0 or more",
                     ));
+                }
+                if y.has("origin") {
+                    let o = y.list("origin", 3)?;
+                    let g = Geodetic::new(o[0], o[1], o[2]);
+                    g.check()
+                        .map_err(|m| DatasetError::file(&path, format!("origin: {m}")))?;
+                    origin = Some(g);
+                }
+                for (key, slot) in [
+                    ("sigma_p_horizontal", &mut sigma_p_horizontal),
+                    ("sigma_p_up", &mut sigma_p_up),
+                ] {
+                    if y.has(key) {
+                        let s = y.f64(key)?;
+                        if !(s.is_finite() && s > 0.0) {
+                            return Err(DatasetError::file(
+                                &path,
+                                format!("{key} must be a positive number of metres"),
+                            ));
+                        }
+                        *slot = Some(s);
+                    }
                 }
                 match y.list("lever_arm", 3) {
                     Ok(l) => Vector3::new(l[0], l[1], l[2]),
@@ -365,9 +679,28 @@ impl Dataset {
                 ));
                 Vector3::zeros()
             };
+            let (frame, origin_from_first_fix) = match &format {
+                GnssFormat::Geodetic(columns) => geodetic_frame(&data, columns, origin)?,
+                GnssFormat::Enu { .. } => (None, false),
+            };
+            if let (Some(f), true) = (&frame, origin_from_first_fix) {
+                let o = f.origin();
+                notes.push(format!(
+                    "{} has no origin: the world frame is east-north-up at the first fix, lat {:.9}°, lon {:.9}°, h {:.3} m",
+                    path.display(),
+                    o.lat_deg,
+                    o.lon_deg,
+                    o.height_m
+                ));
+            }
             Some(GnssParams {
                 lever_arm,
                 latency_s,
+                format,
+                frame,
+                origin_from_first_fix,
+                sigma_p_horizontal,
+                sigma_p_up,
             })
         } else {
             None
@@ -419,6 +752,7 @@ impl Dataset {
             baro,
             has_groundtruth: dir.join("state_groundtruth_estimate0/data.csv").is_file(),
             warnings,
+            notes,
             movement: {
                 let (m, w) = movement_checked(dir)?;
                 data_warnings.extend(w);
@@ -449,11 +783,11 @@ impl Dataset {
             } else {
                 None
             },
-            gnss: if self.gnss.is_some() {
-                open("gnss0/data.csv", 9, false)?
-            } else {
-                None
+            gnss: match &self.gnss {
+                Some(g) => open("gnss0/data.csv", g.format.columns(), false)?,
+                None => None,
             },
+            gnss_decode: self.gnss.as_ref().map(GnssDecode::new),
             cam: if self.camera.is_some() {
                 open("cam0/observations.csv", 4, true)?
             } else {
@@ -535,6 +869,7 @@ pub struct EventStream {
     imu: Option<Source>,
     mag: Option<Source>,
     gnss: Option<Source>,
+    gnss_decode: Option<GnssDecode>,
     cam: Option<Source>,
     baro: Option<Source>,
     dir: PathBuf,
@@ -632,16 +967,17 @@ impl EventStream {
                 };
                 (e, origin(Sensor::Mag, line, t))
             }),
-            2 => take(&mut self.gnss).map(|(line, t, v)| {
-                let e = Event::Gnss {
-                    t_ns: t,
-                    position: v3(&v, 0),
-                    velocity: v3(&v, 3),
-                    sigma_p: v[6],
-                    sigma_v: v[7],
+            2 => {
+                let (Some(src), Some(decode)) = (self.gnss.as_mut(), self.gnss_decode.as_ref())
+                else {
+                    return Ok(None);
                 };
-                (e, origin(Sensor::Gnss, line, t))
-            }),
+                let Some((line, t, v)) = src.ahead.take() else {
+                    return Ok(None);
+                };
+                let e = decode.event(&src.rows.path, line, t, &v)?;
+                Some((e, origin(Sensor::Gnss, line, t)))
+            }
             3 => {
                 let Some(src) = self.cam.as_mut() else {
                     return Ok(None);
@@ -1149,6 +1485,310 @@ mod tests {
         std::fs::write(dir.join("faults.csv"), "#h\n1,2,gnss,frozen\nbad\n").expect("write");
         let err = read_faults(&dir).expect_err("malformed").to_string();
         assert!(err.contains("faults.csv:3:"), "{err}");
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    /// A dataset folder with a two-row IMU and the given `gnss0/data.csv` (and
+    /// `gnss0/sensor.yaml`, when given).
+    fn gnss_dataset(name: &str, data: &str, yaml: Option<&str>) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("host-sim-gnss-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("imu0")).expect("tmp");
+        std::fs::create_dir_all(dir.join("gnss0")).expect("tmp");
+        std::fs::write(
+            dir.join("imu0/sensor.yaml"),
+            "rate_hz: 200\ngyroscope_noise_density: 1e-4\ngyroscope_random_walk: 1e-5\naccelerometer_noise_density: 1e-3\naccelerometer_random_walk: 1e-4\n",
+        )
+        .expect("write");
+        std::fs::write(
+            dir.join("imu0/data.csv"),
+            "#timestamp [ns],w_x,w_y,w_z,a_x,a_y,a_z\n1000,0,0,0,0,0,9.81\n2000,0,0,0,0,0,9.81\n",
+        )
+        .expect("write");
+        std::fs::write(dir.join("gnss0/data.csv"), data).expect("write");
+        if let Some(y) = yaml {
+            std::fs::write(dir.join("gnss0/sensor.yaml"), y).expect("write");
+        }
+        dir
+    }
+
+    fn gnss_events(dir: &Path) -> Result<Vec<Event>, DatasetError> {
+        Dataset::open(dir)?
+            .events()?
+            .filter(|e| matches!(e, Ok(Event::Gnss { .. }) | Err(_)))
+            .collect()
+    }
+
+    /// `(position, velocity, sigma_p, sigma_p_up, sigma_v)` of a GNSS event.
+    #[allow(clippy::type_complexity)]
+    fn fix(e: &Event) -> (Vector3<f64>, Option<Vector3<f64>>, f64, f64, f64) {
+        match e {
+            Event::Gnss {
+                position,
+                velocity,
+                sigma_p,
+                sigma_p_up,
+                sigma_v,
+                ..
+            } => (*position, *velocity, *sigma_p, *sigma_p_up, *sigma_v),
+            other => panic!("not a fix: {other:?}"),
+        }
+    }
+
+    const ENU_HEADER: &str = "#timestamp [ns],p_x [m],p_y [m],p_z [m],v_x [m s^-1],v_y [m s^-1],v_z [m s^-1],sigma_p [m],sigma_v [m s^-1]";
+
+    #[test]
+    fn the_enu_form_gives_one_sigma_or_a_vertical_one() {
+        // Nine columns: one σ for every axis, as before.
+        let row = "1500,1,2,3,0.1,0.2,0.3,1.5,0.1";
+        let dir = gnss_dataset("enu9", &format!("{ENU_HEADER}\n{row}\n"), None);
+        let ds = Dataset::open(&dir).expect("opens");
+        let g = ds.gnss.as_ref().expect("gnss");
+        assert_eq!(
+            g.format,
+            GnssFormat::Enu {
+                sigma_up_column: false
+            }
+        );
+        assert!(g.frame.is_none() && ds.notes.is_empty());
+        let events = gnss_events(&dir).expect("rows");
+        assert_eq!(
+            fix(&events[0]),
+            (
+                Vector3::new(1.0, 2.0, 3.0),
+                Some(Vector3::new(0.1, 0.2, 0.3)),
+                1.5,
+                1.5,
+                0.1
+            )
+        );
+        // The simulator's keys in sensor.yaml: horizontal and vertical replace the row's σ.
+        std::fs::write(
+            dir.join("gnss0/sensor.yaml"),
+            "lever_arm: [0, 0, 0]\nsigma_p_horizontal: 1.0\nsigma_p_up: 1.5\n",
+        )
+        .expect("write");
+        let (_, _, h, up, _) = fix(&gnss_events(&dir).expect("rows")[0]);
+        assert_eq!((h, up), (1.0, 1.5));
+        std::fs::write(dir.join("gnss0/sensor.yaml"), "sigma_p_up: -2\n").expect("write");
+        let err = Dataset::open(&dir).expect_err("negative").to_string();
+        assert!(
+            err.contains("sensor.yaml") && err.contains("sigma_p_up"),
+            "{err}"
+        );
+        // Ten columns, with a header or without: the 10th is the vertical σ.
+        for (name, text) in [
+            (
+                "enu10",
+                format!("{ENU_HEADER},sigma_p_up [m]\n1500,1,2,3,0.1,0.2,0.3,0.8,0.1,2.5\n"),
+            ),
+            (
+                "enu10-bare",
+                "1500,1,2,3,0.1,0.2,0.3,0.8,0.1,2.5\n1600,1,2,3,0.1,0.2,0.3,0.8,0.1,2.5\n"
+                    .to_string(),
+            ),
+        ] {
+            let dir = gnss_dataset(name, &text, Some("lever_arm: [0, 0, 0]\nsigma_p_up: 9\n"));
+            let ds = Dataset::open(&dir).expect("opens");
+            assert_eq!(
+                ds.gnss.expect("gnss").format,
+                GnssFormat::Enu {
+                    sigma_up_column: true
+                }
+            );
+            let (p, _, h, up, _) = fix(&gnss_events(&dir).expect("rows")[0]);
+            assert_eq!(
+                (p, h, up),
+                (Vector3::new(1.0, 2.0, 3.0), 0.8, 2.5),
+                "{name}"
+            );
+            let _ = std::fs::remove_dir_all(dir);
+        }
+        // A 10th column of another name, or a row of the wrong length, names file and line.
+        let dir2 = gnss_dataset("enu10-bad", &format!("{ENU_HEADER},hdop\n"), None);
+        let err = Dataset::open(&dir2).expect_err("unknown").to_string();
+        assert!(
+            err.contains("gnss0/data.csv:1:") && err.contains("'hdop'"),
+            "{err}"
+        );
+        let dir3 = gnss_dataset(
+            "enu10-short",
+            &format!("{ENU_HEADER},sigma_p_up [m]\n1500,1,2,3,0.1,0.2,0.3,0.8,0.1\n"),
+            None,
+        );
+        let err = gnss_events(&dir3).expect_err("short").to_string();
+        assert!(
+            err.contains("gnss0/data.csv:2:") && err.contains("expected 10 columns"),
+            "{err}"
+        );
+        for d in [dir, dir2, dir3] {
+            let _ = std::fs::remove_dir_all(d);
+        }
+    }
+
+    #[test]
+    fn the_geodetic_form_is_converted_to_enu_at_its_origin() {
+        use crate::dataset::geodesy::LocalEnu;
+        let origin = Geodetic::new(47.376_887, 8.541_694, 408.0);
+        let frame = LocalEnu::new(origin);
+        let enu = [
+            Vector3::new(10.0, -20.0, 3.0),
+            Vector3::new(12.0, -19.0, 2.5),
+        ];
+        let v_here = Vector3::new(2.0, 1.0, -0.5);
+        let mut text = format!("{GEODETIC_HEADER}\n");
+        for (k, p) in enu.iter().enumerate() {
+            let g = frame.to_geodetic(p);
+            // The velocity as the receiver gives it: east-north-up where it is.
+            let v = frame.vector_from_enu(&g, &v_here);
+            text += &format!(
+                "{},{:.12},{:.12},{:.6},{},{},{},0.7,1.4,0.05\n",
+                1500 + k,
+                g.lat_deg,
+                g.lon_deg,
+                g.height_m,
+                v.x,
+                v.y,
+                v.z
+            );
+        }
+        let yaml = format!(
+            "lever_arm: [0, 0, 0]\norigin: [{}, {}, {}]\n",
+            origin.lat_deg, origin.lon_deg, origin.height_m
+        );
+        let dir = gnss_dataset("geodetic", &text, Some(&yaml));
+        let ds = Dataset::open(&dir).expect("opens");
+        let g = ds.gnss.as_ref().expect("gnss");
+        assert!(matches!(g.format, GnssFormat::Geodetic(_)));
+        assert!(!g.origin_from_first_fix && ds.notes.is_empty());
+        let events = gnss_events(&dir).expect("rows");
+        assert_eq!(events.len(), 2);
+        for (e, want) in events.iter().zip(&enu) {
+            let (p, v, h, up, sv) = fix(e);
+            // 1e-12° is 0.1 µm, 1e-6 m of height 1 µm.
+            assert!((p - want).norm() < 1e-5, "{p} vs {want}");
+            assert!((v.expect("velocity") - v_here).norm() < 1e-9);
+            assert_eq!((h, up, sv), (0.7, 1.4, 0.05));
+        }
+
+        // Without an origin, the first fix is the origin (and a note says so); another order
+        // and names of the columns, no velocity, an extra column ignored.
+        let first = frame.to_geodetic(&enu[0]);
+        let second = frame.to_geodetic(&enu[1]);
+        let text = format!(
+            "#timestamp [ns],sigma_h [m],latitude [deg],longitude [deg],height [m],num_sv,sigma_p_up [m]\n\
+             1500,0.7,{:.12},{:.12},{:.6},12,1.4\n1600,0.7,{:.12},{:.12},{:.6},11,1.4\n",
+            first.lat_deg, first.lon_deg, first.height_m, second.lat_deg, second.lon_deg, second.height_m
+        );
+        std::fs::write(dir.join("gnss0/data.csv"), text).expect("write");
+        std::fs::write(dir.join("gnss0/sensor.yaml"), "lever_arm: [0, 0, 0]\n").expect("write");
+        let ds = Dataset::open(&dir).expect("opens");
+        assert!(ds.gnss.as_ref().expect("gnss").origin_from_first_fix);
+        assert!(
+            ds.notes.len() == 1 && ds.notes[0].contains("first fix"),
+            "{:?}",
+            ds.notes
+        );
+        let events = gnss_events(&dir).expect("rows");
+        let (p0, v0, h, up, _) = fix(&events[0]);
+        assert!(p0.norm() < 1e-5 && v0.is_none() && (h, up) == (0.7, 1.4));
+        let (p1, ..) = fix(&events[1]);
+        let want = LocalEnu::new(first).to_enu(&second);
+        assert!((p1 - want).norm() < 1e-5 && (p1 - (enu[1] - enu[0])).norm() < 1e-3);
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    /// The header with the velocity's unit written once, after the three
+    /// (`v_e,v_n,v_u [m s^-1]`), reads as the one the reader writes in its messages.
+    #[test]
+    fn the_short_spelling_of_the_geodetic_header_is_read() {
+        let short = "#timestamp [ns],lat [deg],lon [deg],h [m],v_e,v_n,v_u [m s^-1],sigma_h [m],sigma_v_up [m],sigma_vel [m s^-1]";
+        let row = "1500,47.1,8.5,400.0,1.0,2.0,0.5,0.8,1.6,0.05";
+        for (k, header) in [short, GEODETIC_HEADER].iter().enumerate() {
+            let dir = gnss_dataset(
+                &format!("short-{k}"),
+                &format!("{header}\n{row}\n"),
+                Some("lever_arm: [0, 0, 0]\norigin: [47.1, 8.5, 400.0]\n"),
+            );
+            let ds = Dataset::open(&dir).expect("opens");
+            assert_eq!(
+                ds.gnss.as_ref().expect("gnss").format,
+                GnssFormat::Geodetic(GeodeticColumns {
+                    columns: 10,
+                    lat: 0,
+                    lon: 1,
+                    height: 2,
+                    velocity: Some([3, 4, 5]),
+                    sigma_h: 6,
+                    sigma_up: 7,
+                    sigma_vel: Some(8),
+                })
+            );
+            let (p, v, h, up, sv) = fix(&gnss_events(&dir).expect("rows")[0]);
+            // At the origin, with the velocity in the origin's own frame.
+            assert!(p.norm() < 1e-9, "{p}");
+            assert!((v.expect("velocity") - Vector3::new(1.0, 2.0, 0.5)).norm() < 1e-12);
+            assert_eq!((h, up, sv), (0.8, 1.6, 0.05));
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
+
+    #[test]
+    fn malformed_geodetic_files_name_file_and_line() {
+        let cases = [
+            (
+                "#timestamp [ns],lat [deg],lon [deg],h [m],sigma_v_up [m]\n",
+                "gnss0/data.csv:1:",
+                "no 'sigma_h' column",
+            ),
+            (
+                "#timestamp [ns],lat [deg],lon [deg],h [m],sigma_h [m],sigma_v [m]\n",
+                "gnss0/data.csv:1:",
+                "ambiguous",
+            ),
+            (
+                "#timestamp [ns],lat,lon,h,v_e,v_n,sigma_h,sigma_v_up,sigma_vel\n",
+                "gnss0/data.csv:1:",
+                "not all three",
+            ),
+            (
+                "#timestamp [ns],lat,lon,h,v_e,v_n,v_u,sigma_h,sigma_v_up\n",
+                "gnss0/data.csv:1:",
+                "no 'sigma_vel [m s^-1]'",
+            ),
+            (
+                "#timestamp [ns],lat,latitude,lon,h,sigma_h,sigma_v_up\n",
+                "gnss0/data.csv:1:",
+                "twice",
+            ),
+            (
+                "#timestamp [ns],lat,lon,h,sigma_h,sigma_v_up\n1500,47.1,8.5,400,1,2\n1600,95.0,8.5,400,1,2\n",
+                "gnss0/data.csv:3:",
+                "latitude 95",
+            ),
+            (
+                "#timestamp [ns],lat,lon,h,sigma_h,sigma_v_up\n1500,47.1,8.5,400,1\n",
+                "gnss0/data.csv:2:",
+                "expected 6 columns, got 5",
+            ),
+        ];
+        for (k, (text, at, what)) in cases.iter().enumerate() {
+            let dir = gnss_dataset(&format!("bad-{k}"), text, Some("lever_arm: [0, 0, 0]\n"));
+            let err = gnss_events(&dir).expect_err(text).to_string();
+            assert!(err.contains(at) && err.contains(what), "{text:?}: {err}");
+            let _ = std::fs::remove_dir_all(dir);
+        }
+        // An origin out of range in sensor.yaml is named.
+        let dir = gnss_dataset(
+            "bad-origin",
+            "#timestamp [ns],lat,lon,h,sigma_h,sigma_v_up\n1500,47.1,8.5,400,1,2\n",
+            Some("origin: [47.1, 400.0, 0]\n"),
+        );
+        let err = Dataset::open(&dir).expect_err("origin").to_string();
+        assert!(
+            err.contains("sensor.yaml") && err.contains("longitude 400"),
+            "{err}"
+        );
         let _ = std::fs::remove_dir_all(dir);
     }
 

@@ -227,10 +227,21 @@ fn write_all(sc: &Scenario, traj: &Trajectory, seed: u64, out: &Out) -> Result<(
     }
 
     if let Some(c) = &sc.gnss {
+        // The rows' `sigma_p` is one σ for every axis (the larger of the two, for readers that
+        // take one); a receiver with a separate vertical σ says both here, where a reader that
+        // does not know the keys ignores them.
+        let sigmas = if c.sigma_horizontal == c.sigma_vertical {
+            String::new()
+        } else {
+            format!(
+                "sigma_p_horizontal: {}\nsigma_p_up: {}\n",
+                c.sigma_horizontal, c.sigma_vertical
+            )
+        };
         out.write(
             "gnss0/sensor.yaml",
             &format!(
-                "sensor_type: gnss\nrate_hz: {}\nlever_arm: [{}, {}, {}]\nlatency_s: {}\n",
+                "sensor_type: gnss\nrate_hz: {}\nlever_arm: [{}, {}, {}]\nlatency_s: {}\n{sigmas}",
                 c.rate_hz, c.lever_arm[0], c.lever_arm[1], c.lever_arm[2], c.latency_s
             ),
         )?;

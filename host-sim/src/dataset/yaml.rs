@@ -43,6 +43,12 @@ impl SensorYaml {
         })
     }
 
+    /// Whether `key` is given (a value other than null).
+    #[must_use]
+    pub fn has(&self, key: &str) -> bool {
+        !matches!(&self.doc[key], Yaml::BadValue | Yaml::Null)
+    }
+
     /// An optional number.
     pub fn f64_or(&self, key: &str, default: f64) -> Result<f64, DatasetError> {
         match &self.doc[key] {

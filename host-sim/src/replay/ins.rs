@@ -220,14 +220,16 @@ pub(super) fn replay_ins<T: Real>(
                 position,
                 velocity,
                 sigma_p,
+                sigma_p_up,
                 sigma_v,
             } => {
                 let fix = GnssFix::new(
                     lit3(&position),
-                    Some(lit3(&velocity)),
+                    velocity.as_ref().map(lit3),
                     T::lit(sigma_p),
                     T::lit(sigma_v),
-                );
+                )
+                .with_vertical_sigma(T::lit(sigma_p_up));
                 let r = nav.gnss(t_ns.saturating_sub(latency_ns), &fix);
                 score(&mut scorer, &mut events, &r, "gnss_position", t_ns);
             }

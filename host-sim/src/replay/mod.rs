@@ -350,6 +350,9 @@ fn replay_in<T: Real>(
     mut scorer: Scorer,
 ) -> Result<Scorer, ReplayError> {
     let ds = Dataset::open(dir)?;
+    for note in &ds.notes {
+        eprintln!("note: {note}");
+    }
     scorer.note_run(&ds, &cfg.precision);
     std::fs::create_dir_all(out).map_err(out_err(out))?;
     if ds.gnss.is_none() && ds.camera.is_none() {

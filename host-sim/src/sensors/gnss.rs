@@ -9,8 +9,10 @@
 //! nothing then); steps and freezes go by the state time (they corrupt what is measured then), so
 //! with a latency the rows they change are those stamped `[start + latency, end + latency)`. The
 //! reported `sigma_p`, `sigma_v` are the configured 1-σ (what a receiver would report), whatever
-//! the faults. Defaults: a u-blox M8/M9 class receiver at 5 Hz, 1 m horizontal and 1.5 m vertical,
-//! without faults.
+//! the faults: `sigma_p` the larger of horizontal and vertical (one σ for readers that take one
+//! for every axis), the two themselves in `gnss0/sensor.yaml` (`sigma_p_horizontal`,
+//! `sigma_p_up`) when they differ. Defaults: a u-blox M8/M9 class receiver at 5 Hz, 1 m
+//! horizontal and 1.5 m vertical, without faults.
 
 use super::Noise;
 use crate::trajectory::Kinematics;
@@ -79,6 +81,10 @@ pub struct GnssFix {
     pub velocity: Vector3<f64>,
     /// Reported position 1σ, m (the larger of horizontal and vertical).
     pub sigma_p: f64,
+    /// Reported horizontal position 1σ, m.
+    pub sigma_p_horizontal: f64,
+    /// Reported vertical position 1σ, m.
+    pub sigma_p_up: f64,
     /// Reported velocity 1σ, m/s.
     pub sigma_v: f64,
 }
@@ -147,6 +153,8 @@ impl Gnss {
             position,
             velocity,
             sigma_p: c.sigma_horizontal.max(c.sigma_vertical),
+            sigma_p_horizontal: c.sigma_horizontal,
+            sigma_p_up: c.sigma_vertical,
             sigma_v: c.sigma_velocity,
         };
         self.last = Some(fix);

@@ -1,10 +1,10 @@
 //! GNSS position (with the antenna lever arm) and GNSS velocity.
 
-use super::shared::{isotropic, three_rows};
+use super::shared::{horizontal_vertical, isotropic, three_rows};
 use crate::eskf::error::EskfError;
 use crate::eskf::state::InsState;
 use crate::eskf::update::{Linearization, Measurement};
-use crate::kernels::all_finite;
+use crate::kernels::{all_finite, positive_finite, usable_variance};
 use crate::lie::LieGroup;
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
@@ -13,6 +13,11 @@ use nalgebra::{Matrix3, Vector3};
 ///
 /// `h(x) = p + R ℓ`; `H = [−R[ℓ]×, 0, I, 0, 0]` (blocks δθ, δv, δp, δb_g, δb_a), the attitude
 /// block being the action Jacobian `−R[ℓ]×`.
+///
+/// The noise `R` is any symmetric positive definite 3 × 3 matrix in the world (ENU) frame:
+/// [`GnssPosition::new`] makes it `σ² I`, [`GnssPosition::with_sigmas`] `diag(σ_h², σ_h², σ_v²)`
+/// (a receiver's horizontal and vertical accuracy, the vertical typically 1.5–2 times the
+/// horizontal).
 ///
 /// ```
 /// use estimator_core::eskf::{FilterConfig, GnssPosition, Ins, InsState, UpdateOptions, UpdateOutcome};
@@ -45,6 +50,49 @@ impl<T: Real> GnssPosition<T> {
             lever_arm,
             noise: isotropic(sigma),
         }
+    }
+
+    /// Separate horizontal and vertical noise: `R = diag(σ_h², σ_h², σ_v²)` in the world (ENU)
+    /// frame, `sigma_h` the 1σ of east and north, `sigma_v` of up, m. With `σ_h = σ_v` it is
+    /// [`GnssPosition::new`].
+    ///
+    /// ```
+    /// use estimator_core::eskf::{FilterConfig, GnssPosition, Ins, InsState, UpdateOptions};
+    /// use nalgebra::{SMatrix, Vector3};
+    ///
+    /// let p0 = SMatrix::<f64, 15, 15>::identity();
+    /// let mut ins = Ins::new(InsState::identity(), p0, FilterConfig::default()).unwrap();
+    /// // 1 m horizontally, 3 m vertically: the fix moves east more than up.
+    /// let fix = GnssPosition::with_sigmas(Vector3::new(1.0, 0.0, 1.0), Vector3::zeros(), 1.0, 3.0)
+    ///     .unwrap();
+    /// ins.update(&fix, &UpdateOptions::default()).unwrap();
+    /// assert!(ins.state().position.x > ins.state().position.z);
+    /// assert!(GnssPosition::with_sigmas(Vector3::zeros(), Vector3::zeros(), 1.0, 0.0).is_err());
+    /// ```
+    ///
+    /// # Errors
+    /// [`EskfError::NonFinite`] for a non-finite position or lever arm;
+    /// [`EskfError::NoiseNotPositiveDefinite`] for a sigma that is not finite and positive, or
+    /// whose square is zero or above the variance ceiling
+    /// ([`crate::Real::VARIANCE_CEILING_F64`]). Nothing is built.
+    pub fn with_sigmas(
+        position: Vector3<T>,
+        lever_arm: Vector3<T>,
+        sigma_h: T,
+        sigma_v: T,
+    ) -> Result<Self, EskfError> {
+        if !(all_finite(position.as_slice()) && all_finite(lever_arm.as_slice())) {
+            return Err(EskfError::NonFinite);
+        }
+        let usable = |s: T| positive_finite(s) && usable_variance(s * s);
+        if !(usable(sigma_h) && usable(sigma_v)) {
+            return Err(EskfError::NoiseNotPositiveDefinite);
+        }
+        Ok(Self {
+            position,
+            lever_arm,
+            noise: horizontal_vertical(sigma_h, sigma_v),
+        })
     }
 }
 

@@ -12,6 +12,23 @@ pub(super) fn isotropic<T: Real>(sigma: T) -> Matrix3<T> {
     Matrix3::from_diagonal_element(sigma * sigma)
 }
 
+/// `diag(σ_h², σ_h², σ_v²)`: a world-frame (ENU) noise with horizontal 1σ `sigma_h` on east
+/// and north and vertical 1σ `sigma_v` on up.
+pub(super) fn horizontal_vertical<T: Real>(sigma_h: T, sigma_v: T) -> Matrix3<T> {
+    let (h, v) = (sigma_h * sigma_h, sigma_v * sigma_v);
+    Matrix3::new(
+        h,
+        T::zero(),
+        T::zero(),
+        T::zero(),
+        h,
+        T::zero(),
+        T::zero(),
+        T::zero(),
+        v,
+    )
+}
+
 /// A world vector `v` seen in the body, `Rᵀ v`, and its attitude Jacobian `[Rᵀ v]×`
 /// (`(R exp(δθ^))ᵀ v ≈ Rᵀ v + [Rᵀ v]× δθ`).
 pub(super) fn in_body<T: Real>(attitude: &So3<T>, v: &Vector3<T>) -> (Vector3<T>, Matrix3<T>) {

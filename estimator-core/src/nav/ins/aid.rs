@@ -2,6 +2,7 @@
 //! between its own time and the filter's (at most a few IMU intervals, when several
 //! measurements come due together), and the GNSS policy.
 
+use super::buffer::FixSigma;
 use super::report::{AidStatus, Aiding, InsEvent, InsFusion};
 use super::{InsNavigator, Mode};
 use crate::eskf::{
@@ -100,10 +101,18 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     }
 
     /// A GNSS position valid at `t_m`, `dt` before the filter's time `t_f`: `z + v̂ dt` against
-    /// `h(x) = p + R ℓ` ([`GnssPosition`]). A fix repeating the previous one exactly while the
+    /// `h(x) = p + R ℓ` ([`GnssPosition`]) with `R = diag(σ_h², σ_h², σ_v²)`
+    /// ([`GnssPosition::with_sigmas`]). A fix repeating the previous one exactly while the
     /// body moves is frozen and refused; rejections count towards the disagreement flag and,
     /// after `gnss_reset_s`, reset position and velocity to the fixes.
-    pub(super) fn fuse_gnss(&mut self, t_f: u64, t_m: u64, dt: T, z: Vector3<T>, sigma: T) {
+    pub(super) fn fuse_gnss(
+        &mut self,
+        t_f: u64,
+        t_m: u64,
+        dt: T,
+        z: Vector3<T>,
+        sigma: FixSigma<T>,
+    ) {
         let lever = self.config.gnss_lever_arm;
         let repeated = self.gnss.last_position == Some(z);
         self.gnss.last_position = Some(z);
@@ -116,10 +125,12 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         let r = if frozen {
             None
         } else {
-            Some(ins.update(
-                &GnssPosition::new(shifted, lever, sigma),
-                &UpdateOptions::default(),
-            ))
+            // The sigmas were checked when the fix was taken; a model that cannot be built
+            // (a position carried out of the finite numbers) is counted as a failed update.
+            Some(
+                GnssPosition::with_sigmas(shifted, lever, sigma.horizontal, sigma.up)
+                    .and_then(|fix| ins.update(&fix, &UpdateOptions::default())),
+            )
         };
         self.gnss.frozen = frozen;
         let Some(r) = r else {
@@ -160,12 +171,12 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         }
     }
 
-    /// Resets the position to a fix (body position `p`, 1σ `sigma`) and asks the next velocity
-    /// fix to reset the velocity.
-    fn reset_to_fix(&mut self, p: Vector3<T>, sigma: T) {
+    /// Resets the position to a fix (body position `p`, the fix's horizontal and vertical 1σ)
+    /// and asks the next velocity fix to reset the velocity.
+    fn reset_to_fix(&mut self, p: Vector3<T>, sigma: FixSigma<T>) {
         let done = self
             .ins_mut()
-            .map(|ins| ins.reset_position(p, sigma).is_ok());
+            .map(|ins| ins.reset_position_per_axis(p, &sigma.per_axis()).is_ok());
         if done != Some(true) {
             count(&mut self.counters.numerical_failures);
             return;

@@ -2,6 +2,7 @@
 //! yet integrated, and the measurements it has not yet fused.
 
 use super::window::Interval;
+use crate::kernels::larger;
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -75,11 +76,30 @@ impl<T: Real, const H: usize> ImuRing<T, H> {
     }
 }
 
+/// A GNSS position's 1σ: east and north (`horizontal`), and up, m.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct FixSigma<T: Real> {
+    pub horizontal: T,
+    pub up: T,
+}
+
+impl<T: Real> FixSigma<T> {
+    /// `[σ_h, σ_h, σ_up]`, the 1σ of each world axis.
+    pub(crate) fn per_axis(&self) -> Vector3<T> {
+        Vector3::new(self.horizontal, self.horizontal, self.up)
+    }
+
+    /// The larger of the two: a bound on the 1σ of any direction.
+    pub(crate) fn largest(&self) -> T {
+        larger(self.horizontal, self.up)
+    }
+}
+
 /// A measurement waiting for the filter to reach its time.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Aid<T: Real> {
-    /// A GNSS antenna position, world frame, with its 1σ.
-    Gnss(Vector3<T>, T),
+    /// A GNSS antenna position, world frame, with its horizontal and vertical 1σ.
+    Gnss(Vector3<T>, FixSigma<T>),
     /// A GNSS antenna velocity, world frame, with its 1σ: the second half of a fix, stamped
     /// like its position and fused after it (in the next call: one update per call).
     GnssVelocity(Vector3<T>, T),

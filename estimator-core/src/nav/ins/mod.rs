@@ -85,7 +85,7 @@ use crate::nav::error::NavError;
 use crate::nav::sample::{check_imu, check_vector, within_limits};
 use crate::nav::{FIX_POSITION_SIGMA, FIX_VELOCITY_SIGMA};
 use crate::Real;
-use buffer::{Aid, AidQueue, ImuRing, QueueError, Queued};
+use buffer::{Aid, AidQueue, FixSigma, ImuRing, QueueError, Queued};
 use nalgebra::{Matrix3, Vector3};
 use window::{Increment, Interval};
 
@@ -116,7 +116,7 @@ struct GnssTrack<T: Real> {
     /// While aligning, the last fix (time, position, 1σ, velocity): the next one starts the
     /// INS if the two agree.
     #[allow(clippy::type_complexity)]
-    start_candidate: Option<(u64, Vector3<T>, T, Option<(Vector3<T>, T)>)>,
+    start_candidate: Option<(u64, Vector3<T>, FixSigma<T>, Option<(Vector3<T>, T)>)>,
     /// Consecutive rejected position fixes, and the time of the first.
     rejected: u16,
     rejected_since: Option<u64>,
@@ -230,20 +230,36 @@ pub struct InsNavigator<T: Real, const H: usize = 64, const Q: usize = 40> {
 }
 
 /// A GNSS fix: antenna position and optional velocity (world frame, ENU) with their 1σ.
+///
+/// The position's noise is `R = diag(σ_h², σ_h², σ_v²)` ([`GnssPosition::with_sigmas`](crate::eskf::GnssPosition::with_sigmas)):
+/// `σ_h = sigma_position` on east and north, and `σ_v = sigma_position_up` on up, or
+/// `sigma_position` as well when that is `None` (a receiver's vertical accuracy is typically
+/// 1.5–2 times its horizontal one; give it with [`GnssFix::with_vertical_sigma`]).
+///
+/// ```
+/// use estimator_core::nav::GnssFix;
+/// use nalgebra::Vector3;
+///
+/// let fix = GnssFix::new(Vector3::new(10.0, 5.0, 2.0), None, 1.0, 0.1).with_vertical_sigma(1.5);
+/// assert_eq!((fix.sigma_position, fix.sigma_position_up), (1.0, Some(1.5)));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GnssFix<T: Real> {
     /// Antenna position, m.
     pub position: Vector3<T>,
     /// Antenna velocity, m/s, when the receiver gives one.
     pub velocity: Option<Vector3<T>>,
-    /// Position 1σ per axis, m.
+    /// Horizontal (east, north) position 1σ per axis, m; also the vertical one when
+    /// `sigma_position_up` is `None`.
     pub sigma_position: T,
     /// Velocity 1σ per axis, m/s.
     pub sigma_velocity: T,
+    /// Vertical (up) position 1σ, m; `None`: `sigma_position`.
+    pub sigma_position_up: Option<T>,
 }
 
 impl<T: Real> GnssFix<T> {
-    /// A fix.
+    /// A fix with one position 1σ on every axis.
     #[must_use]
     pub fn new(
         position: Vector3<T>,
@@ -256,6 +272,25 @@ impl<T: Real> GnssFix<T> {
             velocity,
             sigma_position,
             sigma_velocity,
+            sigma_position_up: None,
+        }
+    }
+
+    /// The fix with the vertical (up) position 1σ `sigma_up`, m; `sigma_position` then holds
+    /// for east and north only. Checked as `sigma_position` is, by [`InsNavigator::gnss`].
+    #[must_use]
+    pub fn with_vertical_sigma(self, sigma_up: T) -> Self {
+        Self {
+            sigma_position_up: Some(sigma_up),
+            ..self
+        }
+    }
+
+    /// The position's 1σ, horizontal and vertical.
+    fn position_sigma(&self) -> FixSigma<T> {
+        FixSigma {
+            horizontal: self.sigma_position,
+            up: self.sigma_position_up.unwrap_or(self.sigma_position),
         }
     }
 }
@@ -532,7 +567,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// Takes one GNSS fix, valid at `t_ns` (the time of the fix, not of its arrival).
     ///
     /// # Errors
-    /// [`NavError::NonFinite`]; [`NavError::InvalidSigma`] for a sigma outside
+    /// [`NavError::NonFinite`]; [`NavError::InvalidSigma`] for a sigma (horizontal, vertical
+    /// or velocity) outside
     /// [`FIX_POSITION_SIGMA`](crate::nav::FIX_POSITION_SIGMA) or
     /// [`FIX_VELOCITY_SIGMA`](crate::nav::FIX_VELOCITY_SIGMA);
     /// [`NavError::TooOld`] for a fix the filter has passed (older than the horizon);
@@ -542,7 +578,9 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     pub fn gnss(&mut self, t_ns: u64, fix: &GnssFix<T>) -> Result<InsReport<T>, NavError> {
         let velocity_ok = fix.velocity.is_none_or(|v| all_finite(v.as_slice()));
         let in_range = |s: T, [min, max]: [f64; 2]| within_limits(s, min, max);
-        let sigmas_ok = in_range(fix.sigma_position, FIX_POSITION_SIGMA)
+        let sigma = fix.position_sigma();
+        let sigmas_ok = in_range(sigma.horizontal, FIX_POSITION_SIGMA)
+            && in_range(sigma.up, FIX_POSITION_SIGMA)
             && (fix.velocity.is_none() || in_range(fix.sigma_velocity, FIX_VELOCITY_SIGMA));
         let checked = if !(all_finite(fix.position.as_slice()) && velocity_ok) {
             Err(NavError::NonFinite)
@@ -551,7 +589,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         } else {
             Ok(())
         };
-        let position = Aid::Gnss(fix.position, fix.sigma_position);
+        let position = Aid::Gnss(fix.position, sigma);
         let velocity = fix
             .velocity
             .map(|v| Aid::GnssVelocity(v, fix.sigma_velocity));

@@ -1,6 +1,7 @@
 //! Start and restart: the INS takes over from the alignment at the first usable fix, and an
 //! IMU gap sends it back to aligning.
 
+use super::buffer::FixSigma;
 use super::report::{AidStatus, InsEvent};
 use super::window::Increment;
 use super::{InsNavigator, Mode, INVALID_START};
@@ -38,14 +39,15 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// A fix starts the INS only when it agrees with the one before it (a gross outlier must
     /// not become the start): `|p₂ − p₁ − v̄ Δt| ≤ 3 √(σ₁² + σ₂²) + 3 σ_v̄ Δt`, with `v̄` the two
     /// fixes' mean velocity (without velocities, `σ_v̄` is the 30 m/s of an unknown velocity),
-    /// fixes at most 2 s apart.
+    /// fixes at most 2 s apart, and `σ₁`, `σ₂` the larger of each fix's horizontal and vertical
+    /// 1σ. The position starts with the second fix's covariance, `diag(σ_h², σ_h², σ_v²)`.
     #[inline(never)] // once per start: its matrices stay out of the caller's frame
     pub(super) fn start(
         &mut self,
         t_m: u64,
         dt: T,
         position: Vector3<T>,
-        sigma_position: T,
+        sigma_position: FixSigma<T>,
         velocity: Option<(Vector3<T>, T)>,
     ) {
         let Mode::Aligning(att) = &self.mode else {
@@ -66,8 +68,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
                 _ => (Vector3::zeros(), T::lit(UNKNOWN_VELOCITY_SIGMA)),
             };
             let miss = mat3::norm(&(position - p_p - v * gap));
-            let tolerance = T::lit(3.0)
-                * ((s_p * s_p + sigma_position * sigma_position).sqrt_rn() + sigma_v * gap);
+            let (s_p, s_n) = (s_p.largest(), sigma_position.largest());
+            let tolerance = T::lit(3.0) * ((s_p * s_p + s_n * s_n).sqrt_rn() + sigma_v * gap);
             miss <= tolerance
         });
         if !agrees {
@@ -98,16 +100,24 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         // state is finite, an invariant of the filter).
         let aligned = *filter;
         let square = |s: T| s * s;
+        let position_sigma = sigma_position.per_axis();
         let ok = all_finite(v.as_slice())
             && all_finite(p.as_slice())
             && carry.is_finite()
             && positive_finite(square(sigma_v))
-            && positive_finite(square(sigma_position));
+            && position_sigma.iter().all(|s| positive_finite(square(*s)));
         let started = if ok {
             self.mode = Mode::Running(Ins::unstarted(*aligned.config()));
             match &mut self.mode {
                 Mode::Running(ins) => ins
-                    .restart_from_attitude_filter(&aligned, &carry, v, p, sigma_v, sigma_position)
+                    .restart_from_attitude_filter_per_axis(
+                        &aligned,
+                        &carry,
+                        v,
+                        p,
+                        sigma_v,
+                        &position_sigma,
+                    )
                     .and_then(|()| {
                         if moving {
                             // Aligned while moving, the attitude navigator's covariance holds

@@ -13,7 +13,8 @@
 #     of src/bin/single.rs alone in its own binary over the same matrix;
 #  5. no f64 soft-float routine in the f32 binaries;
 #  6. instruction counts, peak stack, size_of and flash against firmware/budgets.txt (opt-level 3)
-#     and firmware/budgets-s.txt (the stack at opt-level "s").
+#     and firmware/budgets-s.txt (the stack at opt-level "s"); the tables of firmware/README.md
+#     against the same run (tools/readme_figures.py).
 #
 # FIRMWARE_STRICT=1 enforces the targets (not the ceilings) and ignores the allowances in
 # budgets.txt.
@@ -365,7 +366,11 @@ fi
 grep -E '^(icount|stack|budgets)' "$OUT/budgets-s.out" || true
 echo "-- opt-level 3 (budgeted)"
 python3 tools/check_budgets.py budgets.txt "$OUT/demo-3.txt" "$OUT/icount-3.txt" "$OUT/extra.txt" \
-  || fail "a figure is over its budget"
+  > "$OUT/budgets-3.out" || fail "a figure is over its budget"
+cat "$OUT/budgets-3.out"
+echo "-- firmware/README.md's tables against this run"
+python3 tools/readme_figures.py README.md "$OUT/budgets-3.out" "$OUT/budgets-s.out" \
+  || fail "firmware/README.md's figures differ from this run (update the tables from the output above)"
 
 # The firmware crate is outside the root workspace, so the root's fmt and clippy do not see it.
 step "fmt and clippy of the firmware crate (warnings are errors)"

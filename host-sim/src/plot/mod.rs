@@ -433,23 +433,28 @@ fn draw_tracks(
     Ok(())
 }
 
-/// The spans `[t_a, t_b]` of consecutive points where block `b` was reported not valid.
+/// The spans `[t_a, t_b]` of consecutive points where block `b` was reported not valid, each
+/// inside one segment between time gaps ([`split_at_gaps`]): nothing was reported in a gap, so
+/// no span crosses it.
 fn invalid_spans(pts: &[HistoryPoint], b: usize) -> Vec<(f64, f64)> {
     let mut spans: Vec<(f64, f64)> = Vec::new();
-    let mut open: Option<f64> = None;
-    for p in pts {
-        let invalid = p.valid.is_some_and(|v| !v.get(b).copied().unwrap_or(true));
-        match (invalid, open) {
-            (true, None) => open = Some(p.t),
-            (false, Some(a)) => {
-                spans.push((a, p.t));
-                open = None;
+    for range in segments(pts) {
+        let part = pts.get(range).unwrap_or(&[]);
+        let mut open: Option<f64> = None;
+        for p in part {
+            let invalid = p.valid.is_some_and(|v| !v.get(b).copied().unwrap_or(true));
+            match (invalid, open) {
+                (true, None) => open = Some(p.t),
+                (false, Some(a)) => {
+                    spans.push((a, p.t));
+                    open = None;
+                }
+                _ => {}
             }
-            _ => {}
         }
-    }
-    if let (Some(a), Some(last)) = (open, pts.last()) {
-        spans.push((a, last.t));
+        if let (Some(a), Some(last)) = (open, part.last()) {
+            spans.push((a, last.t));
+        }
     }
     spans
 }
@@ -852,6 +857,27 @@ mod tests {
         // Several gaps, one at each end.
         let t = [0.0, 5.0, 5.1, 5.2, 5.3, 9.0, 9.1, 9.2, 20.0];
         assert_eq!(split_at_gaps(&t), vec![0..1, 1..5, 5..8, 8..9]);
+    }
+
+    /// A "not valid" span stops at a time gap and starts again after it.
+    #[test]
+    fn not_valid_spans_stop_at_gaps() {
+        let point = |t: f64, valid: bool| HistoryPoint {
+            t,
+            est_position: Vector3::zeros(),
+            true_position: Vector3::zeros(),
+            error: [0.0; 15],
+            sigma: [0.0; 15],
+            est_bias: [0.0; 6],
+            true_bias: [0.0; 6],
+            valid: Some([valid; 5]),
+        };
+        // Not valid from 0.2 s, through a 10 s hole after 0.3 s, valid again at 10.5 s.
+        let pts: Vec<HistoryPoint> = [0.0, 0.1, 0.2, 0.3, 10.3, 10.4, 10.5]
+            .iter()
+            .map(|&t| point(t, !(0.15..=10.45).contains(&t)))
+            .collect();
+        assert_eq!(invalid_spans(&pts, 0), vec![(0.2, 0.3), (10.3, 10.5)]);
     }
 
     /// The gated-out updates the legend lists are drawn: hollow squares of their colour, in

@@ -3,14 +3,10 @@
 //! line, non-zero exit, no outputs left looking complete).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn host_sim(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_host-sim"))
-        .args(args)
-        .output()
-        .expect("host-sim runs")
-}
+mod common;
+use common::host_sim;
+use std::process::{Command, Output};
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("host-sim-cli-{}-{name}", std::process::id()));

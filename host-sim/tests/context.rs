@@ -5,6 +5,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+mod common;
+use common::{copy_dir, empty_dir, s};
+
 /// `host-sim ARGS` with stdout and stderr captured (so stderr is not a terminal) and progress
 /// lines every 0.05 s.
 fn host_sim(args: &[&str]) -> Output {
@@ -16,14 +19,7 @@ fn host_sim(args: &[&str]) -> Output {
 }
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("host-sim-context-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp");
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8")
+    empty_dir("context", name)
 }
 
 fn text(b: &[u8]) -> String {
@@ -239,20 +235,6 @@ fn no_heading_aid_says_so() {
         "{stdout}"
     );
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// Copies a dataset folder (two levels of files).
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).expect("mkdir");
-    for e in std::fs::read_dir(from).expect("read_dir") {
-        let e = e.expect("entry");
-        let target = to.join(e.file_name());
-        if e.path().is_dir() {
-            copy_dir(&e.path(), &target);
-        } else {
-            std::fs::copy(e.path(), &target).expect("copy");
-        }
-    }
 }
 
 fn simulate(scenario: &Path, out: &Path) {

@@ -5,24 +5,12 @@
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn host_sim(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_host-sim"))
-        .args(args)
-        .output()
-        .expect("host-sim runs")
-}
+mod common;
+use common::{empty_dir, host_sim, s};
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("host-sim-data-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp");
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8")
+    empty_dir("data", name)
 }
 
 /// A 30 s dataset (IMU 200 Hz, magnetometer 50 Hz, GNSS 5 Hz, ground truth) in `dir/ds`.

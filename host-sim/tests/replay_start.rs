@@ -4,14 +4,9 @@
 //! (`validity.csv`), and the run scores what it estimated.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn host_sim(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_host-sim"))
-        .args(args)
-        .output()
-        .expect("host-sim runs")
-}
+mod common;
+use common::host_sim;
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("host-sim-start-{}-{name}", std::process::id()));

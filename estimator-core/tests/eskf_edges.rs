@@ -555,7 +555,7 @@ fn a_bias_walk_that_would_pass_the_variance_ceiling_is_refused() {
     config.imu_noise.accelerometer_random_walk = 1e9;
     let mut f = AhrsAccelBias::new(
         AhrsAccelBiasState::identity(),
-        SMatrix::<f32, 9, 9>::identity() * 1e-2,
+        SMatrix::<f32, 12, 12>::identity() * 1e-2,
         config,
     )
     .expect("valid start");

@@ -222,6 +222,7 @@ fn random_ahrs_accel_bias(rng: &mut Rng) -> AhrsAccelBiasState<f64> {
         attitude: So3::exp(&rng.vec3(1.0)),
         gyro_bias: rng.vec3(0.01),
         accel_bias: rng.vec3(0.1),
+        velocity: rng.vec3(1.0),
     }
 }
 
@@ -241,6 +242,84 @@ fn zero_rate_and_accelerometer_match_finite_differences_for_every_state() {
             &GravityDirection::new(rng.vec3(9.0), 0.05),
             &x9,
         );
+        check(
+            "velocity bound, ahrs accel bias",
+            &ZeroVelocity::new(0.5),
+            &x9,
+        );
+    }
+}
+
+/// `integrate_velocity` against the error it models: a block of constant attitude with the
+/// true state `x = x̂ ⊕ δx` integrates the true specific force `R (f_m − b_a)` where the
+/// estimate integrates `R̂ (f_m − b̂_a)`; the difference of the two velocities, to first order
+/// in `δx` (central differences, error `O(ε²)`), is row `v` of `G` (`δv⁺ = G δx`), and the
+/// covariance is `G P Gᵀ + N_a² T I`.
+#[test]
+fn ahrs_accel_bias_velocity_integration_matches_its_error_model() {
+    let mut rng = Rng::new(15);
+    let na = 0.003;
+    let mut config = zero_noise();
+    config.imu_noise.accelerometer_noise_density = na;
+    for _ in 0..10 {
+        let x = random_ahrs_accel_bias(&mut rng);
+        let p = random_spd::<12>(&mut rng);
+        let f_m = rng.vec3(10.0);
+        let t = 0.5;
+        // One block, attitude constant over it: Σ R̂ f_m Δt = R̂ f_m T, Σ R̂ Δt = R̂ T.
+        let sums = |s: &AhrsAccelBiasState<f64>| {
+            let r = s.attitude.rotation_matrix();
+            (r * f_m * t, r * t)
+        };
+        let after = |s: &AhrsAccelBiasState<f64>| {
+            let (force, frames) = sums(s);
+            let mut f = AhrsAccelBias::new(*s, p, config).expect("filter");
+            f.integrate_velocity(&force, &frames, t).expect("integrate");
+            f.state().velocity - s.velocity
+        };
+        let g = |dx: &SVector<f64, 12>| {
+            let truth = x.oplus(dx);
+            // The true velocity after the block (the truth's own sums) minus the estimate's
+            // after the block (the estimate's sums), as an error: v + Δv(truth) − (v̂ + Δv(x̂)).
+            truth.velocity + after(&truth) - (x.velocity + after(&x))
+        };
+        let rows = fd_jacobian(g, EPS);
+        let (force, frames) = sums(&x);
+        let mut filter = AhrsAccelBias::new(x, p, config).expect("filter");
+        filter
+            .integrate_velocity(&force, &frames, t)
+            .expect("integrate");
+        let mut gm = SMatrix::<f64, 12, 12>::identity();
+        gm.fixed_view_mut::<3, 12>(9, 0).copy_from(&rows);
+        let mut dense = gm * p * gm.transpose();
+        for k in 9..12 {
+            dense[(k, k)] += na * na * t;
+        }
+        let err = (filter.covariance() - dense).amax();
+        assert!(err < 1e-6 * dense.amax(), "G P Gᵀ mismatch {err:e}");
+        // The nominal velocity: v + R̂ (f_m − b̂_a) T + g T.
+        let expected = x.velocity
+            + x.attitude.rotation_matrix() * (f_m - x.accel_bias) * t
+            + config.gravity * t;
+        assert!((filter.state().velocity - expected).amax() < 1e-12);
+    }
+}
+
+/// Bad input to `integrate_velocity` is refused and leaves the filter as it was.
+#[test]
+fn ahrs_accel_bias_velocity_integration_refuses_bad_input_unchanged() {
+    let mut rng = Rng::new(16);
+    let x = random_ahrs_accel_bias(&mut rng);
+    let f = AhrsAccelBias::new(x, random_spd::<12>(&mut rng), zero_noise()).expect("filter");
+    let bad: [(Vector3<f64>, SMatrix<f64, 3, 3>, f64); 3] = [
+        (Vector3::new(f64::NAN, 0.0, 0.0), SMatrix::identity(), 0.5),
+        (Vector3::zeros(), SMatrix::identity() * f64::INFINITY, 0.5),
+        (Vector3::zeros(), SMatrix::identity(), 0.0),
+    ];
+    for (force, frames, t) in bad {
+        let mut g = f;
+        assert!(g.integrate_velocity(&force, &frames, t).is_err());
+        assert_eq!(g, f);
     }
 }
 
@@ -281,7 +360,7 @@ fn ahrs_accel_bias_predict_matches_dense_f_p_ft() {
     let mut rng = Rng::new(14);
     for _ in 0..10 {
         let x = random_ahrs_accel_bias(&mut rng);
-        let p = random_spd::<9>(&mut rng);
+        let p = random_spd::<12>(&mut rng);
         let w = rng.vec3(1.0);
         let dt = 0.01;
         let prop = |s: AhrsAccelBiasState<f64>| {
@@ -290,15 +369,17 @@ fn ahrs_accel_bias_predict_matches_dense_f_p_ft() {
             *f.state()
         };
         let base = prop(x);
-        let g = |dx: &SVector<f64, 9>| {
+        let g = |dx: &SVector<f64, 12>| {
             let s = prop(x.oplus(dx));
-            let mut e = SVector::<f64, 9>::zeros();
+            let mut e = SVector::<f64, 12>::zeros();
             e.fixed_rows_mut::<3>(0)
                 .copy_from(&s.attitude.rminus(&base.attitude));
             e.fixed_rows_mut::<3>(3)
                 .copy_from(&(s.gyro_bias - base.gyro_bias));
             e.fixed_rows_mut::<3>(6)
                 .copy_from(&(s.accel_bias - base.accel_bias));
+            e.fixed_rows_mut::<3>(9)
+                .copy_from(&(s.velocity - base.velocity));
             e
         };
         let f = fd_jacobian(g, EPS);

@@ -35,6 +35,8 @@ fn seconds(t_ns: u64) -> f64 {
 
 fn config() -> InsConfig<f64> {
     let mut attitude = AttitudeConfig::new(FilterConfig::default());
+    // The streams of these tests are the motion's values at each sample's instant.
+    attitude.instantaneous_imu = true;
     attitude.magnetometer = Some(MagneticConfig::new(0.5, Some(Vector3::from(FIELD))));
     InsConfig::new(attitude)
 }
@@ -115,13 +117,22 @@ fn ins_navigator_out_of_order_within_horizon_matches_in_order_f64() {
     let aids = aids(30.0, 5.0);
     let in_order = delayed(&aids, 200_000_000);
     // Each measurement delivered 20–280 ms after its time, by a fixed pseudo-random draw:
-    // arrival order differs from validity order throughout.
+    // arrival order differs from validity order once the INS runs (it starts at the first fix,
+    // 5 s, delivered by 5.2 s). Until 1 s after that fix both runs get the same stream: the
+    // alignment takes samples as they come and drops a late one (a magnetometer sample fewer
+    // changes the start's heading variance, so the two runs would start from different
+    // covariances, not differ in how the horizon orders them).
+    let shuffled_from = T0 + 6_000_000_000;
     let mut shuffled: Vec<(u64, u64, Aid)> = aids
         .iter()
         .enumerate()
         .map(|(i, (t, a))| {
             let jitter = (i as u64).wrapping_mul(2_654_435_761) % 260_000_000;
-            (t + 20_000_000 + jitter, *t, *a)
+            if *t < shuffled_from {
+                (t + 200_000_000, *t, *a)
+            } else {
+                (t + 20_000_000 + jitter, *t, *a)
+            }
         })
         .collect();
     shuffled.sort_by_key(|d| d.0);

@@ -206,12 +206,14 @@ fn within_one_turn<T: Real>(turn: &Vector3<T>) -> bool {
     turn.dot(turn) < T::pi() * T::pi()
 }
 
-/// The attitude-only prediction for the attitude states (`N = 6`: `(R, b_g)`; `N = 9`:
-/// `(R, b_g, b_a)`): `R⁺ = R exp((ω_m − b_g) dt)`, `P⁺ = F P Fᵀ + Q` with
-/// `F = [ΔRᵀ, −J_r dt, 0; 0, I, 0; 0, 0, I]` and `Q = diag(σ_g² dt I, σ_bg² dt I, σ_ba² dt I)`.
+/// The attitude-only prediction for the attitude states (`N = 6`: `(R, b_g)`; `N = 12`:
+/// `(R, b_g, b_a, v)`): `R⁺ = R exp((ω_m − b_g) dt)`, `P⁺ = F P Fᵀ + Q` with
+/// `F = [ΔRᵀ, −J_r dt, 0, 0; 0, I, 0, 0; 0, 0, I, 0; 0, 0, 0, I]` and
+/// `Q = diag(σ_g² dt I, σ_bg² dt I, σ_ba² dt I, 0)` (the velocity moves by the block
+/// integration of [`AhrsAccelBias::integrate_velocity`](super::AhrsAccelBias::integrate_velocity)).
 /// Only the gyro and `dt` of the sample are read. Block row 0 of `F P` is
 /// `M0j = F00 P0j + F01 P1j`; then `P⁺00 = M00 F00ᵀ + M01 F01ᵀ`, `P⁺0j = M0j` (`j ≥ 1`), and
-/// the bias blocks are unchanged.
+/// the other blocks are unchanged.
 fn predict_attitude<T: Real, const N: usize>(
     attitude: &mut So3<T>,
     gyro_bias: &Vector3<T>,
@@ -262,12 +264,12 @@ fn predict_attitude<T: Real, const N: usize>(
     set_block(p, 0, 0, &n00);
     set_block(p, 0, 1, &m01);
     set_block(p, 1, 0, &m01.transpose());
-    // The accelerometer-bias column, when there is one (`N` is a constant: the 6-state
-    // filter compiles without it).
-    if N >= 9 {
-        let m02 = mat3::mul(&f00, &block(p, 0, 2)) + mat3::mul(&f01, &block(p, 1, 2));
-        set_block(p, 0, 2, &m02);
-        set_block(p, 2, 0, &m02.transpose());
+    // The columns of the states the gyro does not move (the accelerometer bias, the
+    // velocity), when there are any (`N` is a constant: the 6-state filter compiles without).
+    for j in 2..N / 3 {
+        let m0j = mat3::mul(&f00, &block(p, 0, j)) + mat3::mul(&f01, &block(p, 1, j));
+        set_block(p, 0, j, &m0j);
+        set_block(p, j, 0, &m0j.transpose());
     }
     add_scaled_identity(
         p,
@@ -306,10 +308,10 @@ impl<T: Real> Sealed<T, 6> for AhrsState<T> {
     }
 }
 
-impl<T: Real> Sealed<T, 9> for AhrsAccelBiasState<T> {
+impl<T: Real> Sealed<T, 12> for AhrsAccelBiasState<T> {
     fn propagate(
         &mut self,
-        p: &mut SMatrix<T, 9, 9>,
+        p: &mut SMatrix<T, 12, 12>,
         imu: &ImuSample<T>,
         config: &FilterConfig<T>,
     ) -> Result<(), EskfError> {

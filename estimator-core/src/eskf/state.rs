@@ -13,7 +13,7 @@ use nalgebra::{SVector, Vector3};
 /// components are additive (`x = x̂ + δx`).
 ///
 /// Sealed: implemented by [`InsState`] (`N = 15`), [`AhrsState`] (`N = 6`) and
-/// [`AhrsAccelBiasState`] (`N = 9`).
+/// [`AhrsAccelBiasState`] (`N = 12`).
 pub trait ErrorState<T: Real, const N: usize>: Copy + sealed::Sealed<T, N> {
     /// `x ⊕ δx`: `R ← R·exp(δθ^)`, every other block `+ δ`.
     #[must_use]
@@ -100,10 +100,17 @@ impl<T: Real> AhrsState<T> {
     }
 }
 
-/// The attitude nominal state with both IMU biases, `x = (R, b_g, b_a)`,
-/// `δx = (δθ, δb_g, δb_a) ∈ R⁹` (indices 0–2, 3–5, 6–8): an AHRS that also estimates the
-/// accelerometer bias, which the accelerometer's readings in different orientations separate
-/// from the tilt.
+/// The attitude nominal state with both IMU biases and the body's velocity,
+/// `x = (R, b_g, b_a, v)`, `δx = (δθ, δb_g, δb_a, δv) ∈ R¹²` (indices 0–2, 3–5, 6–8, 9–11): an
+/// AHRS that also estimates the accelerometer bias, which the accelerometer's readings in
+/// different orientations separate from the tilt, and carries the velocity the specific force
+/// integrates to, so that a bound on the body's velocity
+/// ([`ZeroVelocity`](super::ZeroVelocity) with the velocity's spread as its noise) measures the
+/// tilt the way an INS's velocity aid does.
+///
+/// The velocity moves only by [`AhrsAccelBias::integrate_velocity`](super::AhrsAccelBias::integrate_velocity),
+/// once per block of samples whose specific force the caller has summed in the world frame;
+/// [`predict`](super::Filter::predict) turns the attitude and leaves it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AhrsAccelBiasState<T: Real> {
     /// `R`: world from body.
@@ -112,33 +119,40 @@ pub struct AhrsAccelBiasState<T: Real> {
     pub gyro_bias: Vector3<T>,
     /// `b_a`: accelerometer bias (body frame), m/s²; `f = f_m − b_a`.
     pub accel_bias: Vector3<T>,
+    /// `v`: velocity in the world frame, m/s.
+    pub velocity: Vector3<T>,
 }
 
 impl<T: Real> AhrsAccelBiasState<T> {
-    /// Level, zero biases.
+    /// Level, at rest, zero biases.
     #[must_use]
     pub fn identity() -> Self {
         Self {
             attitude: So3::identity(),
             gyro_bias: Vector3::zeros(),
             accel_bias: Vector3::zeros(),
+            velocity: Vector3::zeros(),
         }
     }
 }
 
-impl<T: Real> ErrorState<T, 9> for AhrsAccelBiasState<T> {
-    fn oplus(&self, dx: &SVector<T, 9>) -> Self {
+impl<T: Real> ErrorState<T, 12> for AhrsAccelBiasState<T> {
+    fn oplus(&self, dx: &SVector<T, 12>) -> Self {
         Self {
             attitude: self.attitude.rplus(&segment(dx, 0)).normalize(),
             gyro_bias: self.gyro_bias + segment(dx, 3),
             accel_bias: self.accel_bias + segment(dx, 6),
+            velocity: self.velocity + segment(dx, 9),
         }
     }
 
     fn is_finite(&self) -> bool {
-        self.attitude.is_finite()
-            && all_finite(self.gyro_bias.as_slice())
-            && all_finite(self.accel_bias.as_slice())
+        let vectors = [
+            self.gyro_bias.data.0,
+            self.accel_bias.data.0,
+            self.velocity.data.0,
+        ];
+        self.attitude.is_finite() && all_finite(vectors.as_flattened().as_flattened())
     }
 
     fn attitude(&self) -> &So3<T> {

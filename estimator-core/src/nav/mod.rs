@@ -29,7 +29,8 @@
 //! | `magnetometer.heading_noise` (8°·√s) | how fast the heading follows the magnetometer | larger near iron and for poorly calibrated magnetometers (slower, more robust); smaller in a clean field |
 //! | `gyro_scale_sigma` (0.5 %) | attitude uncertainty added per radian turned | the gyro's sensitivity and cross-axis error after calibration (data sheets: 1–3 % raw); raise it if the attitude lags after fast turns |
 //! | `block_s` (0.5 s) | length over which accelerometer and magnetometer are averaged | 0.25–1 s: longer averages out more motion but reacts later |
-//! | `acceleration_correlation_s` (0.15 s), `motion_memory_s` (5 s) | how much of the measured motion stays in a block's mean | the time scale of the body's accelerations (hand: 0.1–0.3 s; vehicle: seconds) and of changes in how much it moves |
+//! | `velocity_sigma` (0.3 m/s), `motion_memory_s` (5 s) | the bound on the body's velocity that measures the tilt: never tighter than `velocity_sigma` while moving, else twice the RMS of the estimated velocity over the memory | the slowest spread of velocity the body has while it moves (a hand moving an object: 0.3 m/s; the bound loosens itself for faster bodies); the memory, the time over which the body's speed changes |
+//! | `instantaneous_imu` (false) | how a sample's rate is integrated over its interval | `false` for a MEMS IMU whose output is the mean of its internal samples since the last output (a decimation filter); `true` for samples of the rate at an instant (a simulator) |
 //! | `rotation_only` (false) | leaves out the motion terms | `true` only for a body that turns in place (gimbal, turntable) |
 //! | `accelerometer_bias_sigma` (0.1 m/s²) | prior of the accelerometer bias | the data sheet's zero-g offset after calibration |
 //! | `gyro_bias_sigma` (0.5 °/s) | prior of the gyro bias when the start is not at rest | the data sheet's zero-rate offset |

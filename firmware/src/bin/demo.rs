@@ -342,7 +342,7 @@ impl<Mo: Measurement<f32, AhrsState<f32>, 6, M>, const M: usize> Filter<Mo, M> f
     }
 }
 
-impl<Mo: Measurement<f32, AhrsAccelBiasState<f32>, 9, M>, const M: usize> Filter<Mo, M>
+impl<Mo: Measurement<f32, AhrsAccelBiasState<f32>, 12, M>, const M: usize> Filter<Mo, M>
     for AhrsAccelBias<f32>
 {
     fn update_with(

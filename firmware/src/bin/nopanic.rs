@@ -323,8 +323,8 @@ fn ahrs_accel_bias<T: Real>(x: &Seed<T>, config: &FilterConfig<T>, opts: &Update
     let [a, b, c, d, e, f, g, _] = *x;
     let (v, w) = (Vector3::new(a, b, c), Vector3::new(d, e, f));
     let st = bb(AhrsAccelBiasState::<T>::identity());
-    keep(&st.oplus(&SVector::<T, 9>::repeat(g)));
-    let p = SMatrix::<T, 9, 9>::from_diagonal_element(b);
+    keep(&st.oplus(&SVector::<T, 12>::repeat(g)));
+    let p = SMatrix::<T, 12, 12>::from_diagonal_element(b);
     let mut filter = match AhrsAccelBias::new(st, p, *config) {
         Ok(f) => f,
         Err(e) => {
@@ -339,6 +339,9 @@ fn ahrs_accel_bias<T: Real>(x: &Seed<T>, config: &FilterConfig<T>, opts: &Update
         dt: g,
     }));
     keep(&filter.widen_attitude(a, b));
+    keep(&filter.integrate_velocity(&v, &Matrix3::from_diagonal(&w), c));
+    keep(&filter.restart_velocity(w, d));
+    keep(&filter.update(&ZeroVelocity::new(e), opts));
     let al = Alignment {
         attitude: So3::exp(&v),
         gyro_bias: w,

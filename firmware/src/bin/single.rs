@@ -65,7 +65,7 @@ fn x3(i: usize) -> Vector3<F> {
 /// Every entry this binary can hold besides the group operations ([`GROUPS`] × [`GROUP_OPS`]):
 /// the calls a firmware main loop makes (each filter's prediction and each of its measurement
 /// models, both navigators' sensor calls), the constructors that start them, and the solvers.
-const ENTRIES: [&str; 63] = [
+const ENTRIES: [&str; 66] = [
     "ins-new",
     "ins-from-alignment",
     "ins-predict",
@@ -96,6 +96,9 @@ const ENTRIES: [&str; 63] = [
     "aab-magnetic-heading",
     "aab-gravity",
     "aab-magnetometer",
+    "aab-integrate-velocity",
+    "aab-zero-velocity",
+    "aab-restart-velocity",
     "align-at-rest",
     "attitude-navigator-imu",
     "attitude-navigator-magnetometer",
@@ -401,7 +404,7 @@ fn main() -> ! {
     let aab_new = || {
         AhrsAccelBias::new(
             AhrsAccelBiasState::identity(),
-            SMatrix::<F, 9, 9>::identity() * x(7),
+            SMatrix::<F, 12, 12>::identity() * x(7),
             config,
         )
     };
@@ -512,6 +515,9 @@ fn main() -> ! {
         aab_call!("aab-magnetic-heading", f => f.update(&MagneticHeading::new(x3(4), x3(1), x(7)), &options));
         aab_call!("aab-gravity", f => f.update(&GravityDirection::new(x3(1), x(7)), &options));
         aab_call!("aab-magnetometer", f => f.update(&Magnetometer::new(x3(4), x3(1), x(7)), &options));
+        aab_call!("aab-integrate-velocity", f => f.integrate_velocity(&x3(1), &Matrix3::from_diagonal(&x3(4)), x(7)));
+        aab_call!("aab-zero-velocity", f => f.update(&ZeroVelocity::new(x(7)), &options));
+        aab_call!("aab-restart-velocity", f => f.restart_velocity(x3(0), x(7)));
         only!("align-at-rest", {
             let samples = [x3(1); 8];
             let gyro = [x3(0); 8];
@@ -909,12 +915,13 @@ fn main() -> ! {
                 attitude: state.attitude,
                 gyro_bias: state.gyro_bias,
                 accel_bias: state.accel_bias,
+                velocity: state.velocity,
             };
             let dx = SVector::<F, 15>::from_fn(|i, _| x(i % 8));
             keep(&(
                 state.oplus(&dx),
                 ahrs_state.oplus(&dx.fixed_rows::<6>(0).into_owned()),
-                aab_state.oplus(&dx.fixed_rows::<9>(0).into_owned()),
+                aab_state.oplus(&dx.fixed_rows::<12>(0).into_owned()),
                 state.is_finite(),
                 ErrorState::attitude(&aab_state),
             ));

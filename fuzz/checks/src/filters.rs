@@ -671,13 +671,15 @@ fn ahrs_accel_bias<T: Scalar>(input: &mut Input<'_>, log: &mut Log) -> Outcome {
                 attitude: attitude(input),
                 gyro_bias: input.vec3(),
                 accel_bias: input.vec3(),
+                velocity: input.vec3(),
             };
             construct(&filter, state, AhrsAccelBiasState::identity(), input, log)?
         }
         1 => {
             let a = alignment::<T>(input);
             let (s, c) = (sigmas(input), config(input));
-            match a.and_then(|a| Filter::<T, AhrsAccelBiasState<T>, 9>::from_alignment(&a, &s, c)) {
+            match a.and_then(|a| Filter::<T, AhrsAccelBiasState<T>, 12>::from_alignment(&a, &s, c))
+            {
                 Ok(f) => {
                     log.take(valid(
                         &format!("{filter}::from_alignment"),

@@ -51,7 +51,7 @@ pub(crate) fn config<T: Scalar>(input: &mut Input<'_>) -> AttitudeConfig<T> {
         &mut c.filter.max_dt,
         &mut c.startup_s,
         &mut c.block_s,
-        &mut c.acceleration_correlation_s,
+        &mut c.velocity_sigma,
         &mut c.motion_memory_s,
         &mut c.accelerometer_bias_sigma,
         &mut c.gyro_scale_sigma,

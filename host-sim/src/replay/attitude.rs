@@ -33,7 +33,7 @@ pub(super) fn navigator_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> Att
     c.instantaneous_imu = cfg.instantaneous_imu;
     c.startup_s = T::lit(cfg.align_window_s);
     c.block_s = T::lit(cfg.block_s);
-    c.acceleration_correlation_s = T::lit(cfg.acceleration_correlation_s);
+    c.velocity_sigma = T::lit(cfg.velocity_sigma);
     c.motion_memory_s = T::lit(cfg.motion_memory_s);
     c.rotation_only = cfg.rotation_only;
     c.accelerometer_bias_sigma = T::lit(cfg.accelerometer_bias_sigma);

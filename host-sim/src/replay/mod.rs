@@ -62,14 +62,14 @@ pub struct ReplayConfig {
     pub max_dt: f64,
     /// Attitude navigator: length of an aiding block, s.
     pub block_s: f64,
-    /// Attitude navigator: correlation time of the body's linear acceleration, s.
-    pub acceleration_correlation_s: f64,
+    /// Attitude navigator: the smallest spread (1σ per axis) of a moving body's velocity, m/s.
+    pub velocity_sigma: f64,
     /// Attitude navigator: fuse the magnetometer's whole field (`true`: a calibrated
     /// magnetometer in a clean field; it then also measures the tilt) rather than its heading.
     pub magnetometer_vector: bool,
     /// Attitude navigator: the body only rotates in place (no linear acceleration).
     pub rotation_only: bool,
-    /// Attitude navigator: memory of the slow-acceleration estimate, s.
+    /// Attitude navigator: memory of the velocity spread, s.
     pub motion_memory_s: f64,
     /// Attitude navigator: 1σ of the accelerometer bias per axis, m/s² (the tilt floor is
     /// this over g; 0 where the accelerometer has no bias).
@@ -127,10 +127,7 @@ impl ReplayConfig {
             ("align_window_s", self.align_window_s),
             ("max_dt", self.max_dt),
             ("block_s", self.block_s),
-            (
-                "acceleration_correlation_s",
-                self.acceleration_correlation_s,
-            ),
+            ("velocity_sigma", self.velocity_sigma),
             ("motion_memory_s", self.motion_memory_s),
         ];
         for (name, x) in positive {
@@ -176,6 +173,18 @@ impl ReplayConfig {
     }
 }
 
+impl ReplayConfig {
+    /// The defaults for data from host-sim's own simulator, whose IMU samples are the motion's
+    /// values at their instant (`instantaneous_imu`; a MEMS IMU's are means over the interval).
+    #[must_use]
+    pub fn simulated() -> Self {
+        Self {
+            instantaneous_imu: true,
+            ..Self::default()
+        }
+    }
+}
+
 impl Default for ReplayConfig {
     fn default() -> Self {
         Self {
@@ -184,7 +193,7 @@ impl Default for ReplayConfig {
             gravity: [0.0, 0.0, -9.81],
             max_dt: 0.1,
             block_s: 0.5,
-            acceleration_correlation_s: 0.15,
+            velocity_sigma: 0.3,
             motion_memory_s: 5.0,
             rotation_only: false,
             rpe_delta: 1.0,
@@ -195,7 +204,7 @@ impl Default for ReplayConfig {
             gyro_scale_sigma: 0.005,
             heading_noise_deg: 8.0,
             heading_floor_deg: 1.0,
-            instantaneous_imu: true,
+            instantaneous_imu: false,
             horizon_s: 0.3,
             ignore_gnss_latency: false,
             plots: true,

@@ -161,8 +161,8 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for AccelerometerAtRest<T> {
 }
 
 /// The attitude filter with both biases: the bias columns are 6–8.
-impl<T: Real> Measurement<T, AhrsAccelBiasState<T>, 9, 3> for AccelerometerAtRest<T> {
-    fn linearize(&self, x: &AhrsAccelBiasState<T>) -> Result<Linearization<T, 9, 3>, EskfError> {
+impl<T: Real> Measurement<T, AhrsAccelBiasState<T>, 12, 3> for AccelerometerAtRest<T> {
+    fn linearize(&self, x: &AhrsAccelBiasState<T>) -> Result<Linearization<T, 12, 3>, EskfError> {
         self.linearization(&x.attitude, &x.accel_bias, 6)
     }
 

@@ -75,8 +75,8 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 3> for ZeroRate<T> {
     }
 }
 
-impl<T: Real> Measurement<T, AhrsAccelBiasState<T>, 9, 3> for ZeroRate<T> {
-    fn linearize(&self, x: &AhrsAccelBiasState<T>) -> Result<Linearization<T, 9, 3>, EskfError> {
+impl<T: Real> Measurement<T, AhrsAccelBiasState<T>, 12, 3> for ZeroRate<T> {
+    fn linearize(&self, x: &AhrsAccelBiasState<T>) -> Result<Linearization<T, 12, 3>, EskfError> {
         self.linearization(&x.gyro_bias, 3)
     }
 

@@ -183,7 +183,7 @@ mod tests {
     #[test]
     fn reset_of_a_turning_correction_keeps_covariance_positive_definite() {
         #[rustfmt::skip]
-        let p: [f64; 81] = [
+        let p9: [f64; 81] = [
             9.869604401089358, 2.2295544065344304e-19, -1.4928154090486902e-9, -7.6969020012945e29, -4081956728395546.0, 1.154535300283212e20, 0.0, 0.0, 0.0,
             2.2295544065344304e-19, 9.869604401089358, 1.492815408822072e-9, 4081922244754491.5, -7.6969020012945e29, -1.1545353001036484e20, 0.0, 0.0, 0.0,
             -1.4928154090486902e-9, 1.492815408822072e-9, 6.314225676018066e-12, 1.1641858622219449e20, -1.1641858620452019e20, -4.924207114946038e17, 0.0, 0.0, 0.0,
@@ -194,7 +194,10 @@ mod tests {
             0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.00813766360325104, 0.0,
             0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.00813766360325104,
         ];
-        let mut p = SMatrix::<f64, 9, 9>::from_column_slice(&p);
+        // The finding's 9 × 9 P (attitude and both biases), the velocity apart from it.
+        let mut p = SMatrix::<f64, 12, 12>::identity();
+        p.fixed_view_mut::<9, 9>(0, 0)
+            .copy_from(&SMatrix::<f64, 9, 9>::from_column_slice(&p9));
         assert!(p.cholesky().is_some(), "the prior is positive definite");
         let q = Quaternion::new(
             1.0,
@@ -210,6 +213,7 @@ mod tests {
                 -827173880672355.0,
             ),
             accel_bias: Vector3::zeros(),
+            velocity: Vector3::zeros(),
         };
         let model = Magnetometer {
             field: Vector3::new(

@@ -98,7 +98,9 @@ pub struct AttitudeConfig<T: Real> {
     /// is integrated; a longer one is a gap after which the navigator starts again.
     pub filter: FilterConfig<T>,
     /// The IMU samples are instantaneous values (integrated over an interval with the mean of
-    /// its two ends) rather than means over the interval ending at their timestamp.
+    /// its two ends) rather than means over the interval ending at their timestamp. A MEMS
+    /// IMU's output is the mean of its internal samples since the previous output (its
+    /// decimation filter), so the default is `false`; a simulator's samples are instants.
     pub instantaneous_imu: bool,
     /// Length of the start-up window, s: the accelerometer, gyro and magnetometer are averaged
     /// over it for the first attitude.
@@ -109,11 +111,12 @@ pub struct AttitudeConfig<T: Real> {
     /// The body only rotates in place (a gimbal, a turntable): the accelerometer sees gravity,
     /// its bias and white noise, and the motion terms of the accelerometer noise are left out.
     pub rotation_only: bool,
-    /// Correlation time of the body's linear acceleration, s: the mean of a block of length
-    /// `T` keeps `min(1, 2τ/T)` of its variance.
-    pub acceleration_correlation_s: T,
-    /// Memory of the slow-acceleration estimate, s (the running mean of the blocks' vertical
-    /// mean acceleration, taken for the horizontal one).
+    /// The smallest spread (1σ per axis) of a moving body's velocity, m/s: the velocity bound
+    /// that measures the tilt (`tilt` in the module docs) is never tighter than this while the
+    /// body moves.
+    pub velocity_sigma: T,
+    /// Memory of the velocity spread, s: the running mean of the estimated velocity's square,
+    /// which loosens the bound for a body that moves faster.
     pub motion_memory_s: T,
     /// 1σ of the accelerometer bias per axis at switch-on, m/s², `> 0` (the bias is a state
     /// with this prior; its random walk is the filter configuration's).
@@ -145,9 +148,10 @@ pub struct AttitudeConfig<T: Real> {
 }
 
 impl<T: Real> AttitudeConfig<T> {
-    /// The defaults around a filter configuration: trapezoidal IMU integration; 1 s start-up;
-    /// 0.5 s blocks; 0.15 s acceleration correlation; 5 s memory of slow
-    /// accelerations; 0.1 m/s² accelerometer bias (0.6° of
+    /// The defaults around a filter configuration: IMU samples as means over their interval;
+    /// 1 s start-up;
+    /// 0.5 s blocks; a moving body's velocity spread at least 0.3 m/s per axis, remembered
+    /// over 5 s; 0.1 m/s² accelerometer bias (0.6° of
     /// tilt); 0.5 % gyro scale and cross-axis error; 0.5 °/s gyro bias at switch-on; rest below 2 °/s and 0.5 m/s² for 1.5 s with a
     /// 0.1 °/s floor; widen after 8 rejected blocks (2 s); valid below 5° tilt and 10° heading;
     /// no magnetometer.
@@ -155,11 +159,11 @@ impl<T: Real> AttitudeConfig<T> {
     pub fn new(filter: FilterConfig<T>) -> Self {
         Self {
             filter,
-            instantaneous_imu: true,
+            instantaneous_imu: false,
             startup_s: T::lit(1.0),
             block_s: T::lit(0.5),
             rotation_only: false,
-            acceleration_correlation_s: T::lit(0.15),
+            velocity_sigma: T::lit(0.3),
             motion_memory_s: T::lit(5.0),
             accelerometer_bias_sigma: T::lit(0.1),
             gyro_scale_sigma: T::lit(0.005),
@@ -190,7 +194,7 @@ impl<T: Real> AttitudeConfig<T> {
             && self.startup_s < four_seconds
             && positive_finite(self.block_s)
             && self.block_s < four_seconds
-            && positive_finite(self.acceleration_correlation_s)
+            && positive_finite(self.velocity_sigma)
             && positive_finite(self.motion_memory_s)
             && positive_finite(self.accelerometer_bias_sigma)
             && non_negative_finite(self.gyro_scale_sigma)

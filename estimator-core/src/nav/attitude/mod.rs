@@ -1,5 +1,6 @@
 //! The attitude navigator: an [`AhrsAccelBias`] filter (attitude, gyro and accelerometer
-//! biases) with everything a sensor stream needs around it.
+//! biases, and the velocity the specific force integrates to) with everything a sensor stream
+//! needs around it.
 //!
 //! One call per sample: [`AttitudeNavigator::imu`] for every IMU sample,
 //! [`AttitudeNavigator::magnetometer`] for every magnetometer sample, each with its own
@@ -11,17 +12,46 @@
 //! 1. **Start-up** (`startup`): the first `startup_s` of samples are averaged in a frame the
 //!    gyro carries along, at rest or moving; tilt, heading, bias and their covariance come from
 //!    the means. A gap in the IMU longer than `max_dt` starts it again.
-//! 2. **Prediction**: every IMU interval is integrated by [`AhrsAccelBias::predict`](crate::eskf::Filter::predict) (trapezoidal for
+//! 2. **Prediction**: every IMU interval turns the attitude by [`AhrsAccelBias::predict`](crate::eskf::Filter::predict)
+//!    (the sample's rate over the interval ending at it, or the mean of both ends for
 //!    instantaneous samples).
-//! 3. **Blocks** (`block`): accelerometer and magnetometer samples are averaged over
-//!    `block_s` in the same gyro-carried frame and fused once at the block's end:
+//! 3. **Blocks** (`block`): accelerometer and magnetometer samples are summed over `block_s`
+//!    in the same gyro-carried frame; at the block's end the velocity moves by the block's
+//!    world-frame specific force ([`AhrsAccelBias::integrate_velocity`]) and the gyro's scale
+//!    error widens the attitude; then, one update per call:
 //!    * **rest** (`rest`): a still block, after `rest_min_s` of them, is a zero-rate update
 //!      of the gyro bias;
-//!    * **tilt** (`tilt`): the block's mean specific force (gravity and the accelerometer
-//!      bias), with a noise that follows the measured linear acceleration; widened, never
-//!      locked out, after repeated rejections;
+//!    * **tilt** (`tilt`): the velocity is bounded, by the spread of a moving body's velocity
+//!      or by the drift of a still one: a tilt error shows as a velocity that grows as
+//!      `g t δθ`; widened, never locked out, after repeated rejections;
 //!    * **heading** (`magnetic`): the magnetometer's heading only, when its norm and dip agree
 //!      with the reference; a steady new field becomes the reference.
+//!
+//! # Beside VQF and BROAD
+//!
+//! VQF (Laidig and Seel, "VQF: Highly accurate IMU orientation estimation with bias estimation
+//! and magnetic disturbance rejection", Information Fusion 2023) and the BROAD benchmark
+//! (Laidig, Caruso, Cereatti and Seel, "BROAD — A Benchmark for Robust Inertial Orientation
+//! Estimation", Data 2021) shaped these choices; no code is taken from either.
+//!
+//! * Taken from VQF: the accelerometer is low-pass filtered in a frame the gyro carries along
+//!   (here: summed over a block in the estimate's frame, `block`), so the body's rotation does
+//!   not smear the mean; the gyro bias is learned at rest and while moving; the magnetometer
+//!   corrects the heading only, and a disturbed field (norm, dip) is not fused.
+//! * Done differently: VQF low-pass filters the specific force (a time constant of about 3 s)
+//!   and corrects the tilt toward its direction with a fixed gain; here the specific force is
+//!   integrated to a velocity, and a bound on the body's velocity corrects the tilt through a
+//!   Kalman gain. Both rest on the same physics — the body's acceleration averages out because
+//!   its velocity stays bounded — but the velocity state keeps the sum exactly (the mean
+//!   acceleration over a window `W` is `Δv/W`) and the filter knows how uncertain the tilt is,
+//!   which gives the reported covariance and the validity flags. The gyro's scale error widens
+//!   the attitude in proportion to the rotation, and the accelerometer bias is a state
+//!   (separated from the tilt by the body's turns), where VQF has neither.
+//! * From BROAD: its metric (the inclination and heading parts of the error, in movement
+//!   phases) is what `host-sim bench` prints, beside VQF's published figures; its trial
+//!   kinds (rotation, translation, rest breaks, tapping, vibration, magnetic disturbances)
+//!   are the motions the defaults are derived for, from sensor and motion properties written
+//!   beside each in [`AttitudeConfig::new`] and the tuning table of [`crate::nav`].
 //!
 //! Nothing allocates; the navigator is a plain value (`size_of::<AttitudeNavigator<f32>>()`
 //! is in the firmware table of the README).
@@ -67,8 +97,8 @@ enum Stage {
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Pending<T: Real> {
     stats: block::BlockStats<T>,
-    /// The accelerometer's 1σ per axis, m/s².
-    sigma: T,
+    /// The velocity bound's variance per axis, (m/s)².
+    variance: Vector3<T>,
     stage: Stage,
 }
 
@@ -128,11 +158,9 @@ pub struct AttitudeNavigator<T: Real> {
     last_imu: Option<(Vector3<T>, Vector3<T>)>,
     /// The bias to start from after a gap.
     bias_prior: Vector3<T>,
-    /// The linear-acceleration power of the previous block, (m/s²)² per axis.
-    last_power: T,
-    /// The running mean of the squared vertical block-mean acceleration, (m/s²)²: the
-    /// variance per axis of slow accelerations that a block's scatter does not show.
-    slow_power: T,
+    /// The running mean of the estimated velocity's square per axis, (m/s)²: the spread of
+    /// the body's velocity (`tilt`).
+    velocity_spread: Vector3<T>,
     /// Still blocks in a row, s.
     still_s: T,
     tilt_rejected: u16,
@@ -174,8 +202,7 @@ impl<T: Real> AttitudeNavigator<T> {
             mag_clock: Clock::default(),
             last_imu: None,
             bias_prior: Vector3::zeros(),
-            last_power: T::zero(),
-            slow_power: T::zero(),
+            velocity_spread: Vector3::zeros(),
             still_s: T::zero(),
             tilt_rejected: 0,
             report: AttitudeReport {
@@ -432,12 +459,18 @@ impl<T: Real> AttitudeNavigator<T> {
             // Free fall for a whole block: nothing to fuse.
             return;
         }
-        let power = tilt::acceleration_power(&stats, tilt::white_sq(&stats, &self.config));
         if !self.running {
-            self.begin(&stats, power);
+            self.begin(&stats);
             return;
         }
         let filter = &mut self.filter;
+        // The velocity over the block, from the block's sums (`block`): Σ R̂ᵢ fᵢ Δt and Σ R̂ᵢ Δt.
+        let r_end = frame.rotation_matrix();
+        let integrated = filter.integrate_velocity(
+            &(mat3::mul_vec(&r_end, &stats.accel_body) * stats.duration),
+            &(mat3::mul(&r_end, &stats.bias_map) * stats.duration),
+            stats.duration,
+        );
         // The gyro's scale and cross-axis errors over the block's rotation.
         let turned = self.config.gyro_scale_sigma * stats.rotation(&filter.state().gyro_bias);
         let widened = turned > T::zero() && filter.widen_attitude(turned, turned).is_err();
@@ -449,21 +482,25 @@ impl<T: Real> AttitudeNavigator<T> {
             T::zero()
         };
         self.report.at_rest = still && self.still_s >= self.config.rest_min_s;
-        if widened {
+        let velocity = filter.state().velocity;
+        if widened || integrated.is_err() {
             self.failed();
         }
-        let used_power = if power > self.last_power {
-            power
-        } else {
-            self.last_power
-        };
-        self.last_power = power;
-        let sigma =
-            tilt::specific_force_sigma(&stats, &self.config, used_power, self.slow_power, g);
-        self.slow_power = tilt::update_slow_power(self.slow_power, &stats, &self.config, g);
+        self.velocity_spread = tilt::update_spread(
+            &self.velocity_spread,
+            &velocity,
+            stats.duration,
+            &self.config,
+        );
+        let variance = tilt::velocity_variance(
+            &stats,
+            &self.config,
+            &self.velocity_spread,
+            self.report.at_rest,
+        );
         self.pending = Some(Pending {
             stats,
-            sigma,
+            variance,
             stage: if self.report.at_rest {
                 Stage::ZeroRate
             } else {
@@ -475,7 +512,7 @@ impl<T: Real> AttitudeNavigator<T> {
 
     /// Starts the filter from the start-up window's statistics, in the navigator's own storage
     /// ([`AhrsAccelBias::restart_from_alignment`]).
-    fn begin(&mut self, stats: &block::BlockStats<T>, power: T) {
+    fn begin(&mut self, stats: &block::BlockStats<T>) {
         let start = startup::start(stats, &self.config, &self.bias_prior, &mut self.magnetic);
         let started = match start {
             Ok(s) => match self.filter.restart_from_alignment(&s.alignment, &s.sigmas) {
@@ -491,7 +528,7 @@ impl<T: Real> AttitudeNavigator<T> {
         };
         self.running = true;
         self.still_s = if still { stats.duration } else { T::zero() };
-        self.last_power = power;
+        self.velocity_spread = Vector3::zeros();
         self.report.at_rest = still;
         if self.report.event.is_none() {
             self.report.event = Some(Event::Started);
@@ -536,7 +573,7 @@ impl<T: Real> AttitudeNavigator<T> {
                 let fused = tilt::fuse(
                     filter,
                     stats,
-                    pending.sigma,
+                    &pending.variance,
                     &self.config,
                     &mut self.tilt_rejected,
                 );

@@ -3,7 +3,8 @@
 //! The window is one long block (see `block`): its mean specific force and mean field are
 //! seen in the body at its end, carried by the gyro, so a body that moves during the window
 //! is aligned as well as one at rest; only the linear acceleration's mean stays in the tilt,
-//! and the tilt model of `tilt` gives its 1σ.
+//! and the tilt model of `tilt` gives its 1σ. The velocity starts at zero, with the spread of a
+//! moving body's velocity, or a still body's drift (`tilt`).
 //!
 //! * Tilt and heading: the triad of [`align_at_rest`] on the two means (the window's mean
 //!   field against the reference; without a magnetometer the body `x` axis points to world
@@ -20,7 +21,7 @@ use super::block::BlockStats;
 use super::config::AttitudeConfig;
 use super::magnetic::Magnetic;
 use super::rest::{is_still, mean_rate_variance};
-use super::tilt::{acceleration_power, specific_force_sigma, white_sq};
+use super::tilt::startup_sigma;
 use crate::eskf::{align_at_rest, Alignment, InitialSigmas, MagnetometerWindow};
 use crate::kernels::mat3;
 use crate::nav::error::NavError;
@@ -43,13 +44,7 @@ pub(super) fn start<T: Real>(
         (*bias_prior, config.gyro_bias_sigma)
     };
     // The mean specific force's error per axis: the motion's and the bias's, as an angle.
-    let motion = specific_force_sigma(
-        stats,
-        config,
-        acceleration_power(stats, white_sq(stats, config)),
-        T::zero(),
-        g,
-    );
+    let motion = startup_sigma(stats, config, g);
     let bias = config.accelerometer_bias_sigma;
     let tilt = (motion * motion + bias * bias).sqrt_rn() / g;
 
@@ -106,6 +101,12 @@ pub(super) fn start<T: Real>(
         yaw,
         gyro_bias: bias_sigma,
         accel_bias: config.accelerometer_bias_sigma,
+        // At rest the velocity is zero; moving, it is one of the body's velocities.
+        velocity: if still {
+            config.rest_accel * stats.duration / T::lit(12.0).sqrt_rn()
+        } else {
+            config.velocity_sigma
+        },
         ..InitialSigmas::default()
     };
     Ok(Start {

@@ -1,46 +1,48 @@
-//! The accelerometer over a block, with a noise that follows the motion.
+//! Tilt from the accelerometer through a bound on the body's velocity.
 //!
-//! The mean specific force of a block, seen in the body at its end (see `block`), is
-//! `f̄ = Rᵀ(ā − g) + M b_a`: gravity, the block's mean linear acceleration `ā`, and the
-//! accelerometer bias, which turned with the body during the block (`M = R̂ₑᵀ mean(R̂ᵢ)`, the
-//! mean rotation from each sample to the end). It is an [`AccelerometerAtRest`] measurement
-//! (`h(x) = Rᵀ(−g) + M b_a`)
-//! whose noise is the mean linear acceleration plus the white noise, per axis
+//! The filter carries the velocity `v` the specific force integrates to
+//! ([`AhrsAccelBias::integrate_velocity`], once per block: `v⁺ = v + Σ R̂ᵢ(f_m,ᵢ − b_a)Δt + g T`).
+//! A tilt error `δθ` turns gravity into a velocity error that grows as `g t δθ`, an
+//! accelerometer bias into one that grows as `R̂ b_a t`; the body's own velocity, whatever it
+//! does, stays bounded. So at each block's end the velocity is measured as zero
+//! ([`ZeroVelocity`]) with the spread of the body's velocity as the noise, per axis
 //!
 //! ```text
-//! σ² = σ_s²/n  +  max(q·min(1, 2τ/T), q_slow)  +  (‖f̄‖ − ‖g‖)²            (m/s²)²
+//! moving:   σ_v² = max(σ_min², 4·⟨v̂²⟩)            at rest:  σ_v² = (a_rest T)²/12 + N_a² T
 //! ```
 //!
-//! * `σ_s² = N_a²/Δt`: the white noise of one sample (density `N_a`, interval `Δt`), `n`
-//!   samples in the block;
-//! * `q`: the variance per axis of the linear acceleration inside the block, from the scatter
-//!   of the world-frame specific force beyond the white noise, `q = max(0, s² − 3σ_s²)/3`
-//!   (the larger of this block's and the previous block's, so that a motion that starts at a
-//!   block's end is not missed);
-//! * `min(1, 2τ/T)`: the share of that variance left in the mean of a block of length `T`
-//!   for an acceleration correlated over `τ` (a first-order Gauss–Markov process keeps
-//!   `2τ/T` of its variance in a mean over `T ≫ τ`);
-//! * `(‖f̄‖ − ‖g‖)²`: the vertical part of `ā`, which the norm shows directly, taken for the
-//!   size of the horizontal part the norm cannot show;
-//! * `q_slow`: the running mean of that vertical part's square over the last
-//!   `motion_memory_s`: accelerations slower than a block (a body that speeds up for a second)
-//!   leave no scatter inside a block, but they show in the vertical means of the blocks
-//!   before, and a hand-held or worn body accelerates about as much across as along gravity.
+//! (with `rotation_only`, a body turning in place, `σ_v² = N_a² T`: its velocity is zero).
 //!
-//! With `rotation_only` (a body that turns in place) only the white noise remains.
+//! * `σ_min` (`velocity_sigma`): the smallest spread assumed for a moving body;
+//! * `⟨v̂²⟩`: the running mean of the estimated velocity's square on that axis over the last
+//!   `motion_memory_s` (first order, weight `min(1, T/τ_m)` per block), so that a body that
+//!   moves faster (walking, a vehicle) loosens its own bound: the factor 4 puts the mean
+//!   square at 2σ, where the gate (99.9 %) still admits it;
+//! * at rest (`rest`): a body whose RMS acceleration is below `a_rest` (`rest_accel`) drifts
+//!   by at most `a_rest T` over a block of length `T`, taken as uniform (variance `/12`),
+//!   plus the accelerometer's white noise integrated over the block (`N_a` its density).
 //!
-//! No threshold throws a block away: a block taken during strong motion simply weighs little.
-//! Because the bias is a state, blocks in different orientations separate it from the tilt
-//! (a body-fixed bias turns with the body, gravity does not). The update is gated
-//! (chi-square, 99.9 %); when `max_rejected_blocks` blocks in a row fail the gate, the
-//! estimate is what is wrong, not the data, and the tilt covariance is widened by the
-//! innovation angle before the block is fused.
+//! Why a velocity and not the block's mean specific force: the mean linear acceleration over
+//! a window `W` is `(v_end − v_start)/W`. Fused block by block as independent noise, the
+//! means of a moving body weigh little and a tilt error takes tens of seconds to correct;
+//! their errors telescope, so the velocity state, which keeps the sum, corrects in a few
+//! seconds what independent means would not (the mean over `W` has an error falling as `1/W`
+//! for a bounded velocity, not as `1/√W`).
+//!
+//! The update is gated (chi-square, 99.9 %); when `max_rejected_blocks` blocks in a row fail
+//! the gate, the estimate is what is wrong, not the data: the tilt covariance is widened by the
+//! angle between the block's mean specific force and the predicted up direction, that mean
+//! is fused (ungated, iterated) with the error a bounded velocity leaves in it
+//! (`2σ_v²/T²` per axis: the mean linear acceleration over `T` is `Δv/T`), and the velocity,
+//! which integrated the wrong tilt, starts again from the bound
+//! ([`AhrsAccelBias::restart_velocity`]).
 
 use super::block::BlockStats;
 use super::config::AttitudeConfig;
 use super::report::{Event, Fusion};
 use crate::eskf::{
     up_direction, AccelerometerAtRest, AhrsAccelBias, ErrorState, Filter, Gate, UpdateOptions,
+    ZeroVelocity,
 };
 use crate::kernels::mat3;
 use crate::lie::LieGroup;
@@ -70,44 +72,63 @@ pub(super) fn white_sq<T: Real>(stats: &BlockStats<T>, config: &AttitudeConfig<T
     }
 }
 
-/// The 1σ per axis of the block's mean specific force, m/s² (module docs), with `power` the
-/// per-axis linear-acceleration variance inside the block and `slow` that of slow
-/// accelerations.
-pub(super) fn specific_force_sigma<T: Real>(
-    stats: &BlockStats<T>,
-    config: &AttitudeConfig<T>,
-    power: T,
-    slow: T,
-    g: T,
-) -> T {
+/// The 1σ per axis of the start-up window's mean specific force, m/s²: the white noise, the
+/// vertical part of the mean linear acceleration (`‖f̄‖ − ‖g‖`, which the norm shows and is
+/// taken for the horizontal part too), and the motion inside the window, at most what a
+/// velocity of spread `σ_min` allows over the window's length `W` (`2σ_min²/W²`: the mean
+/// linear acceleration is `(v_end − v_start)/W`).
+pub(super) fn startup_sigma<T: Real>(stats: &BlockStats<T>, config: &AttitudeConfig<T>, g: T) -> T {
     let white = white_sq(stats, config) / T::from_count(stats.n.max(1));
     if config.rotation_only {
         return white.sqrt_rn();
     }
-    let two_tau = T::lit(2.0) * config.acceleration_correlation_s;
-    let keep = if stats.duration > two_tau {
-        two_tau / stats.duration
-    } else {
-        T::one()
-    };
+    let power = acceleration_power(stats, white_sq(stats, config));
+    let w = stats.duration;
+    let bound = T::lit(2.0) * config.velocity_sigma * config.velocity_sigma / (w * w);
+    let inside = if power < bound { power } else { bound };
     let vertical = stats.accel_norm - g;
-    let inside = power * keep;
-    let motion = if inside > slow { inside } else { slow };
-    (white + motion + vertical * vertical).sqrt_rn()
+    (white + inside + vertical * vertical).sqrt_rn()
 }
 
-/// The running mean of `(‖f̄‖ − ‖g‖)²` over the last `motion_memory_s` (first order, weight
-/// `min(1, T/τ_m)` per block).
-pub(super) fn update_slow_power<T: Real>(
-    slow: T,
+/// The variance per axis of the velocity bound of a block (module docs), (m/s)², with `spread`
+/// the running mean of `v̂²` per axis.
+pub(super) fn velocity_variance<T: Real>(
     stats: &BlockStats<T>,
     config: &AttitudeConfig<T>,
-    g: T,
-) -> T {
-    let vertical = stats.accel_norm - g;
-    let w = stats.duration / config.motion_memory_s;
+    spread: &Vector3<T>,
+    at_rest: bool,
+) -> Vector3<T> {
+    let na = config.filter.imu_noise.accelerometer_noise_density;
+    if config.rotation_only {
+        // The velocity is zero, known to the white noise of one block's integral.
+        return Vector3::repeat(na * na * stats.duration);
+    }
+    if at_rest {
+        let drift = config.rest_accel * stats.duration;
+        return Vector3::repeat(drift * drift / T::lit(12.0) + na * na * stats.duration);
+    }
+    let floor = config.velocity_sigma * config.velocity_sigma;
+    spread.map(|s| {
+        let v = T::lit(4.0) * s;
+        if v > floor {
+            v
+        } else {
+            floor
+        }
+    })
+}
+
+/// The running mean of `v̂²` per axis over the last `motion_memory_s` (first order, weight
+/// `min(1, T/τ_m)` per block).
+pub(super) fn update_spread<T: Real>(
+    spread: &Vector3<T>,
+    velocity: &Vector3<T>,
+    duration: T,
+    config: &AttitudeConfig<T>,
+) -> Vector3<T> {
+    let w = duration / config.motion_memory_s;
     let w = if w < T::one() { w } else { T::one() };
-    slow + (vertical * vertical - slow) * w
+    spread + (velocity.component_mul(velocity) - spread) * w
 }
 
 /// The world-frame attitude covariance `R P_θθ Rᵀ` of a filter, its diagonal kept at the
@@ -127,24 +148,21 @@ pub(super) fn world_attitude_covariance<T: Real, S: ErrorState<T, N>, const N: u
     w
 }
 
-/// Fuses the block's mean specific force with 1σ `sigma` per axis; widens the tilt after
-/// `max_rejected_blocks` rejections in a row (`rejected` counts them).
+/// Fuses the velocity bound with the variance `variance` per axis; widens the tilt after
+/// `max_rejected_blocks` rejections in a row (`rejected` counts them), by the angle between
+/// the block's mean specific force (bias removed) and the predicted up direction.
 /// Returns the update's outcome (after the widening, if there was one), and the event if the
 /// covariance was widened.
 #[inline(never)] // its own stack frame, not the caller's
 pub(super) fn fuse<T: Real>(
     filter: &mut AhrsAccelBias<T>,
     stats: &BlockStats<T>,
-    sigma: T,
+    variance: &Vector3<T>,
     config: &AttitudeConfig<T>,
     rejected: &mut u16,
 ) -> Result<(Fusion<T>, Option<Event>), NavError> {
-    // The bias turned with the body during the block: the block sees `M b_a`.
-    let model = AccelerometerAtRest {
-        accel: stats.accel_body,
-        gravity: config.filter.gravity,
-        noise: Matrix3::from_diagonal_element(sigma * sigma),
-        bias_map: stats.bias_map,
+    let model = ZeroVelocity {
+        noise: Matrix3::from_diagonal(variance),
     };
     let options = UpdateOptions::default();
     let mut event = None;
@@ -154,14 +172,28 @@ pub(super) fn fuse<T: Real>(
     } else {
         *rejected = rejected.saturating_add(1);
         if *rejected >= config.max_rejected_blocks {
-            // The innovation angle: between the measured (bias removed) and the predicted up
-            // direction.
+            // The innovation angle: between the block's mean specific force (bias removed) and
+            // the predicted up direction.
             let up = up_direction(&config.filter.gravity).unwrap_or_else(Vector3::zeros);
             let predicted = filter.state().attitude.inverse().act(&up);
-            let f = stats.accel_body - filter.state().accel_bias;
+            let f = stats.accel_body - mat3::mul_vec(&stats.bias_map, &filter.state().accel_bias);
             let angle = mat3::norm(&(f / mat3::norm(&f) - predicted));
             filter.widen_attitude(angle, T::zero())?;
+            // The velocity integrated the wrong tilt: it is no information. The block's mean
+            // specific force measures the tilt again, with the error a bounded velocity leaves
+            // in a mean over `T` (`Δv/T`, `Δv` of variance `2σ_v²`), and the velocity starts
+            // again from the bound.
+            let larger = crate::kernels::larger;
+            let spread = larger(variance.x, larger(variance.y, variance.z));
+            let t = stats.duration;
+            let model = AccelerometerAtRest {
+                accel: stats.accel_body,
+                gravity: config.filter.gravity,
+                noise: Matrix3::from_diagonal_element(T::lit(2.0) * spread / (t * t)),
+                bias_map: stats.bias_map,
+            };
             fusion = Fusion::from(filter.update(&model, &recovery_options())?);
+            filter.restart_velocity(Vector3::zeros(), spread.sqrt_rn())?;
             *rejected = 0;
             event = Some(Event::TiltWidened);
         }

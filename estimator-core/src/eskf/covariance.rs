@@ -163,7 +163,7 @@ const GROWTH_FLOOR: f64 = 64.0;
 /// The mixing floor's `64 ε`, of the size of the products that feed the velocity and the
 /// position ([`floor_mixing`]): the rounding of the rotation that mixes their axes, with a
 /// margin.
-const GROWTH_MIXING: f64 = 64.0;
+pub(crate) const GROWTH_MIXING: f64 = 64.0;
 
 /// And `2 ε` of each variance: the rounding of one prediction, twice over.
 const GROWTH_ROUNDING: f64 = 2.0;

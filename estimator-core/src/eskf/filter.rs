@@ -707,7 +707,8 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 12> {
     /// from `R f = R̂ Exp(δθ) f ≈ R̂f − [R̂f]× R̂δθ` (the right `⊕` of *Lie Groups and Smooth
     /// Manifolds for Robotic State Estimation*, eq. 4.5, with `R̂ δθ` the world-frame error,
     /// eq. 3.1's adjoint `Ad_R = R`), `N_a` the accelerometer noise density: `P⁺ = G P Gᵀ + Q`
-    /// with `G` the identity but for block row `v`. `R̂ δθ` is taken at the block's end: the
+    /// with `G` the identity but for block row `v`, and the mixing floor of the 15-state
+    /// prediction on the velocity variances. `R̂ δθ` is taken at the block's end: the
     /// world-frame attitude error moves inside the block only by the gyro bias error, so the
     /// approximation leaves out `½ g T² |δb_g|` (0.01 m/s for a 0.5 s block and a bias error
     /// of 0.01 rad/s).
@@ -716,6 +717,7 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 12> {
     /// [`EskfError::NonFinite`] for a non-finite input or a variance that would leave the
     /// usable range, [`EskfError::NonPositiveDt`] for a duration that is not positive; the
     /// filter is then unchanged.
+    #[inline(never)] // its own stack frame, not the navigator's
     pub fn integrate_velocity(
         &mut self,
         specific_force: &Vector3<T>,
@@ -742,8 +744,17 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 12> {
         let na = self.config.imu_noise.accelerometer_noise_density;
         let n33 = c3 + mat3::mul(&c0, &a.transpose()) + mat3::mul(&c2, &b.transpose());
         let half = T::lit(0.5);
-        let n33 =
-            (n33 + n33.transpose()) * half + Matrix3::from_diagonal_element(na * na * duration);
+        // The mixing floor of the 15-state prediction (`floor_mixing`): `[s]× R̂` mixes the
+        // three axes, so each velocity variance rounds by a few ε of the products that feed
+        // it, `M = ‖s‖² tr P_θθ + ‖frames‖² tr P_aa`, not of its own result.
+        let trace = |k: usize| {
+            let b = block(p, k, k);
+            b.m11 + b.m22 + b.m33
+        };
+        let products = s.dot(&s) * trace(0) + frames.norm_squared() * trace(2);
+        let mixing = T::lit(super::covariance::GROWTH_MIXING * T::EPSILON_F64) * products;
+        let n33 = (n33 + n33.transpose()) * half
+            + Matrix3::from_diagonal_element(na * na * duration + mixing);
         let usable = (0..3).all(|k| n33.get((k, k)).is_some_and(|d| usable_variance(*d)))
             && all_finite(velocity.as_slice())
             && all_finite(c0.as_slice())
@@ -752,13 +763,13 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 12> {
         if !usable {
             return Err(EskfError::NonFinite);
         }
-        let mut p = self.covariance;
+        // Every check has passed: written in place (no second `P` on the stack).
+        let p = &mut self.covariance;
         for (j, cj) in [c0, c1, c2].iter().enumerate() {
-            set_block(&mut p, 3, j, cj);
-            set_block(&mut p, j, 3, &cj.transpose());
+            set_block(p, 3, j, cj);
+            set_block(p, j, 3, &cj.transpose());
         }
-        set_block(&mut p, 3, 3, &n33);
-        self.covariance = p;
+        set_block(p, 3, 3, &n33);
         self.state.velocity = velocity;
         Ok(())
     }

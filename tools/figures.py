@@ -221,19 +221,21 @@ def section_bench(binary, tmp, args):
             lines = [
                 f"`{folder}`: BROAD's RMSE [°] inside each trial's movement intervals",
                 "",
-                "| trial | ours total / heading / inclination | real-time VQF total | Madgwick total |",
-                "|---|---|---:|---:|",
+                "| trial | ours total / heading / inclination | ours inside 3σ [%] | real-time VQF total | Madgwick total |",
+                "|---|---|---:|---:|---:|",
             ]
-            cols = {"total": [], "heading": [], "inclination": [], "vqf": [], "madgwick": []}
+            cols = {"total": [], "heading": [], "inclination": [], "inside": [], "vqf": [], "madgwick": []}
             for r in rows:
                 o = r.get("ours") or {}
                 vals = (o.get("total_deg"), o.get("heading_deg"), o.get("inclination_deg"))
                 for k, v in zip(("total", "heading", "inclination"), vals):
                     cols[k].append(v)
+                cols["inside"].append(o.get("inside_3sigma_pct"))
                 cols["vqf"].append(r.get("vqf_total_deg"))
                 cols["madgwick"].append(r.get("madgwick_total_deg"))
                 lines.append(
                     f"| {r['dataset']} | {' / '.join(fmt(v, 2) for v in vals)} "
+                    f"| {fmt(o.get('inside_3sigma_pct'), 1)} "
                     f"| {fmt(r.get('vqf_total_deg'), 2)} | {fmt(r.get('madgwick_total_deg'), 2)} |"
                 )
 
@@ -242,10 +244,12 @@ def section_bench(binary, tmp, args):
                 return f(v) if v and all(x is not None for x in v) else None
 
             mean = lambda v: sum(v) / len(v)
-            for label, f in (("mean", mean), ("max", max)):
+            # The worst trial: the largest error, the smallest share inside 3σ.
+            for label, f, g in (("mean", mean, mean), ("max", max, min)):
                 ours = " / ".join(fmt(agg(k, f), 2) for k in ("total", "heading", "inclination"))
                 lines.append(
-                    f"| **{label}** | {ours} | {fmt(agg('vqf', f), 2)} | {fmt(agg('madgwick', f), 2)} |"
+                    f"| **{label}** | {ours} | {fmt(agg('inside', g), 1)} "
+                    f"| {fmt(agg('vqf', f), 2)} | {fmt(agg('madgwick', f), 2)} |"
                 )
         else:
             lines = [

@@ -217,14 +217,14 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
             Ok(m) => m,
             Err(e) => return Err(e),
         };
-        let mut p = self.covariance;
-        let widened = block(&p, 0, 0) + extra;
+        // Only the attitude block changes (the rest of `P` is finite, an invariant of the
+        // filter): checked and written in place, without a second `P` on the stack.
+        let widened = block(&self.covariance, 0, 0) + extra;
         let widened = widened + Matrix3::from_diagonal_element(attitude_resolution(&widened));
-        set_block(&mut p, 0, 0, &widened);
-        if !all_finite(p.as_slice()) {
+        if !all_finite(widened.as_slice()) {
             return Err(EskfError::NumericalFailure);
         }
-        self.covariance = p;
+        set_block(&mut self.covariance, 0, 0, &widened);
         Ok(())
     }
 
@@ -751,7 +751,12 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 12> {
             let b = block(p, k, k);
             b.m11 + b.m22 + b.m33
         };
-        let products = s.dot(&s) * trace(0) + frames.norm_squared() * trace(2);
+        // ‖frames‖², over the slice (nalgebra's column views carry a panic branch).
+        let frames_sq = frames
+            .as_slice()
+            .iter()
+            .fold(T::zero(), |acc, x| acc + *x * *x);
+        let products = s.dot(&s) * trace(0) + frames_sq * trace(2);
         let mixing = T::lit(super::covariance::GROWTH_MIXING * T::EPSILON_F64) * products;
         let n33 = (n33 + n33.transpose()) * half
             + Matrix3::from_diagonal_element(na * na * duration + mixing);

@@ -124,7 +124,7 @@ Example: host-sim replay data/car --out out/car"
 replays each (plots off; --config, else the dataset's replay.toml, else the defaults) and prints one table per parent folder, \
 against that folder's references.json when present:\n\
   BROAD (references.json with \"trials\"): BROAD's total / heading / inclination RMSE [deg] inside movement.csv, \
-real-time VQF's and Madgwick's total, the mean and the worst trial (each only where every trial has the figure);\n\
+the share of those samples inside the reported 3σ ellipsoid (NEES ≤ 9), real-time VQF's and Madgwick's total, the mean and the worst trial (each only where every trial has the figure);\n\
   otherwise (\"datasets\", or none): the sensors ours fuses, the attitude RMSE [deg] from 2 s after the first ground-truth sample, \
 the attitude ANEES, VQF's RMSE and ours/VQF, the ratio only where ours fuses VQF 9D's sensors (IMU+mag): \
 a dataset with GNSS replays through the INS navigator and is not divided by attitude-only VQF.\n\

@@ -62,11 +62,18 @@ pub fn in_intervals(intervals: &[(u64, u64)], t_ns: u64) -> bool {
     intervals.get(i).is_some_and(|&(start, _)| start <= t_ns)
 }
 
-/// Squared error angles summed over the scored samples.
+/// The NEES bound of the reported 3σ ellipsoid of a 3-D error: `eᵀ P⁻¹ e ≤ 3²`, which a
+/// consistent estimate's error satisfies with probability `P(χ²₃ ≤ 9) = 97.1 %`.
+pub const THREE_SIGMA_NEES: f64 = 9.0;
+
+/// Squared error angles summed over the scored samples, and how many of the samples with a
+/// reported attitude covariance had their error inside its 3σ ellipsoid.
 #[derive(Clone, Debug, Default)]
 pub struct BroadAccumulator {
     sq: [f64; 3],
     n: u64,
+    inside: u64,
+    covered: u64,
 }
 
 impl BroadAccumulator {
@@ -76,6 +83,15 @@ impl BroadAccumulator {
         self.sq[1] += e.heading * e.heading;
         self.sq[2] += e.inclination * e.inclination;
         self.n += 1;
+    }
+
+    /// Adds one sample's attitude NEES `eᵀ P⁻¹ e` (the error in the frame of the reported
+    /// covariance `P`): inside the 3σ ellipsoid when at most [`THREE_SIGMA_NEES`].
+    pub fn add_nees(&mut self, nees: f64) {
+        self.covered += 1;
+        if nees <= THREE_SIGMA_NEES {
+            self.inside += 1;
+        }
     }
 
     /// The RMSEs so far (NaN, written `null`, when no sample was scored).
@@ -93,6 +109,11 @@ impl BroadAccumulator {
             heading_deg: rmse(1),
             inclination_deg: rmse(2),
             samples: self.n,
+            inside_3sigma: if self.covered > 0 {
+                self.inside as f64 / self.covered as f64
+            } else {
+                f64::NAN
+            },
         }
     }
 }
@@ -108,6 +129,10 @@ pub struct BroadRmse {
     pub inclination_deg: f64,
     /// IMU samples scored (inside the movement intervals, with a truth).
     pub samples: u64,
+    /// The fraction of those samples, among the ones with a reported attitude covariance,
+    /// whose attitude error is inside the reported 3σ ellipsoid ([`THREE_SIGMA_NEES`]; 0.971
+    /// for a consistent estimate); NaN (`null`) without a covariance.
+    pub inside_3sigma: f64,
 }
 
 #[cfg(test)]
@@ -222,5 +247,17 @@ mod tests {
             assert_eq!(in_intervals(&iv, t), inside, "t = {t}");
         }
         assert!(!in_intervals(&[], 5));
+    }
+
+    /// The 3σ share counts a NEES of exactly 9 as inside and above it as outside, over the
+    /// samples with a covariance only; without any it is NaN (`null`), not 0.
+    #[test]
+    fn the_three_sigma_share_counts_nees_up_to_nine() {
+        let mut a = BroadAccumulator::default();
+        assert!(a.rmse().inside_3sigma.is_nan());
+        for nees in [1.0, 9.0, 9.5, 20.0, 0.0] {
+            a.add_nees(nees);
+        }
+        assert!((a.rmse().inside_3sigma - 0.6).abs() < 1e-12);
     }
 }

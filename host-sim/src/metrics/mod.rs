@@ -460,6 +460,10 @@ impl Scorer {
                     &e.attitude.quaternion(),
                     &truth.attitude.quaternion(),
                 ));
+                let attitude = errs.first().zip(e.cov.first().and_then(Option::as_ref));
+                if let Some((d, inv)) = attitude.and_then(|(d, p)| Some((d, p.try_inverse()?))) {
+                    self.broad.add_nees((d.transpose() * inv * d)[(0, 0)]);
+                }
             }
         }
         let mut error = [0.0; 15];

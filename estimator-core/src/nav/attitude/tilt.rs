@@ -11,7 +11,8 @@
 //! moving:   σ_v² = max(σ_min², 4·⟨v̂²⟩)            at rest:  σ_v² = (a_rest T)²/12 + N_a² T
 //! ```
 //!
-//! (with `rotation_only`, a body turning in place, `σ_v² = N_a² T`: its velocity is zero).
+//! (with `rotation_only`, a body turning in place, the velocity is exactly zero: `σ_v²` is
+//! `ε N_a² T`, positive only for the update, which raises it to its floor).
 //!
 //! * `σ_min` (`velocity_sigma`): the smallest spread assumed for a moving body;
 //! * `⟨v̂²⟩`: the running mean of the estimated velocity's square on that axis over the last
@@ -100,8 +101,9 @@ pub(super) fn velocity_variance<T: Real>(
 ) -> Vector3<T> {
     let na = config.filter.imu_noise.accelerometer_noise_density;
     if config.rotation_only {
-        // The velocity is zero, known to the white noise of one block's integral.
-        return Vector3::repeat(na * na * stats.duration);
+        // The velocity is exactly zero: the noise only has to be positive (the update raises it
+        // to its floor, `256 N ε` of the predicted variance, where that is larger).
+        return Vector3::repeat(na * na * stats.duration * T::lit(T::EPSILON_F64));
     }
     if at_rest {
         let drift = config.rest_accel * stats.duration;
@@ -172,33 +174,48 @@ pub(super) fn fuse<T: Real>(
     } else {
         *rejected = rejected.saturating_add(1);
         if *rejected >= config.max_rejected_blocks {
-            // The innovation angle: between the block's mean specific force (bias removed) and
-            // the predicted up direction.
-            let up = up_direction(&config.filter.gravity).unwrap_or_else(Vector3::zeros);
-            let predicted = filter.state().attitude.inverse().act(&up);
-            let f = stats.accel_body - mat3::mul_vec(&stats.bias_map, &filter.state().accel_bias);
-            let angle = mat3::norm(&(f / mat3::norm(&f) - predicted));
-            filter.widen_attitude(angle, T::zero())?;
-            // The velocity integrated the wrong tilt: it is no information. The block's mean
-            // specific force measures the tilt again, with the error a bounded velocity leaves
-            // in a mean over `T` (`Δv/T`, `Δv` of variance `2σ_v²`), and the velocity starts
-            // again from the bound.
-            let larger = crate::kernels::larger;
-            let spread = larger(variance.x, larger(variance.y, variance.z));
-            let t = stats.duration;
-            let model = AccelerometerAtRest {
-                accel: stats.accel_body,
-                gravity: config.filter.gravity,
-                noise: Matrix3::from_diagonal_element(T::lit(2.0) * spread / (t * t)),
-                bias_map: stats.bias_map,
-            };
-            fusion = Fusion::from(filter.update(&model, &recovery_options())?);
-            filter.restart_velocity(Vector3::zeros(), spread.sqrt_rn())?;
+            fusion = recover(filter, stats, variance, config)?;
             *rejected = 0;
             event = Some(Event::TiltWidened);
         }
     }
     Ok((fusion, event))
+}
+
+/// The recovery after `max_rejected_blocks` rejections (module docs): the tilt widened by the
+/// innovation angle, the block's mean specific force fused with the error a bounded velocity
+/// leaves in it, the velocity started again from the bound. Out of line: its models stay out
+/// of the usual update's frame.
+#[cold]
+#[inline(never)]
+fn recover<T: Real>(
+    filter: &mut AhrsAccelBias<T>,
+    stats: &BlockStats<T>,
+    variance: &Vector3<T>,
+    config: &AttitudeConfig<T>,
+) -> Result<Fusion<T>, NavError> {
+    // The innovation angle: between the block's mean specific force (bias removed) and the
+    // predicted up direction.
+    let up = up_direction(&config.filter.gravity).unwrap_or_else(Vector3::zeros);
+    let predicted = filter.state().attitude.inverse().act(&up);
+    let f = stats.accel_body - mat3::mul_vec(&stats.bias_map, &filter.state().accel_bias);
+    let angle = mat3::norm(&(f / mat3::norm(&f) - predicted));
+    filter.widen_attitude(angle, T::zero())?;
+    // The velocity integrated the wrong tilt: it is no information. The block's mean specific
+    // force measures the tilt again, with the error a bounded velocity leaves in a mean over
+    // `T` (`Δv/T`, `Δv` of variance `2σ_v²`), and the velocity starts again from the bound.
+    let larger = crate::kernels::larger;
+    let spread = larger(variance.x, larger(variance.y, variance.z));
+    let t = stats.duration;
+    let model = AccelerometerAtRest {
+        accel: stats.accel_body,
+        gravity: config.filter.gravity,
+        noise: Matrix3::from_diagonal_element(T::lit(2.0) * spread / (t * t)),
+        bias_map: stats.bias_map,
+    };
+    let fusion = Fusion::from(filter.update(&model, &recovery_options())?);
+    filter.restart_velocity(Vector3::zeros(), spread.sqrt_rn())?;
+    Ok(fusion)
 }
 
 /// The update after a widening: ungated (the data were just found right and the estimate

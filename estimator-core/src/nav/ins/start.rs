@@ -94,7 +94,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             self.config.attitude.gyro_bias_sigma,
             self.config.attitude.accelerometer_bias_sigma,
         );
-        // The attitude filter lives where the INS will: copied out first (a 9-state filter),
+        // The attitude filter lives where the INS will: copied out first (a 12-state filter),
         // so that the INS is built in place rather than beside it. What the in-place start
         // checks is checked here, before the alignment is given up (the attitude filter's own
         // state is finite, an invariant of the filter).

@@ -264,9 +264,9 @@ pub enum Rows {
         /// One row per trial.
         rows: Vec<BroadRow>,
         /// The mean over the trials.
-        mean: BroadSummary,
+        mean: Box<BroadSummary>,
         /// The worst trial per column.
-        max: BroadSummary,
+        max: Box<BroadSummary>,
         /// The trials without a Madgwick figure in `references.json` (the Madgwick mean and
         /// maximum are left out when any is).
         madgwick_missing: Vec<String>,
@@ -430,8 +430,8 @@ fn broad_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Value>
         madgwick_total_deg: pick(madgwick),
     };
     Rows::Broad {
-        mean: summary(|(mean, _)| mean, inside_mean),
-        max: summary(|(_, max)| max, inside_lowest),
+        mean: Box::new(summary(|(mean, _)| mean, inside_mean)),
+        max: Box::new(summary(|(_, max)| max, inside_lowest)),
         rows,
         madgwick_missing,
     }

@@ -53,6 +53,11 @@ pub struct BandResult {
     pub upper: f64,
     /// For NEES: the fraction of samples whose run-average was inside the band.
     pub fraction_inside: Option<f64>,
+    /// The chi-square degrees of freedom `D` and the divisor `c` of the band: the band at
+    /// confidence `p` is `[χ²_{(1−p)/2}(D), χ²_{(1+p)/2}(D)] / c` (`lower`, `upper` at 95 %).
+    pub dof: f64,
+    /// See [`BandResult::dof`].
+    pub divisor: f64,
 }
 
 impl BandResult {
@@ -60,6 +65,18 @@ impl BandResult {
     #[must_use]
     pub fn holds(&self) -> bool {
         self.value >= self.lower && self.value <= self.upper
+    }
+
+    /// The band at two-sided confidence `p` (the 95 % band for `p = 0.95`). Checking `k`
+    /// statistics together at a family-wise confidence `P` takes `p = P^(1/k)` for each
+    /// (Šidák): with `p = 0.95` each, some statistic of a consistent filter falls outside its
+    /// band in `1 − 0.95^k` of the checks (49 % for 13).
+    #[must_use]
+    pub fn band(&self, p: f64) -> (f64, f64) {
+        (
+            chi2_quantile((1.0 - p) / 2.0, self.dof) / self.divisor,
+            chi2_quantile((1.0 + p) / 2.0, self.dof) / self.divisor,
+        )
     }
 }
 
@@ -509,6 +526,8 @@ pub fn run_from(
                 lower: lo,
                 upper: hi,
                 fraction_inside: Some(inside as f64 / count as f64),
+                dof: 3.0 * nf,
+                divisor: nf,
             });
         }
     }
@@ -538,6 +557,8 @@ pub fn run_from(
                 lower: chi2_quantile(0.025, dof) / count,
                 upper: chi2_quantile(0.975, dof) / count,
                 fraction_inside: None,
+                dof,
+                divisor: count,
             });
         }
     }

@@ -192,7 +192,7 @@ impl Default for ReplayConfig {
             align_window_s: 1.0,
             gravity: [0.0, 0.0, -9.81],
             max_dt: 0.1,
-            block_s: 0.5,
+            block_s: 0.25,
             velocity_sigma: 0.3,
             motion_memory_s: 5.0,
             rotation_only: false,

@@ -121,8 +121,10 @@ pub struct AttitudeConfig<T: Real> {
     /// 1σ of the accelerometer bias per axis at switch-on, m/s², `> 0` (the bias is a state
     /// with this prior; its random walk is the filter configuration's).
     pub accelerometer_bias_sigma: T,
-    /// 1σ of the gyro's scale-factor and cross-axis errors (a fraction): a block that turns
-    /// by `θ` adds `(σ_s θ)²` to the attitude variance on every axis. The noise densities of a
+    /// 1σ of the gyro's scale-factor and cross-axis errors (a fraction): a block of length `T`
+    /// turning at an RMS rate `ω` adds `(σ_s ω)² T τ_turn` to the attitude variance on every
+    /// axis, `τ_turn` = 0.5 s the time a body keeps turning one way (the error of one turn is
+    /// coherent, the next turn's independent of it). The noise densities of a
     /// data sheet do not contain this error; it dominates during fast rotation.
     pub gyro_scale_sigma: T,
     /// 1σ of the gyro bias at switch-on per axis, rad/s (used when the start is not at rest).
@@ -150,7 +152,7 @@ pub struct AttitudeConfig<T: Real> {
 impl<T: Real> AttitudeConfig<T> {
     /// The defaults around a filter configuration: IMU samples as means over their interval;
     /// 1 s start-up;
-    /// 0.5 s blocks; a moving body's velocity spread at least 0.3 m/s per axis, remembered
+    /// 0.25 s blocks; a moving body's velocity spread at least 0.3 m/s per axis, remembered
     /// over 5 s; 0.1 m/s² accelerometer bias (0.6° of
     /// tilt); 0.5 % gyro scale and cross-axis error; 0.5 °/s gyro bias at switch-on; rest below 2 °/s and 0.5 m/s² for 1.5 s with a
     /// 0.1 °/s floor; widen after 8 rejected blocks (2 s); valid below 5° tilt and 10° heading;
@@ -161,7 +163,7 @@ impl<T: Real> AttitudeConfig<T> {
             filter,
             instantaneous_imu: false,
             startup_s: T::lit(1.0),
-            block_s: T::lit(0.5),
+            block_s: T::lit(0.25),
             rotation_only: false,
             velocity_sigma: T::lit(0.3),
             motion_memory_s: T::lit(5.0),

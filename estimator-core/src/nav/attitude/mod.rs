@@ -102,6 +102,15 @@ struct Pending<T: Real> {
     stage: Stage,
 }
 
+/// How long a body keeps turning one way, s: the attitude error that the gyro's scale and
+/// cross-axis errors (`gyro_scale_sigma`, `σ_s`) leave from one turn is coherent over it and
+/// independent of the next turn's, so a block of length `T` turning at an RMS rate `ω` adds
+/// `(σ_s ω)² T τ_turn` to the attitude variance per axis (a random walk in the turned angle,
+/// independent of the block length). Hand-held and worn motion reverses its turns within about
+/// half a second (the arm's and wrist's motions run at 1 Hz and above); a vehicle turns more
+/// slowly, for which the same variance per second is conservative.
+const TURN_CORRELATION_S: f64 = 0.5;
+
 /// Durations of the configuration in nanoseconds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Durations {
@@ -471,8 +480,11 @@ impl<T: Real> AttitudeNavigator<T> {
             &(mat3::mul(&r_end, &stats.bias_map) * stats.duration),
             stats.duration,
         );
-        // The gyro's scale and cross-axis errors over the block's rotation.
-        let turned = self.config.gyro_scale_sigma * stats.rotation(&filter.state().gyro_bias);
+        // The gyro's scale and cross-axis errors over the block's rotation: a turn at RMS rate
+        // ω for T adds (σ_s ω)² T τ_turn, whatever the block's length.
+        let turned = self.config.gyro_scale_sigma
+            * stats.rotation(&filter.state().gyro_bias)
+            * (T::lit(TURN_CORRELATION_S) / stats.duration).sqrt_rn();
         let widened = turned > T::zero() && filter.widen_attitude(turned, turned).is_err();
         // Rest: zero-rate update of the gyro bias.
         let still = rest::is_still(&stats, &filter.state().gyro_bias, &self.config, g);

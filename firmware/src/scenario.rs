@@ -446,13 +446,13 @@ pub struct NavStep<T: Real> {
 /// part of the call alone.
 #[derive(Clone, Copy, Debug)]
 pub struct NavParts<T: Real> {
-    /// The navigator's filter (attitude, gyro and accelerometer biases).
+    /// The navigator's filter (attitude, gyro and accelerometer biases, velocity).
     pub filter: AhrsAccelBias<T>,
     /// The IMU interval of the call.
     pub imu: ImuSample<T>,
     /// The zero-rate update of a block at rest.
     pub zero_rate: ZeroRate<T>,
-    /// The block's mean specific force.
+    /// The block's mean specific force (the navigator fuses it when it recovers a wrong tilt).
     pub at_rest: AccelerometerAtRest<T>,
     /// The block's magnetic heading.
     pub heading: MagneticHeading<T>,

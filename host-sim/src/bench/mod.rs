@@ -403,15 +403,11 @@ fn broad_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Value>
     let total = column(&|r| r.ours.total_deg);
     let heading = column(&|r| r.ours.heading_deg);
     let inclination = column(&|r| r.ours.inclination_deg);
-    let inside: Vec<f64> = rows
-        .iter()
-        .filter_map(|r| r.ours.inside_3sigma_pct)
-        .collect();
-    let inside_mean = (inside.len() == rows.len() && !inside.is_empty())
-        .then(|| inside.iter().sum::<f64>() / inside.len() as f64);
-    let inside_lowest = (inside.len() == rows.len())
-        .then(|| inside.iter().copied().reduce(f64::min))
-        .flatten();
+    let (inside_mean, _) = column(&|r| r.ours.inside_3sigma_pct);
+    // The lowest trial: the largest of the negated shares.
+    let inside_lowest = column(&|r| r.ours.inside_3sigma_pct.map(|x| -x))
+        .1
+        .map(|x| -x);
     let vqf = column(&|r| r.vqf_total_deg);
     let madgwick = column(&|r| r.madgwick_total_deg);
     let madgwick_missing = rows

@@ -454,17 +454,15 @@ impl Scorer {
             self.after_start.0 += errs[0].norm_squared();
             self.after_start.1 += 1;
         }
-        if let Some(intervals) = &self.movement {
-            if in_intervals(intervals, truth.t_ns) {
-                self.broad.add(&broad_error(
-                    &e.attitude.quaternion(),
-                    &truth.attitude.quaternion(),
-                ));
-                let attitude = errs.first().zip(e.cov.first().and_then(Option::as_ref));
-                if let Some((d, inv)) = attitude.and_then(|(d, p)| Some((d, p.try_inverse()?))) {
-                    self.broad.add_nees((d.transpose() * inv * d)[(0, 0)]);
-                }
-            }
+        let moving = self
+            .movement
+            .as_ref()
+            .is_some_and(|intervals| in_intervals(intervals, truth.t_ns));
+        if moving {
+            self.broad.add(&broad_error(
+                &e.attitude.quaternion(),
+                &truth.attitude.quaternion(),
+            ));
         }
         let mut error = [0.0; 15];
         let mut step = [f64::NAN; 5];
@@ -481,6 +479,10 @@ impl Scorer {
             for i in 0..3 {
                 error[3 * b + i] = d[i];
             }
+        }
+        // The attitude's NEES (block 0), when it has a covariance, for BROAD's 3σ share.
+        if moving && step[0].is_finite() {
+            self.broad.add_nees(step[0]);
         }
         self.n += 1;
         if self.keep_nees {

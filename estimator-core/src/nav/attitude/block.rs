@@ -63,10 +63,15 @@ pub(super) struct MagStats<T: Real> {
 }
 
 impl<T: Real> BlockStats<T> {
-    /// The rotation of the block, rad: RMS rate about `bias` times the duration.
-    pub(super) fn rotation(&self, bias: &Vector3<T>) -> T {
+    /// The RMS rate of the block about `bias`, rad/s.
+    pub(super) fn rate(&self, bias: &Vector3<T>) -> T {
         let w = self.gyro_mean - bias;
-        (self.gyro_scatter_sq + w.dot(&w)).sqrt_rn() * self.duration
+        (self.gyro_scatter_sq + w.dot(&w)).sqrt_rn()
+    }
+
+    /// The rotation of the block, rad: its RMS rate about `bias` times the duration.
+    pub(super) fn rotation(&self, bias: &Vector3<T>) -> T {
+        self.rate(bias) * self.duration
     }
 }
 
@@ -83,6 +88,22 @@ impl<T: Real> Default for Block<T> {
 }
 
 impl<T: Real> Block<T> {
+    /// The world-frame sums the velocity integrates (`AhrsAccelBias::integrate_velocity`):
+    /// `Σ R̂ᵢ fᵢ Δt` and `Σ R̂ᵢ Δt` over the block, as its means times its length (the samples
+    /// of a block are evenly spaced), and its length `T`, s; `None` for a block without IMU
+    /// samples.
+    pub(super) fn world_sums(&self) -> Option<(Vector3<T>, Matrix3<T>, T)> {
+        let force = self.accel.mean()?;
+        let t = self.duration();
+        let frames = self.frames * (t / T::from_count(self.accel.count().max(1)));
+        Some((force * t, frames, t))
+    }
+
+    /// Length so far, s.
+    fn duration(&self) -> T {
+        T::from_count(self.elapsed_ns) * T::lit(1e-9)
+    }
+
     /// The statistics, with `end` the estimate's attitude at the end (`R̂ₑ`); `None` for a
     /// block without IMU samples.
     pub(super) fn stats(&self, end: &crate::lie::So3<T>) -> Option<BlockStats<T>> {
@@ -102,7 +123,7 @@ impl<T: Real> Block<T> {
         });
         Some(BlockStats {
             n: self.accel.count(),
-            duration: T::from_count(self.elapsed_ns) * T::lit(1e-9),
+            duration: self.duration(),
             accel_norm: crate::kernels::mat3::norm(&accel_body),
             accel_body,
             bias_map,

@@ -111,6 +111,20 @@ struct Pending<T: Real> {
 /// slowly, for which the same variance per second is conservative.
 const TURN_CORRELATION_S: f64 = 0.5;
 
+/// Moves the filter's velocity by a block's world-frame sums ([`Block::world_sums`],
+/// [`AhrsAccelBias::integrate_velocity`]). Out of line: the sums stay out of the frame of the
+/// call that ends a block, which the start-up also goes through.
+#[inline(never)]
+fn integrate_block<T: Real>(
+    filter: &mut AhrsAccelBias<T>,
+    block: &Block<T>,
+) -> Result<(), crate::eskf::EskfError> {
+    match block.world_sums() {
+        Some((force, frames, duration)) => filter.integrate_velocity(&force, &frames, duration),
+        None => Ok(()),
+    }
+}
+
 /// Durations of the configuration in nanoseconds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Durations {
@@ -459,6 +473,14 @@ impl<T: Real> AttitudeNavigator<T> {
     fn end_block(&mut self) {
         let frame = self.current_frame();
         let stats = self.block.stats(&frame);
+        // The velocity over a running block (in free fall nothing is fused: below), from the
+        // block's world-frame sums, before the block is emptied.
+        let integrated = match &stats {
+            Some(s) if self.running && tilt::has_direction(&s.accel_body) => {
+                integrate_block(&mut self.filter, &self.block)
+            }
+            _ => Ok(()),
+        };
         self.block = Block::default();
         let Some(stats) = stats else {
             return;
@@ -473,18 +495,11 @@ impl<T: Real> AttitudeNavigator<T> {
             return;
         }
         let filter = &mut self.filter;
-        // The velocity over the block, from the block's sums (`block`): Σ R̂ᵢ fᵢ Δt and Σ R̂ᵢ Δt.
-        let r_end = frame.rotation_matrix();
-        let integrated = filter.integrate_velocity(
-            &(mat3::mul_vec(&r_end, &stats.accel_body) * stats.duration),
-            &(mat3::mul(&r_end, &stats.bias_map) * stats.duration),
-            stats.duration,
-        );
         // The gyro's scale and cross-axis errors over the block's rotation: a turn at RMS rate
         // ω for T adds (σ_s ω)² T τ_turn, whatever the block's length.
         let turned = self.config.gyro_scale_sigma
-            * stats.rotation(&filter.state().gyro_bias)
-            * (T::lit(TURN_CORRELATION_S) / stats.duration).sqrt_rn();
+            * stats.rate(&filter.state().gyro_bias)
+            * (stats.duration * T::lit(TURN_CORRELATION_S)).sqrt_rn();
         let widened = turned > T::zero() && filter.widen_attitude(turned, turned).is_err();
         // Rest: zero-rate update of the gyro bias.
         let still = rest::is_still(&stats, &filter.state().gyro_bias, &self.config, g);

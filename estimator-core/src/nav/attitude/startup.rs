@@ -21,7 +21,7 @@ use super::block::BlockStats;
 use super::config::AttitudeConfig;
 use super::magnetic::Magnetic;
 use super::rest::{is_still, mean_rate_variance};
-use super::tilt::startup_sigma;
+use super::tilt::{rest_drift_variance, startup_sigma};
 use crate::eskf::{align_at_rest, Alignment, InitialSigmas, MagnetometerWindow};
 use crate::kernels::mat3;
 use crate::nav::error::NavError;
@@ -103,7 +103,7 @@ pub(super) fn start<T: Real>(
         accel_bias: config.accelerometer_bias_sigma,
         // At rest the velocity is zero; moving, it is one of the body's velocities.
         velocity: if still {
-            config.rest_accel * stats.duration / T::lit(12.0).sqrt_rn()
+            rest_drift_variance(config, stats.duration).sqrt_rn()
         } else {
             config.velocity_sigma
         },

@@ -79,11 +79,12 @@ pub(super) fn white_sq<T: Real>(stats: &BlockStats<T>, config: &AttitudeConfig<T
 /// velocity of spread `σ_min` allows over the window's length `W` (`2σ_min²/W²`: the mean
 /// linear acceleration is `(v_end − v_start)/W`).
 pub(super) fn startup_sigma<T: Real>(stats: &BlockStats<T>, config: &AttitudeConfig<T>, g: T) -> T {
-    let white = white_sq(stats, config) / T::from_count(stats.n.max(1));
+    let sample = white_sq(stats, config);
+    let white = sample / T::from_count(stats.n.max(1));
     if config.rotation_only {
         return white.sqrt_rn();
     }
-    let power = acceleration_power(stats, white_sq(stats, config));
+    let power = acceleration_power(stats, sample);
     let w = stats.duration;
     let bound = T::lit(2.0) * config.velocity_sigma * config.velocity_sigma / (w * w);
     let inside = if power < bound { power } else { bound };
@@ -106,18 +107,20 @@ pub(super) fn velocity_variance<T: Real>(
         return Vector3::repeat(na * na * stats.duration * T::lit(T::EPSILON_F64));
     }
     if at_rest {
-        let drift = config.rest_accel * stats.duration;
-        return Vector3::repeat(drift * drift / T::lit(12.0) + na * na * stats.duration);
+        return Vector3::repeat(
+            rest_drift_variance(config, stats.duration) + na * na * stats.duration,
+        );
     }
     let floor = config.velocity_sigma * config.velocity_sigma;
-    spread.map(|s| {
-        let v = T::lit(4.0) * s;
-        if v > floor {
-            v
-        } else {
-            floor
-        }
-    })
+    spread.map(|s| crate::kernels::larger(floor, T::lit(4.0) * s))
+}
+
+/// The variance per axis of a still body's velocity after `t` seconds, (m/s)²: a body whose RMS
+/// acceleration is below `rest_accel` drifts by at most `a_rest t`, taken as uniform
+/// (`(a_rest t)²/12`; module docs).
+pub(super) fn rest_drift_variance<T: Real>(config: &AttitudeConfig<T>, t: T) -> T {
+    let drift = config.rest_accel * t;
+    drift * drift / T::lit(12.0)
 }
 
 /// The running mean of `v̂²` per axis over the last `motion_memory_s` (first order, weight

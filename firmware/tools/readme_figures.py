@@ -12,8 +12,13 @@ tables cannot drift from the tools. Instruction counts, stack and flash are dete
 compiler: they must be equal when the run's rustc is the one README names ("Measured with ... and
 rustc X"), and within 5 % otherwise (a compiler release moves a count by a few per cent; the
 budgets in budgets.txt stay the hard limits either way). `size_of` must always be equal.
+The demo embeds the expected values it checks; when this run built it against values computed
+afresh on this host that differ from the committed src/expected.rs (FIRMWARE_EXPECTED_DIFFERS=1,
+set by .ci/firmware.sh: another host's last bits in the f32 run), its flash is another binary's
+and is printed, not compared.
 The host ns column is not checked (criterion on a shared machine; benches/README.md).
 """
+import os
 import re
 import subprocess
 import sys
@@ -180,6 +185,11 @@ def main():
             failures.append(f"row not tied to a figure: {row[0]}")
             continue
         rel = 0.0 if keys[0].startswith("sizeof.") else tolerance
+        if keys[0].startswith("flash.demo") and os.environ.get("FIRMWARE_EXPECTED_DIFFERS") == "1":
+            shown = ", ".join(f"{k} {opt3.get(k, '?')}" for k in keys)
+            print(f"  {row[0]}: not compared (built against this host's expected values, "
+                  f"not the committed ones): {shown}")
+            continue
         compare(row[0], numbers(row[1]), keys, opt3, rel)
     for f in failures:
         print("  " + f)

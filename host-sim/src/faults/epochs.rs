@@ -3,7 +3,7 @@
 //! (`estimate.csv` and the dataset's ground truth).
 
 use crate::dataset::read::{Truth, TruthStream};
-use crate::metrics::{errors, interpolate_truth, Estimate};
+use crate::metrics::{errors, Estimate, TruthSpacing};
 use estimator_core::lie::So3;
 use estimator_core::nav::{self, Reason};
 use nalgebra::Vector3;
@@ -301,10 +301,12 @@ fn data_lines(path: &Path) -> Result<Vec<(usize, String)>, String> {
         .collect())
 }
 
-/// The truth at sorted times, each interpolated between the rows around it.
+/// The truth at sorted times, each interpolated between the rows around it (none where rows are
+/// lost around it, [`TruthSpacing::between`]).
 struct TruthCursor<'a> {
     rows: &'a [Truth],
     i: usize,
+    spacing: TruthSpacing,
 }
 
 impl TruthCursor<'_> {
@@ -317,7 +319,10 @@ impl TruthCursor<'_> {
             return Some(*a);
         }
         let b = self.rows.get(self.i + 1)?;
-        (a.t_ns < t_ns && t_ns < b.t_ns).then(|| interpolate_truth(a, b, t_ns))
+        if !(a.t_ns < t_ns && t_ns < b.t_ns) {
+            return None;
+        }
+        self.spacing.between(a, b, t_ns)
     }
 }
 
@@ -344,9 +349,15 @@ pub fn read_epochs(out: &Path, dataset: &Path) -> Result<Vec<Epoch>, String> {
     while let Some(t) = stream.next_truth().map_err(|e| e.to_string())? {
         truth_rows.push(t);
     }
+    // The shortest row interval of the whole file: these rows are all read before scoring.
+    let mut spacing = TruthSpacing::default();
+    for w in truth_rows.windows(2) {
+        spacing.observe(w[0].t_ns, w[1].t_ns);
+    }
     let mut truth = TruthCursor {
         rows: &truth_rows,
         i: 0,
+        spacing,
     };
     // Both files are in time order and the estimates are written at epochs: walk them together.
     let mut k = 0;

@@ -23,7 +23,8 @@
 //! `2·atan2(‖(e_x, e_y)‖, ‖(e_w, e_z)‖)`, which keep their precision near zero error. The figure of a
 //! trial is the RMSE in degrees of each angle over the IMU samples inside the trial's movement
 //! intervals (`movement.csv`, inclusive), with the estimate at a sample being the filter's
-//! output after that sample.
+//! output after that sample. A sample where the optical system lost the marker (rows left out of
+//! the truth) is not scored, as BROAD skips its NaN truth ([`super::TruthSpacing`]).
 
 use nalgebra::UnitQuaternion;
 use serde::Serialize;

@@ -5,7 +5,7 @@ use super::{out_err, ReplayError};
 use crate::baseline::{Madgwick, Mahony};
 use crate::dataset::check::DataWarning;
 use crate::dataset::read::{Truth, TruthStream};
-use crate::metrics::{interpolate_truth, Estimate, Scorer};
+use crate::metrics::{Estimate, Scorer, TruthSpacing};
 use estimator_core::lie::So3;
 use nalgebra::Vector3;
 use std::fs::File;
@@ -19,6 +19,8 @@ pub(super) struct TruthCursor {
     pub(super) next: Option<Truth>,
     pub(super) tum: BufWriter<File>,
     pub(super) tum_path: PathBuf,
+    /// The truth's sampling, to leave its lost rows unscored.
+    pub(super) spacing: TruthSpacing,
 }
 
 impl TruthCursor {
@@ -33,7 +35,8 @@ impl TruthCursor {
         Ok(())
     }
 
-    /// The truth at `t_ns`, interpolated between the rows around it; `None` outside the truth.
+    /// The truth at `t_ns`, interpolated between the rows around it; `None` outside the truth
+    /// and where rows are lost around `t_ns` ([`TruthSpacing::between`]).
     pub(super) fn at(&mut self, t_ns: u64) -> Result<Option<Truth>, ReplayError> {
         if self.prev.is_none() && self.next.is_none() {
             self.advance()?;
@@ -44,7 +47,7 @@ impl TruthCursor {
         }
         Ok(match (self.prev, self.next) {
             (_, Some(b)) if b.t_ns == t_ns => Some(b),
-            (Some(a), Some(b)) if a.t_ns <= t_ns => Some(interpolate_truth(&a, &b, t_ns)),
+            (Some(a), Some(b)) if a.t_ns <= t_ns => self.spacing.between(&a, &b, t_ns),
             _ => None,
         })
     }
@@ -196,6 +199,7 @@ impl EstimateFiles {
                 next: None,
                 tum: gt_tum,
                 tum_path: gt_path,
+                spacing: TruthSpacing::default(),
             })
         } else {
             None

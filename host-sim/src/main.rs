@@ -134,22 +134,24 @@ fn execute(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             out,
             config,
             force,
+            references_6d,
         } => {
             let opts = BenchOptions {
                 dir,
                 out,
                 config,
                 force,
+                references_6d,
             };
             let mut progress: Option<Progress> = None;
-            let report = host_sim::bench::run(&opts, |i, n, dataset| {
+            let report = host_sim::bench::run(&opts, |i, n, run| {
                 let p = progress.get_or_insert_with(|| {
-                    Progress::new("bench", "datasets", n as u64, Mode::for_stderr(true))
+                    Progress::new("bench", "runs", n as u64, Mode::for_stderr(true))
                 });
                 if i > 0 {
                     p.inc(1);
                 }
-                p.note(&format!("bench [{}/{n}] {}", i + 1, dataset.display()));
+                p.note(&format!("bench [{}/{n}] {run}", i + 1));
             });
             if let Some(p) = progress {
                 if report.is_ok() {

@@ -700,7 +700,7 @@ fn bench_prints_tables_and_writes_bench_json() {
 }
 
 /// `bench` on one BROAD trial of the shared datasets, when they are present: BROAD's metric is
-/// computed and below 20°.
+/// computed and below 20°, and so is the inclination without the magnetometer.
 #[test]
 fn bench_on_a_broad_trial_scores_it() {
     let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/datasets/broad");
@@ -738,6 +738,23 @@ fn bench_on_a_broad_trial_scores_it() {
         "BROAD total {total}°\n{text}"
     );
     assert!(row["vqf_total_deg"].as_f64().is_some(), "{text}");
+    // The trial again without its magnetometer, beside VQF 6D where references.json has it
+    // (else `–` and null: BROAD's published references have no VQF 6D).
+    let six = row["inclination_6axis_deg"]
+        .as_f64()
+        .expect("6-axis inclination computed");
+    assert!(
+        six.is_finite() && six < 5.0,
+        "6-axis inclination {six}°\n{text}"
+    );
+    assert!(out.join("6axis").join(trial).join("metrics.json").is_file());
+    let refs: serde_json::Value =
+        serde_json::from_slice(&read(&shared.join("references.json"))).unwrap();
+    let published_6d = &refs["trials"][trial]["vqf_6d"]["inclination"];
+    assert_eq!(&row["vqf_6d_inclination_deg"], published_6d, "{text}");
+    if published_6d.is_null() {
+        assert!(text.contains("no VQF 6D figure for"), "{text}");
+    }
     let _ = std::fs::remove_dir_all(dir);
 }
 

@@ -36,6 +36,7 @@
 //! | `gyro_bias_sigma` (0.5 °/s) | prior of the gyro bias when the start is not at rest | the data sheet's zero-rate offset |
 //! | `rest_gyro`, `rest_accel`, `rest_min_s` (2 °/s, 0.5 m/s², 1.5 s) | when the body counts as at rest (zero-rate updates) | lower for a quiet sensor on a table; never above the slowest real rotation |
 //! | `magnetometer.norm_tolerance`, `dip_tolerance` (10 %, 10°) | when a field counts as disturbed | tighter for a well-calibrated magnetometer |
+//! | `magnetometer.hard_iron` (on), `hard_iron_sigma` (3 % of the field), `hard_iron_max` (3 fields), `hard_iron_drift` (0.1 %/√s) | a constant offset in the body frame (a magnet or a battery on the board) learned while the body turns about two axes and taken off every sample; offsets within 3 `hard_iron_sigma` of the calibration's are left to it | `hard_iron_sigma`: what the magnetometer's calibration leaves; off for a magnetometer calibrated on the finished device |
 //! | `magnetometer.fusion` (`Heading`) | heading only, or the whole field | `Vector` only for a calibrated magnetometer in a clean field (it then also corrects the tilt) |
 //! | `max_rejected_blocks` (8) | how many rejected blocks in a row before the estimate is taken for wrong | lower recovers faster from a wrong estimate, higher resists long disturbances |
 //! | `tilt_valid_sigma`, `heading_valid_sigma` (5°, 10°) | when the report calls a quantity valid | what the application can use |

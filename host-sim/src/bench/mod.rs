@@ -13,6 +13,21 @@
 //! | `datasets.{name}.{anchor}.attitude_rmse_deg` | the sensors ours fuses, the attitude RMSE from 2 s after the first ground-truth sample, the ANEES of the attitude, VQF's RMSE and ours / VQF |
 //! | none | the same columns as the kind of data suggests (BROAD where every dataset has `movement.csv`), ours only |
 //!
+//! **Without the magnetometer (6-axis).** Every trial of a BROAD table that has a magnetometer
+//! (and no GNSS or camera) is replayed a second time with the same configuration but
+//! `use_magnetometer = false`, into `OUT/6axis/<dataset name>`; its BROAD inclination RMSE
+//! (`inclination_6axis_deg`) is set beside VQF 6D's (`vqf_6d_inclination_deg`: real-time VQF on
+//! the gyroscope and accelerometer only, `getQuat6D`). A trial with the IMU alone is 6-axis
+//! already: its first run's figure is used. The inclination only: without a magnetometer
+//! nothing observes the heading, while a heading offset of the earth frame leaves the
+//! inclination error unchanged. VQF 6D's figure is the anchor `vqf_6d` of the folder's
+//! `references.json` where it has one, else that of the file given with `--references-6d FILE`
+//! ([`BenchOptions::references_6d`]), which has the same shape,
+//! `{"trials": {NAME: {"vqf_6d": {"inclination": x}}}}`, and is written by
+//! `python3 tools/vqf_references.py DIR --out FILE` (VQF 6D and 9D on the trials, scored with
+//! [`crate::metrics::broad`] as here). `bench.json` names the file each figure came from
+//! (`vqf_6d_from`). Without either, the column prints `–`.
+//!
 //! **Like with like.** Real-time VQF 9D fuses the IMU and the magnetometer. A dataset with GNSS
 //! (or a camera) replays through the INS navigator, which fuses those too: its row names the
 //! sensors and gets no ours / VQF ratio, which is printed only where ours fuses exactly VQF's
@@ -36,6 +51,11 @@ use std::path::{Path, PathBuf};
 pub const VQF: &str = "vqf_9d";
 /// BROAD's published Madgwick at its trial-agnostic good parameter.
 pub const MADGWICK: &str = "madgwick_tagp_published";
+/// The anchor of VQF 6D (real-time, gyroscope and accelerometer only), in `references.json` or
+/// the `--references-6d` file.
+pub const VQF_6D: &str = "vqf_6d";
+/// The folder of `OUT` that holds the 6-axis runs (`OUT/6axis/<dataset name>`).
+pub const SIX_AXIS_DIR: &str = "6axis";
 
 /// The sensors real-time VQF 9D fuses, as [`sensors_of`] names them.
 pub const VQF_SENSORS: &[&str] = &["IMU", "mag"];
@@ -73,6 +93,10 @@ pub struct BenchOptions {
     pub config: Option<PathBuf>,
     /// Replace `out` if it holds an earlier host-sim output.
     pub force: bool,
+    /// VQF 6D's figures for the BROAD trials whose folder's `references.json` has none: a JSON
+    /// file `{"trials": {NAME: {"vqf_6d": {"inclination": x}}}}` (written by
+    /// `tools/vqf_references.py`).
+    pub references_6d: Option<PathBuf>,
 }
 
 /// Errors that stop the bench before or after the datasets run (a dataset that fails is
@@ -101,6 +125,9 @@ pub enum BenchError {
     /// The given configuration is unreadable or invalid.
     #[error("{0}")]
     Config(String),
+    /// The `--references-6d` file is unreadable or not of BROAD's shape.
+    #[error("--references-6d {0}")]
+    References6d(String),
     /// The output folder may not be written, or moving it into place failed.
     #[error(transparent)]
     Output(#[from] OutputError),
@@ -217,6 +244,15 @@ pub struct BroadRow {
     pub vqf_total_deg: Option<f64>,
     /// BROAD's published Madgwick's total RMSE, degrees.
     pub madgwick_total_deg: Option<f64>,
+    /// This project's inclination RMSE without the magnetometer (the 6-axis run, see the
+    /// module docs), degrees.
+    pub inclination_6axis_deg: Option<f64>,
+    /// Why the 6-axis run failed, if it did.
+    pub error_6axis: Option<String>,
+    /// VQF 6D's inclination RMSE, degrees.
+    pub vqf_6d_inclination_deg: Option<f64>,
+    /// The file VQF 6D's figure comes from (`references.json` or the `--references-6d` file).
+    pub vqf_6d_from: Option<PathBuf>,
 }
 
 /// The mean or the maximum over the trials of a BROAD table (each `null` unless every trial has
@@ -229,6 +265,10 @@ pub struct BroadSummary {
     pub vqf_total_deg: Option<f64>,
     /// BROAD's published Madgwick's total RMSE, degrees.
     pub madgwick_total_deg: Option<f64>,
+    /// This project's inclination RMSE without the magnetometer, degrees.
+    pub inclination_6axis_deg: Option<f64>,
+    /// VQF 6D's inclination RMSE, degrees.
+    pub vqf_6d_inclination_deg: Option<f64>,
 }
 
 /// One row of a table of attitude RMSEs.
@@ -270,6 +310,9 @@ pub enum Rows {
         /// The trials without a Madgwick figure in `references.json` (the Madgwick mean and
         /// maximum are left out when any is).
         madgwick_missing: Vec<String>,
+        /// The trials without a VQF 6D figure (in `references.json` or the `--references-6d`
+        /// file; its mean and maximum are left out when any is).
+        vqf_6d_missing: Vec<String>,
     },
     /// Attitude RMSE from 2 s after the start.
     Attitude {
@@ -301,6 +344,8 @@ pub struct Report {
     pub out: PathBuf,
     /// The replay configuration file given for every dataset, if any.
     pub config: Option<PathBuf>,
+    /// The `--references-6d` file, if given.
+    pub references_6d: Option<PathBuf>,
     /// One table per parent folder.
     pub tables: Vec<Table>,
     /// What the datasets had wrong that their runs survived, dataset by dataset
@@ -308,10 +353,32 @@ pub struct Report {
     pub data_warnings: Vec<DataWarning>,
 }
 
-/// One dataset's run.
+/// One dataset's run, and its 6-axis run where it has one.
 struct Outcome {
     name: String,
     result: Result<Metrics, String>,
+    six_axis: SixAxis,
+}
+
+/// The 6-axis figure of a dataset (see the module docs).
+enum SixAxis {
+    /// Not a BROAD trial, or one with GNSS or a camera: none.
+    None,
+    /// The IMU alone: the first run is the 6-axis run.
+    SameRun,
+    /// A second run with `use_magnetometer = false`.
+    Run(Box<Result<Metrics, String>>),
+}
+
+/// How a dataset's 6-axis figure is had, by the sensors it holds ([`sensors_of`]): `Some(true)`
+/// a second run (IMU and magnetometer), `Some(false)` the first run (the IMU alone), `None`
+/// none (GNSS or a camera: not a 6-axis run either way).
+fn six_axis_plan(dataset: &Path) -> Option<bool> {
+    match sensors_of(dataset).as_slice() {
+        ["IMU"] => Some(false),
+        ["IMU", "mag"] => Some(true),
+        _ => None,
+    }
 }
 
 /// The references of one folder, by dataset name.
@@ -344,6 +411,18 @@ fn read_references(path: &Path) -> Result<Option<References>, String> {
     }
 }
 
+/// The `--references-6d` file: BROAD's shape (`trials`), by trial name.
+fn read_references_6d(path: &Path) -> Result<BTreeMap<String, Value>, String> {
+    match read_references(path)? {
+        Some(References::Broad(m)) => Ok(m),
+        Some(References::Attitude(_)) => Err(format!(
+            "{}: a \"datasets\" object; VQF 6D's figures are BROAD's, {{\"trials\": {{NAME: {{\"{VQF_6D}\": {{\"inclination\": x}}}}}}}}",
+            path.display()
+        )),
+        None => Err(format!("{}: no such file", path.display())),
+    }
+}
+
 fn reference(entries: &BTreeMap<String, Value>, dataset: &str, path: &[&str]) -> Option<f64> {
     let mut v = entries.get(dataset)?;
     for key in path {
@@ -367,7 +446,34 @@ fn aggregate(values: &[Option<f64>]) -> MeanMax {
     }
 }
 
-fn broad_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Value>>) -> Rows {
+/// A source of reference figures: the file and its entries by dataset name.
+type Source<'a> = (&'a Path, &'a BTreeMap<String, Value>);
+
+/// BROAD's inclination RMSE of a run, degrees.
+fn inclination(m: &Metrics) -> Option<f64> {
+    m.broad.as_ref().and_then(|b| finite(b.inclination_deg))
+}
+
+/// VQF 6D's inclination for `dataset`: from the first of `sources` that has it, with that file.
+fn vqf_6d(sources: &[Source<'_>], dataset: &str) -> (Option<f64>, Option<PathBuf>) {
+    sources
+        .iter()
+        .find_map(|(path, m)| {
+            reference(m, dataset, &[VQF_6D, "inclination"])
+                .map(|x| (Some(x), Some(path.to_path_buf())))
+        })
+        .unwrap_or((None, None))
+}
+
+/// The rows of a BROAD table; `refs`: the folder's `references.json`, `refs_6d`: the
+/// `--references-6d` file (VQF 6D is taken from `refs` first).
+fn broad_table(
+    runs: &[(&Path, &Outcome)],
+    refs: Option<Source<'_>>,
+    refs_6d: Option<Source<'_>>,
+) -> Rows {
+    let sources_6d: Vec<Source<'_>> = refs.into_iter().chain(refs_6d).collect();
+    let refs = refs.map(|(_, m)| m);
     let rows: Vec<BroadRow> = runs
         .iter()
         .map(|(_, o)| {
@@ -388,6 +494,15 @@ fn broad_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Value>
                 },
                 Err(e) => (BroadFigures::default(), None, Some(e.clone())),
             };
+            let (inclination_6axis_deg, error_6axis) = match &o.six_axis {
+                SixAxis::None => (None, None),
+                SixAxis::SameRun => (o.result.as_ref().ok().and_then(inclination), None),
+                SixAxis::Run(run) => match run.as_ref() {
+                    Ok(m) => (inclination(m), None),
+                    Err(e) => (None, Some(e.clone())),
+                },
+            };
+            let (vqf_6d_inclination_deg, vqf_6d_from) = vqf_6d(&sources_6d, &o.name);
             BroadRow {
                 dataset: o.name.clone(),
                 error,
@@ -395,6 +510,10 @@ fn broad_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Value>
                 samples,
                 vqf_total_deg: r(VQF),
                 madgwick_total_deg: r(MADGWICK),
+                inclination_6axis_deg,
+                error_6axis,
+                vqf_6d_inclination_deg,
+                vqf_6d_from,
             }
         })
         .collect();
@@ -410,11 +529,16 @@ fn broad_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Value>
         .map(|x| -x);
     let vqf = column(&|r| r.vqf_total_deg);
     let madgwick = column(&|r| r.madgwick_total_deg);
-    let madgwick_missing = rows
-        .iter()
-        .filter(|r| r.madgwick_total_deg.is_none())
-        .map(|r| r.dataset.clone())
-        .collect();
+    let six = column(&|r| r.inclination_6axis_deg);
+    let vqf_6d = column(&|r| r.vqf_6d_inclination_deg);
+    let missing = |f: fn(&BroadRow) -> Option<f64>| {
+        rows.iter()
+            .filter(|r| f(r).is_none())
+            .map(|r| r.dataset.clone())
+            .collect()
+    };
+    let madgwick_missing = missing(|r| r.madgwick_total_deg);
+    let vqf_6d_missing = missing(|r| r.vqf_6d_inclination_deg);
     let summary = |pick: fn(MeanMax) -> Option<f64>, inside: Option<f64>| BroadSummary {
         ours: BroadFigures {
             total_deg: pick(total),
@@ -424,12 +548,15 @@ fn broad_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Value>
         },
         vqf_total_deg: pick(vqf),
         madgwick_total_deg: pick(madgwick),
+        inclination_6axis_deg: pick(six),
+        vqf_6d_inclination_deg: pick(vqf_6d),
     };
     Rows::Broad {
         mean: Box::new(summary(|(mean, _)| mean, inside_mean)),
         max: Box::new(summary(|(_, max)| max, inside_lowest)),
         rows,
         madgwick_missing,
+        vqf_6d_missing,
     }
 }
 
@@ -482,7 +609,7 @@ fn attitude_table(runs: &[(&Path, &Outcome)], refs: Option<&BTreeMap<String, Val
 }
 
 /// Output subfolder names: the dataset folder's name, prefixed with its parent's where two
-/// datasets share a name.
+/// datasets share a name or where it is [`SIX_AXIS_DIR`] (the folder of the 6-axis runs).
 fn output_names(datasets: &[PathBuf]) -> Vec<String> {
     let base = |d: &Path| {
         d.file_name().map_or_else(
@@ -495,7 +622,7 @@ fn output_names(datasets: &[PathBuf]) -> Vec<String> {
         .iter()
         .zip(datasets)
         .map(|(n, d)| {
-            if names.iter().filter(|m| *m == n).count() > 1 {
+            if n == SIX_AXIS_DIR || names.iter().filter(|m| *m == n).count() > 1 {
                 let parent = d.parent().map_or_else(String::new, base);
                 format!("{parent}-{n}")
             } else {
@@ -505,15 +632,20 @@ fn output_names(datasets: &[PathBuf]) -> Vec<String> {
         .collect()
 }
 
-/// Replays one dataset into `out`; a panic in the filter is reported as the dataset's failure.
+/// Replays one dataset into `out` (`six_axis`: without its magnetometer); a panic in the filter
+/// is reported as the dataset's failure.
 fn run_one(
     dataset: &Path,
     out: &Path,
     given: Option<&Path>,
     name: &str,
+    six_axis: bool,
 ) -> Result<Metrics, String> {
     let mut cfg = replay_config(given, dataset)?;
     cfg.plots = false;
+    if six_axis {
+        cfg.use_magnetometer = false;
+    }
     let scorer = crate::metrics::Scorer::default()
         .for_dataset(dataset)
         .map_err(|e| e.to_string())?;
@@ -552,7 +684,7 @@ fn run_one(
 /// No dataset found, an unusable `--config`, or an output folder that may not be written.
 pub fn run(
     opts: &BenchOptions,
-    mut progress: impl FnMut(usize, usize, &Path),
+    mut progress: impl FnMut(usize, usize, &str),
 ) -> Result<Report, BenchError> {
     let datasets = find_datasets(&opts.dir)?;
     if datasets.is_empty() {
@@ -570,49 +702,118 @@ pub fn run(
         // Checked once before anything runs (and again per dataset).
         replay_config(Some(c), &opts.dir).map_err(BenchError::Config)?;
     }
+    let refs_6d = match &opts.references_6d {
+        Some(p) => Some(read_references_6d(p).map_err(BenchError::References6d)?),
+        None => None,
+    };
+
+    // One table per parent folder, in the order found, with its references: read before the
+    // runs, since the trials of a BROAD table also run without the magnetometer.
+    let mut groups: Vec<(PathBuf, Vec<usize>)> = Vec::new();
+    for (i, dataset) in datasets.iter().enumerate() {
+        let parent = dataset
+            .parent()
+            .map_or_else(PathBuf::new, Path::to_path_buf);
+        match groups.iter_mut().find(|(p, _)| *p == parent) {
+            Some((_, members)) => members.push(i),
+            None => groups.push((parent, vec![i])),
+        }
+    }
+    let group_refs: Vec<(PathBuf, Result<Option<References>, String>)> = groups
+        .iter()
+        .map(|(folder, _)| {
+            let path = folder.join("references.json");
+            let refs = read_references(&path);
+            (path, refs)
+        })
+        .collect();
+    let mut six_axis_plans: Vec<Option<bool>> = vec![None; datasets.len()];
+    for ((_, members), (_, refs)) in groups.iter().zip(&group_refs) {
+        let broad = match refs {
+            Ok(Some(References::Broad(_))) => true,
+            Ok(Some(References::Attitude(_))) => false,
+            Ok(None) | Err(_) => members
+                .iter()
+                .all(|&i| datasets[i].join("movement.csv").is_file()),
+        };
+        if broad {
+            for &i in members {
+                six_axis_plans[i] = six_axis_plan(&datasets[i]);
+            }
+        }
+    }
+
     let staging = Staging::new(&opts.out, opts.force, "bench")?;
     let names = output_names(&datasets);
-    let mut outcomes = Vec::with_capacity(datasets.len());
+    let total_runs = datasets.len() + six_axis_plans.iter().filter(|p| **p == Some(true)).count();
+    let mut results = Vec::with_capacity(datasets.len());
     for (i, (dataset, name)) in datasets.iter().zip(&names).enumerate() {
-        progress(i, datasets.len(), dataset);
-        let result = run_one(
+        progress(i, total_runs, &dataset.display().to_string());
+        results.push(run_one(
             dataset,
             &staging.dir().join(name),
             opts.config.as_deref(),
             name,
-        );
+            false,
+        ));
+    }
+    // The 6-axis runs, into OUT/6axis/<name>.
+    let mut done = datasets.len();
+    let mut outcomes = Vec::with_capacity(datasets.len());
+    for (((dataset, name), result), plan) in datasets
+        .iter()
+        .zip(&names)
+        .zip(results)
+        .zip(&six_axis_plans)
+    {
+        let six_axis = match plan {
+            None => SixAxis::None,
+            Some(false) => SixAxis::SameRun,
+            Some(true) => {
+                progress(
+                    done,
+                    total_runs,
+                    &format!("{} without the magnetometer", dataset.display()),
+                );
+                done += 1;
+                SixAxis::Run(Box::new(run_one(
+                    dataset,
+                    &staging.dir().join(SIX_AXIS_DIR).join(name),
+                    opts.config.as_deref(),
+                    name,
+                    true,
+                )))
+            }
+        };
         let dataset_name = dataset
             .file_name()
             .map_or_else(|| name.clone(), |n| n.to_string_lossy().into_owned());
         outcomes.push(Outcome {
             name: dataset_name,
             result,
+            six_axis,
         });
     }
 
-    // One table per parent folder, in the order found.
-    let mut groups: Vec<(PathBuf, Vec<(&Path, &Outcome)>)> = Vec::new();
-    for (dataset, outcome) in datasets.iter().zip(&outcomes) {
-        let parent = dataset
-            .parent()
-            .map_or_else(PathBuf::new, Path::to_path_buf);
-        match groups.iter_mut().find(|(p, _)| *p == parent) {
-            Some((_, runs)) => runs.push((dataset, outcome)),
-            None => groups.push((parent, vec![(dataset, outcome)])),
-        }
-    }
+    let refs_6d = refs_6d
+        .as_ref()
+        .zip(opts.references_6d.as_deref())
+        .map(|(m, p)| (p, m));
     let mut tables = Vec::new();
-    for (folder, runs) in groups {
-        let path = folder.join("references.json");
-        let (refs, references_error) = match read_references(&path) {
+    for ((folder, members), (path, refs)) in groups.into_iter().zip(group_refs) {
+        let runs: Vec<(&Path, &Outcome)> = members
+            .iter()
+            .map(|&i| (datasets[i].as_path(), &outcomes[i]))
+            .collect();
+        let (refs, references_error) = match refs {
             Ok(r) => (r, None),
             Err(e) => (None, Some(e)),
         };
         let rows = match &refs {
-            Some(References::Broad(m)) => broad_table(&runs, Some(m)),
+            Some(References::Broad(m)) => broad_table(&runs, Some((&path, m)), refs_6d),
             Some(References::Attitude(m)) => attitude_table(&runs, Some(m)),
             None if runs.iter().all(|(d, _)| d.join("movement.csv").is_file()) => {
-                broad_table(&runs, None)
+                broad_table(&runs, None, refs_6d)
             }
             None => attitude_table(&runs, None),
         };
@@ -632,6 +833,7 @@ pub fn run(
         dir: opts.dir.clone(),
         out: opts.out.clone(),
         config: opts.config.clone(),
+        references_6d: opts.references_6d.clone(),
         tables,
         data_warnings,
     };
@@ -663,9 +865,22 @@ impl Report {
             if let Some(e) = &t.references_error {
                 out.push(e.clone());
             }
-            let errors: Vec<(&String, &Option<String>)> = match &t.rows {
-                Rows::Broad { rows, .. } => rows.iter().map(|r| (&r.dataset, &r.error)).collect(),
-                Rows::Attitude { rows } => rows.iter().map(|r| (&r.dataset, &r.error)).collect(),
+            let errors: Vec<(String, &Option<String>)> = match &t.rows {
+                Rows::Broad { rows, .. } => rows
+                    .iter()
+                    .flat_map(|r| {
+                        [
+                            (r.dataset.clone(), &r.error),
+                            (
+                                format!("{} (without the magnetometer)", r.dataset),
+                                &r.error_6axis,
+                            ),
+                        ]
+                    })
+                    .collect(),
+                Rows::Attitude { rows } => {
+                    rows.iter().map(|r| (r.dataset.clone(), &r.error)).collect()
+                }
             };
             for (name, e) in errors {
                 if let Some(e) = e {
@@ -692,6 +907,7 @@ impl Report {
                     mean,
                     max,
                     madgwick_missing,
+                    vqf_6d_missing,
                 } => {
                     let w = rows
                         .iter()
@@ -706,13 +922,29 @@ impl Report {
                     );
                     let _ = writeln!(
                         s,
-                        "{:<w$}  {:>8} {:>8} {:>8} {:>8}  {:>8}  {:>8}",
-                        "", "ours", "ours", "ours", "ours", "VQF", "Madgwick"
+                        "{:<w$}  {:>8} {:>8} {:>8} {:>8}  {:>8}  {:>8}  {:>9} {:>9}",
+                        "",
+                        "ours",
+                        "ours",
+                        "ours",
+                        "ours",
+                        "VQF",
+                        "Madgwick",
+                        "ours 6-ax",
+                        "VQF 6D"
                     );
                     let _ = writeln!(
                         s,
-                        "{:<w$}  {:>8} {:>8} {:>8} {:>8}  {:>8}  {:>8}",
-                        "trial", "total", "heading", "inclin.", "in 3σ %", "total", "total"
+                        "{:<w$}  {:>8} {:>8} {:>8} {:>8}  {:>8}  {:>8}  {:>9} {:>9}",
+                        "trial",
+                        "total",
+                        "heading",
+                        "inclin.",
+                        "in 3σ %",
+                        "total",
+                        "total",
+                        "inclin.",
+                        "inclin."
                     );
                     for r in rows {
                         if let Some(e) = &r.error {
@@ -721,7 +953,7 @@ impl Report {
                         }
                         let _ = writeln!(
                             s,
-                            "{:<w$}  {:>8} {:>8} {:>8} {:>8}  {:>8}  {:>8}",
+                            "{:<w$}  {:>8} {:>8} {:>8} {:>8}  {:>8}  {:>8}  {:>9} {:>9}",
                             r.dataset,
                             cell(r.ours.total_deg, 3),
                             cell(r.ours.heading_deg, 3),
@@ -729,12 +961,14 @@ impl Report {
                             cell(r.ours.inside_3sigma_pct, 1),
                             cell(r.vqf_total_deg, 3),
                             cell(r.madgwick_total_deg, 3),
+                            cell(r.inclination_6axis_deg, 3),
+                            cell(r.vqf_6d_inclination_deg, 3),
                         );
                     }
                     for (label, a) in [("mean", mean), ("max", max)] {
                         let _ = writeln!(
                             s,
-                            "{:<w$}  {:>8} {:>8} {:>8} {:>8}  {:>8}  {:>8}",
+                            "{:<w$}  {:>8} {:>8} {:>8} {:>8}  {:>8}  {:>8}  {:>9} {:>9}",
                             label,
                             cell(a.ours.total_deg, 3),
                             cell(a.ours.heading_deg, 3),
@@ -742,12 +976,50 @@ impl Report {
                             cell(a.ours.inside_3sigma_pct, 1),
                             cell(a.vqf_total_deg, 3),
                             cell(a.madgwick_total_deg, 3),
+                            cell(a.inclination_6axis_deg, 3),
+                            cell(a.vqf_6d_inclination_deg, 3),
                         );
                     }
                     let _ = writeln!(
                         s,
                         "(in 3σ %: the movement samples whose attitude error is inside the reported 3σ ellipsoid, NEES ≤ 9: 97.1 % for a consistent estimate; in the max row, the lowest trial's)"
                     );
+                    let mut sources: Vec<String> = Vec::new();
+                    for r in rows {
+                        if let Some(p) = &r.vqf_6d_from {
+                            let p = p.display().to_string();
+                            if !sources.contains(&p) {
+                                sources.push(p);
+                            }
+                        }
+                    }
+                    let from = if sources.is_empty() {
+                        String::new()
+                    } else {
+                        format!(", from {}", sources.join(" and "))
+                    };
+                    let _ = writeln!(
+                        s,
+                        "(6-ax: ours without the magnetometer, use_magnetometer = false (outputs in {SIX_AXIS_DIR}/); \
+VQF 6D: real-time VQF on the gyroscope and accelerometer only{from}; the inclination only: without a magnetometer nothing observes the heading)"
+                    );
+                    for r in rows {
+                        if let (None, Some(e)) = (&r.error, &r.error_6axis) {
+                            let _ = writeln!(
+                                s,
+                                "({}: the run without the magnetometer failed: {e})",
+                                r.dataset
+                            );
+                        }
+                    }
+                    if !vqf_6d_missing.is_empty() {
+                        let _ = writeln!(
+                            s,
+                            "(no VQF 6D figure for {}: neither references.json nor a --references-6d file has {VQF_6D}; \
+python3 tools/vqf_references.py DIR --out FILE writes one)",
+                            vqf_6d_missing.join(", ")
+                        );
+                    }
                     if !madgwick_missing.is_empty() {
                         let _ = writeln!(
                             s,
@@ -861,6 +1133,147 @@ mod tests {
         std::fs::remove_file(&p).expect("rm");
         assert!(matches!(read_references(&p), Ok(None)));
         let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn the_six_axis_folder_is_no_dataset_output() {
+        let d = [PathBuf::from("a/6axis"), PathBuf::from("a/t1")];
+        assert_eq!(output_names(&d), ["a-6axis", "t1"]);
+    }
+
+    fn broad_run(inclination_deg: f64) -> Result<Metrics, String> {
+        let mut m = crate::metrics::Scorer::default().metrics();
+        m.broad = Some(crate::metrics::broad::BroadRmse {
+            total_deg: 2.0 * inclination_deg,
+            heading_deg: inclination_deg,
+            inclination_deg,
+            samples: 10,
+            inside_3sigma: f64::NAN,
+        });
+        Ok(m)
+    }
+
+    /// VQF 6D from references.json before the --references-6d file, each figure with its file;
+    /// a trial that neither has prints `–` and is written `null`, and so are the mean and max.
+    #[test]
+    fn a_missing_vqf_6d_figure_is_a_dash_and_null() {
+        let outcomes = [
+            Outcome {
+                name: "a".into(),
+                result: broad_run(1.0),
+                six_axis: SixAxis::Run(Box::new(broad_run(1.5))),
+            },
+            Outcome {
+                name: "b".into(),
+                result: broad_run(2.0),
+                six_axis: SixAxis::SameRun,
+            },
+            Outcome {
+                name: "c".into(),
+                result: broad_run(3.0),
+                six_axis: SixAxis::Run(Box::new(Err("boom".into()))),
+            },
+        ];
+        let runs: Vec<(&Path, &Outcome)> = outcomes.iter().map(|o| (Path::new("x"), o)).collect();
+        let entries = |json: &str| -> BTreeMap<String, Value> {
+            let v: Value = serde_json::from_str(json).expect("json");
+            v["trials"]
+                .as_object()
+                .expect("trials")
+                .iter()
+                .map(|(k, v)| (k.clone(), v.clone()))
+                .collect()
+        };
+        let refs = entries(r#"{"trials": {"a": {"vqf_6d": {"inclination": 0.5}}}}"#);
+        let file = entries(
+            r#"{"trials": {"a": {"vqf_6d": {"inclination": 9.0}}, "b": {"vqf_6d": {"inclination": 0.75}}}}"#,
+        );
+        let (rp, fp) = (Path::new("references.json"), Path::new("six.json"));
+        let table = |refs_6d: Option<Source<'_>>| {
+            let rows = broad_table(&runs, Some((rp, &refs)), refs_6d);
+            let report = Report {
+                dir: PathBuf::from("x"),
+                out: PathBuf::from("out"),
+                config: None,
+                references_6d: None,
+                tables: vec![Table {
+                    folder: PathBuf::from("x"),
+                    references: Some(rp.to_path_buf()),
+                    references_error: None,
+                    rows,
+                }],
+                data_warnings: Vec::new(),
+            };
+            let json = serde_json::to_value(&report).expect("json");
+            (report, json)
+        };
+
+        // Without the file: b and c have no VQF 6D figure.
+        let (report, json) = table(None);
+        let rows = &json["tables"][0]["rows"];
+        assert_eq!(rows[0]["vqf_6d_inclination_deg"], 0.5);
+        assert_eq!(rows[0]["vqf_6d_from"], "references.json");
+        assert_eq!(rows[0]["inclination_6axis_deg"], 1.5);
+        // The IMU alone: the first run is the 6-axis run.
+        assert_eq!(rows[1]["inclination_6axis_deg"], 2.0);
+        assert!(rows[1]["vqf_6d_inclination_deg"].is_null() && rows[1]["vqf_6d_from"].is_null());
+        assert!(rows[2]["inclination_6axis_deg"].is_null());
+        assert_eq!(rows[2]["error_6axis"], "boom");
+        for summary in ["mean", "max"] {
+            let s = &json["tables"][0][summary];
+            assert!(s["vqf_6d_inclination_deg"].is_null(), "{summary}: {s}");
+            assert!(s["inclination_6axis_deg"].is_null(), "{summary}: {s}");
+        }
+        assert_eq!(
+            json["tables"][0]["vqf_6d_missing"],
+            serde_json::json!(["b", "c"])
+        );
+        let text = report.render();
+        let row = |name: &str| {
+            text.lines()
+                .find(|l| l.starts_with(name))
+                .unwrap_or_else(|| panic!("no row {name}:\n{text}"))
+                .to_string()
+        };
+        assert!(
+            row("a ").trim_end().ends_with("1.500     0.500"),
+            "{}",
+            row("a ")
+        );
+        assert!(
+            row("b ").trim_end().ends_with("2.000         –"),
+            "{}",
+            row("b ")
+        );
+        assert!(
+            row("c ").trim_end().ends_with("–         –"),
+            "{}",
+            row("c ")
+        );
+        assert!(
+            row("mean").trim_end().ends_with("–         –"),
+            "{}",
+            row("mean")
+        );
+        assert!(text.contains("no VQF 6D figure for b, c"), "{text}");
+        assert!(
+            text.contains("c: the run without the magnetometer failed: boom"),
+            "{text}"
+        );
+        assert!(report
+            .failures()
+            .contains(&"c (without the magnetometer): boom".to_string()));
+
+        // With the file: references.json first, the file for the others.
+        let (report, json) = table(Some((fp, &file)));
+        let rows = &json["tables"][0]["rows"];
+        assert_eq!(rows[0]["vqf_6d_inclination_deg"], 0.5);
+        assert_eq!(rows[1]["vqf_6d_inclination_deg"], 0.75);
+        assert_eq!(rows[1]["vqf_6d_from"], "six.json");
+        assert!(rows[2]["vqf_6d_inclination_deg"].is_null());
+        assert!(report
+            .render()
+            .contains("from references.json and six.json"));
     }
 
     #[test]

@@ -5,7 +5,7 @@
 //! | `host-sim [run] [--scenario NAME] [--seed N] [--out DIR] [--force]` | simulate, filter, score, plot; prints a summary table (default: the `default` scenario into `out/`) |
 //! | `host-sim simulate --scenario NAME [--seed N] --out DIR [--force]` | write a dataset folder with ground truth ([`crate::dataset`]) |
 //! | `host-sim replay DATASET [--out DIR] [--config FILE] [--force]` | run the filter over a dataset folder, with or without ground truth |
-//! | `host-sim bench DIR [--out OUT] [--config FILE] [--force]` | replay every dataset folder under `DIR` (one and two levels deep) and print its scores beside the `references.json` of its folder ([`host_sim::bench`]; default `OUT`: `out/bench`) |
+//! | `host-sim bench DIR [--out OUT] [--config FILE] [--references-6d FILE] [--force]` | replay every dataset folder under `DIR` (one and two levels deep) and print its scores beside the `references.json` of its folder; BROAD trials also without the magnetometer, beside VQF 6D ([`host_sim::bench`]; default `OUT`: `out/bench`) |
 //! | `host-sim montecarlo --scenario NAME --runs N [--seed S] [--out DIR] [--json] [--force] [--check]` | consistency over the seeds `S`..`S+N-1`: NEES / NIS against chi-square bands; with `--out`, the runs and bands as CSV and JSON ([`host_sim::montecarlo`]) |
 //! | `host-sim faults [--scenario NAME ...] [--runs N] [--seed S] --out DIR [--force] [--json] [--latency]` | the fault bench over the `fault_*` scenarios: detection and recovery times, false-valid epochs, ATE, and the latency comparison ([`host_sim::faults`]) |
 //! | `host-sim calibrate DIR [--out DIR] [--from S] [--to S] [--force]` | IMU and magnetometer noise from a static recording (Allan deviation, `host_sim::calibrate`) |
@@ -124,15 +124,20 @@ Example: host-sim replay data/car --out out/car"
 replays each (plots off; --config, else the dataset's replay.toml, else the defaults) and prints one table per parent folder, \
 against that folder's references.json when present:\n\
   BROAD (references.json with \"trials\"): BROAD's total / heading / inclination RMSE [deg] inside movement.csv, \
-the share of those samples inside the reported 3σ ellipsoid (NEES ≤ 9), real-time VQF's and Madgwick's total, the mean and the worst trial (each only where every trial has the figure);\n\
+the share of those samples inside the reported 3σ ellipsoid (NEES ≤ 9), real-time VQF's and Madgwick's total, \
+and the 6-axis inclination: each trial with a magnetometer replayed again with use_magnetometer = false (into OUT/6axis/), \
+beside VQF 6D's inclination (gyroscope and accelerometer only) from references.json's \"vqf_6d\", else from --references-6d FILE; \
+the mean and the worst trial (each only where every trial has the figure);\n\
   otherwise (\"datasets\", or none): the sensors ours fuses, the attitude RMSE [deg] from 2 s after the first ground-truth sample, \
 the attitude ANEES, VQF's RMSE and ours/VQF, the ratio only where ours fuses VQF 9D's sensors (IMU+mag): \
 a dataset with GNSS replays through the INS navigator and is not divided by attitude-only VQF.\n\
 Progress goes to stderr: a bar on a terminal, else a line every 5 s (HOST_SIM_PROGRESS_S sets the interval).\n\
 A figure not computed is printed '–' (null in bench.json).\n\
-Writes into --out: one folder per dataset (estimate.tum, estimate.csv, groundtruth.tum, metrics.json) and bench.json (every figure of the tables).\n\
+Writes into --out: one folder per dataset (estimate.tum, estimate.csv, groundtruth.tum, metrics.json), 6axis/ (the same for the runs without the magnetometer) and bench.json (every figure of the tables).\n\
 Exit status non-zero when a dataset fails to run (its error is in its row; the others still run) or a references.json cannot be read.\n\n\
-Example: host-sim bench ../shared/datasets --out out/bench"
+Examples:\n  host-sim bench ../shared/datasets --out out/bench\n  \
+python3 tools/vqf_references.py ../shared/datasets/broad --out out/vqf_6d.json\n  \
+host-sim bench ../shared/datasets --references-6d out/vqf_6d.json --out out/bench-6d"
     )]
     Bench {
         /// The folder holding the dataset folders.
@@ -143,6 +148,11 @@ Example: host-sim bench ../shared/datasets --out out/bench"
         /// Filter configuration (TOML) for every dataset.
         #[arg(long)]
         config: Option<PathBuf>,
+        /// VQF 6D's BROAD figures for the trials whose references.json has none: a JSON file
+        /// {"trials": {NAME: {"vqf_6d": {"inclination": DEG}}}}, as
+        /// `python3 tools/vqf_references.py DIR --out FILE` writes it.
+        #[arg(long, value_name = "FILE")]
+        references_6d: Option<PathBuf>,
         /// Replace the files of an earlier host-sim output in the output folder (the ones its
         /// manifest lists; every other file or folder in it is kept; a folder host-sim did not
         /// write is refused).

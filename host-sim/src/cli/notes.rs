@@ -22,7 +22,8 @@ fn has_sensor(m: &Metrics, name: &str) -> bool {
 ///   above `heading_floor_deg`; where the magnetometer is cleaner than that, the σ stays above
 ///   the error and the NIS and the attitude ANEES read low: the navigator is conservative.
 ///   `matched_ahrs` is the scenario that checks consistency.
-/// * No heading aid (no magnetometer, GNSS or camera): the heading is observed by nothing, and
+/// * No heading aid (no magnetometer, or `use_magnetometer = false`; no GNSS or camera): the
+///   heading is observed by nothing, and
 ///   where the attitude ANEES is below 3, the heading's σ, grown from the start-up prior with
 ///   the gyro noise and bias, is why.
 #[must_use]
@@ -68,8 +69,13 @@ host-sim montecarlo --scenario matched_ahrs --runs 20 --check",
             ),
             _ => String::new(),
         };
+        let aids = if cfg.use_magnetometer {
+            "no magnetometer, GNSS or camera"
+        } else {
+            "use_magnetometer = false, no GNSS or camera"
+        };
         notes.push(format!(
-            "no heading aid (no magnetometer, GNSS or camera): the heading is observed by nothing{anees_part}; \
+            "no heading aid ({aids}): the heading is observed by nothing{anees_part}; \
 the yaw-aligned attitude RMSE is the figure to read"
         ));
     }

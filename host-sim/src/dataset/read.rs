@@ -581,6 +581,16 @@ fn geodetic_frame(
 impl Dataset {
     /// Reads the folder's `sensor.yaml` files and the landmark map.
     pub fn open(dir: &Path) -> Result<Self, DatasetError> {
+        Self::open_with_magnetometer(dir, true)
+    }
+
+    /// As [`Dataset::open`]; with `use_magnetometer` false, `mag0/` is not read at all, as if
+    /// absent: `mag` is `None` and [`Dataset::events`] has no magnetometer samples (a replay's
+    /// `use_magnetometer = false`).
+    pub fn open_with_magnetometer(
+        dir: &Path,
+        use_magnetometer: bool,
+    ) -> Result<Self, DatasetError> {
         let imu_yaml = dir.join("imu0/sensor.yaml");
         if !dir.join("imu0/data.csv").is_file() {
             return Err(DatasetError::file(
@@ -612,7 +622,7 @@ impl Dataset {
             accelerometer_noise_density: y.f64("accelerometer_noise_density")?,
             accelerometer_random_walk: y.f64("accelerometer_random_walk")?,
         };
-        let mag = if dir.join("mag0/data.csv").is_file() {
+        let mag = if use_magnetometer && dir.join("mag0/data.csv").is_file() {
             let y = SensorYaml::read(&dir.join("mag0/sensor.yaml"))?;
             let r = y.list("reference_field", 3)?;
             Some(MagParams {

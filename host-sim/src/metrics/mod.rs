@@ -327,8 +327,9 @@ pub struct Metrics {
     pub attitude_rmse_yaw_aligned_deg: f64,
     /// That heading offset, degrees.
     pub attitude_yaw_offset_deg: f64,
-    /// Whether the dataset has a heading reference (a magnetometer, GNSS or a camera); `false`:
-    /// IMU only, the heading is arbitrary and `attitude_rmse_yaw_aligned_deg` is the score.
+    /// Whether the run has a heading reference (a magnetometer it fuses, GNSS or a camera);
+    /// `false`: IMU only (or `use_magnetometer = false`), the heading is arbitrary and
+    /// `attitude_rmse_yaw_aligned_deg` is the score.
     pub heading_reference: Option<bool>,
     /// Attitude RMSE (geodesic angle) from 2 s after the first ground-truth sample, degrees
     /// (NaN, written `null`, when nothing was scored there).

@@ -1,6 +1,8 @@
 //! The attitude-only replay (a dataset with an IMU and optionally a magnetometer, without GNSS
 //! or camera): every sample goes to [`AttitudeNavigator`], exactly as a firmware main loop
-//! would call it; this file only reads, writes and scores.
+//! would call it; this file only reads, writes and scores. With `use_magnetometer = false` the
+//! dataset comes opened without its magnetometer (`ds.mag` is `None`, no `mag0` samples): the
+//! navigator is configured without one and fuses the gyroscope and accelerometer only.
 
 use super::output::{EstimateFiles, Partials};
 use super::{lit3, up3, ReplayConfig, ReplayError};
@@ -43,6 +45,7 @@ pub(super) fn navigator_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> Att
         let mut mc = MagneticConfig::new(T::lit(m.sigma), Some(lit3(&m.reference_field)));
         mc.heading_noise = T::lit(cfg.heading_noise_deg.to_radians());
         mc.heading_floor = T::lit(cfg.heading_floor_deg.to_radians());
+        mc.hard_iron = cfg.magnetometer_hard_iron;
         if cfg.magnetometer_vector {
             mc.fusion = MagneticFusion::Vector;
         }

@@ -1,7 +1,9 @@
 //! The GNSS replay (a dataset with an IMU and GNSS, optionally a magnetometer and a
 //! barometer): every sample goes to [`InsNavigator`], exactly as a firmware main loop would
 //! call it, each GNSS fix stamped with the time it was valid (its row's time minus the
-//! receiver's `latency_s`); this file only reads, writes and scores.
+//! receiver's `latency_s`); this file only reads, writes and scores. With `use_magnetometer =
+//! false` the dataset comes opened without its magnetometer (`ds.mag` is `None`, no `mag0`
+//! samples), so the navigator has none.
 
 use super::attitude::navigator_config;
 use super::output::{open_partial, EstimateFiles, Partials};

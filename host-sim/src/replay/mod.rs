@@ -64,9 +64,19 @@ pub struct ReplayConfig {
     pub block_s: f64,
     /// Attitude navigator: the smallest spread (1σ per axis) of a moving body's velocity, m/s.
     pub velocity_sigma: f64,
+    /// Fuse the magnetometer where the dataset has one (`mag0/`). `false`: `mag0/` is not read
+    /// at all (neither its `sensor.yaml` nor its samples), as if absent, by every navigator
+    /// (attitude, INS, the camera replay): a 6-axis run on the gyroscope and the
+    /// accelerometer, whose heading nothing observes (score it by the yaw-aligned attitude RMSE
+    /// or BROAD's inclination). `host-sim bench` replays BROAD trials so a second time.
+    pub use_magnetometer: bool,
     /// Attitude navigator: fuse the magnetometer's whole field (`true`: a calibrated
     /// magnetometer in a clean field; it then also measures the tilt) rather than its heading.
     pub magnetometer_vector: bool,
+    /// Attitude navigator: learn the magnetometer's hard iron (a constant offset in the body
+    /// frame: a magnet or a battery on the board) while the body turns, and take it off every
+    /// sample.
+    pub magnetometer_hard_iron: bool,
     /// Attitude navigator: the body only rotates in place (no linear acceleration).
     pub rotation_only: bool,
     /// Attitude navigator: memory of the velocity spread, s.
@@ -175,7 +185,8 @@ impl ReplayConfig {
 
 impl ReplayConfig {
     /// The defaults for data from host-sim's own simulator, whose IMU samples are the motion's
-    /// values at their instant (`instantaneous_imu`; a MEMS IMU's are means over the interval).
+    /// values at their instant (`instantaneous_imu`; a MEMS IMU's are means over the interval);
+    /// every sensor of the dataset fused (`use_magnetometer`), as by default.
     #[must_use]
     pub fn simulated() -> Self {
         Self {
@@ -198,7 +209,9 @@ impl Default for ReplayConfig {
             rotation_only: false,
             rpe_delta: 1.0,
             rpe_delta_unit: "s".into(),
+            use_magnetometer: true,
             magnetometer_vector: false,
+            magnetometer_hard_iron: true,
             accelerometer_bias_sigma: 0.1,
             gyro_bias_sigma_dps: 0.5,
             gyro_scale_sigma: 0.005,
@@ -358,7 +371,7 @@ fn replay_in<T: Real>(
     title: &str,
     mut scorer: Scorer,
 ) -> Result<Scorer, ReplayError> {
-    let ds = Dataset::open(dir)?;
+    let ds = Dataset::open_with_magnetometer(dir, cfg.use_magnetometer)?;
     for note in &ds.notes {
         eprintln!("note: {note}");
     }
@@ -656,4 +669,88 @@ fn pnp_pose(
         .camera_from_world
         .inverse()
         .compose(&cam.body_from_camera.inverse()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dataset::write::simulate;
+    use crate::scenario::Scenario;
+    use crate::sensors::gnss::GnssConfig;
+    use crate::sensors::mag::MagConfig;
+
+    fn tmp(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!(
+            "host-sim-replay-unit-{}-{name}",
+            std::process::id()
+        ));
+        let _ = std::fs::remove_dir_all(&d);
+        d
+    }
+
+    fn read(p: &Path) -> String {
+        std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+    }
+
+    /// `use_magnetometer = false`: the attitude and the INS replays fuse no magnetometer and
+    /// read nothing of `mag0/`; their estimate is the same with the magnetometer's files
+    /// garbled or gone, and differs from the run that fuses them.
+    #[test]
+    fn without_the_magnetometer_the_mag_files_do_not_matter() {
+        let key: ReplayConfig = toml::from_str("use_magnetometer = false").expect("the key");
+        assert!(!key.use_magnetometer && ReplayConfig::default().use_magnetometer);
+        assert!(ReplayConfig::simulated().use_magnetometer);
+        let err = toml::from_str::<ReplayConfig>("use_magnetometer = 0")
+            .expect_err("not a bool")
+            .to_string();
+        assert!(err.contains("use_magnetometer"), "{err}");
+        for (name, gnss) in [("attitude", None), ("ins", Some(GnssConfig::default()))] {
+            let dir = tmp(name);
+            let ds = dir.join("ds");
+            let sc = Scenario {
+                duration_s: 12.0,
+                static_s: 3.0,
+                mag: Some(MagConfig {
+                    rate_hz: 25.0,
+                    ..MagConfig::default()
+                }),
+                gnss,
+                ..Scenario::default()
+            };
+            simulate(&sc, 1, &ds).expect("simulate");
+            let with = ReplayConfig {
+                plots: false,
+                ..sc.replay.clone()
+            };
+            let without = ReplayConfig {
+                use_magnetometer: false,
+                ..with.clone()
+            };
+            without.validate().expect("valid");
+            let m_with = replay(&ds, &dir.join("with"), &with, name).expect("with mag");
+            let m_without = replay(&ds, &dir.join("without"), &without, name).expect("without");
+            assert!(m_with.updates_accepted.contains_key("mag"), "{name}");
+            for m in [&m_without.updates_accepted, &m_without.updates_rejected] {
+                assert!(!m.contains_key("mag"), "{name}: {m:?}");
+            }
+            assert!(!m_without.updates_refused.contains_key("mag"), "{name}");
+            assert_eq!(m_with.heading_reference, Some(true));
+            // GNSS observes the heading (the INS replay); nothing does in the attitude replay.
+            assert_eq!(m_without.heading_reference, Some(name == "ins"));
+            let estimate = |out: &str| read(&dir.join(out).join("estimate.csv"));
+            assert_ne!(estimate("with"), estimate("without"), "{name}: mag unused");
+
+            // Garbled magnetometer files: unreadable with it, no difference without it.
+            std::fs::write(ds.join("mag0/data.csv"), "not,a\nmagnetometer\n").expect("garble");
+            std::fs::write(ds.join("mag0/sensor.yaml"), "rate_hz: [\n").expect("garble");
+            assert!(replay(&ds, &dir.join("garbled-with"), &with, name).is_err());
+            replay(&ds, &dir.join("garbled"), &without, name).expect("mag0 not read");
+            assert_eq!(estimate("without"), estimate("garbled"), "{name}");
+            // And no magnetometer at all.
+            std::fs::remove_dir_all(ds.join("mag0")).expect("rm mag0");
+            replay(&ds, &dir.join("gone"), &without, name).expect("no mag0");
+            assert_eq!(estimate("without"), estimate("gone"), "{name}");
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
 }

@@ -28,6 +28,10 @@ impl TruthCursor {
     fn advance(&mut self) -> Result<(), ReplayError> {
         self.prev = self.next.take();
         self.next = self.stream.next_truth()?;
+        // Every row interval, also where the samples fall on the rows themselves.
+        if let (Some(a), Some(b)) = (&self.prev, &self.next) {
+            self.spacing.observe(a.t_ns, b.t_ns);
+        }
         if let Some(n) = &self.next {
             write_tum(&mut self.tum, n.t_ns, &n.position, &n.attitude)
                 .map_err(out_err(&self.tum_path))?;

@@ -272,6 +272,13 @@ fn intervals<const N: usize>(name: &str, list: &[[f64; N]]) -> Result<(), String
     Ok(())
 }
 
+/// The hard-iron offset of the `handheld_hard_iron` scenario, µT, body frame: a small magnet
+/// or a speaker a few centimetres from the magnetometer (0.65 of the 48 µT field).
+pub const HARD_IRON_UT: [f64; 3] = [15.0, -10.0, 25.0];
+
+/// When the magnet of the `handheld_hard_iron` scenario is fixed to the board, s.
+pub const HARD_IRON_FROM_S: f64 = 20.0;
+
 /// The built-in scenarios. `default` is what `host-sim run` runs with no arguments.
 #[must_use]
 pub fn builtin_scenarios() -> Vec<Scenario> {
@@ -347,6 +354,15 @@ pub fn builtin_scenarios() -> Vec<Scenario> {
             shape: "handheld".into(),
             imu: ImuConfig { gyro_turn_on_bias: 0.5 * deg, ..ImuConfig::default() },
             mag: Some(MagConfig::default()),
+            ceilings: Ceilings { ate_m: f64::INFINITY, attitude_deg: 1.2 },
+            ..base.clone()
+        },
+        Scenario {
+            name: "handheld_hard_iron".into(),
+            description: "handheld_ahrs with a magnet fixed to the board at 20 s: a 31 µT hard-iron offset the navigator learns while the body turns".into(),
+            shape: "handheld".into(),
+            imu: ImuConfig { gyro_turn_on_bias: 0.5 * deg, ..ImuConfig::default() },
+            mag: Some(MagConfig { hard_iron: HARD_IRON_UT, hard_iron_from_s: HARD_IRON_FROM_S, ..MagConfig::default() }),
             ceilings: Ceilings { ate_m: f64::INFINITY, attitude_deg: 1.2 },
             ..base.clone()
         },

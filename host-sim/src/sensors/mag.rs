@@ -1,7 +1,7 @@
 //! A 3-axis magnetometer: white noise, hard and soft iron, disturbance episodes, rotated output.
 //!
-//! `m̃ = R_z(α(t)) (A (Rᵀ (m_w + d(t))) + b + σ n)`, with `A = I + S` (soft iron), `b` (hard iron,
-//! µT), `d(t)` a world-frame disturbance that is non-zero during episodes (a steel structure
+//! `m̃ = R_z(α(t)) (A (Rᵀ (m_w + d(t))) + b(t) + σ n)`, with `A = I + S` (soft iron), `b` (hard
+//! iron, µT, from `hard_iron_from_s` on), `d(t)` a world-frame disturbance that is non-zero during episodes (a steel structure
 //! nearby), `σ` the per-sample white noise (µT), and `R_z(α)` a rotation by `α` about the body z
 //! axis, the identity outside `rotated` intervals (a sensor remounted or its axes mislabelled).
 //! Defaults: an ICM-20948 class magnetometer (AK09916: 0.15 µT/LSB, about 0.4 µT rms noise) under
@@ -27,6 +27,9 @@ pub struct MagConfig {
     pub reference_field: [f64; 3],
     /// Hard-iron offset in the body frame, µT.
     pub hard_iron: [f64; 3],
+    /// The hard iron is there from this time on, s from the scenario's start (a magnet fixed
+    /// to the board while it runs); 0: from the start.
+    pub hard_iron_from_s: f64,
     /// Soft-iron matrix minus identity, row-major.
     pub soft_iron: [f64; 9],
     /// Disturbance episodes `[start_s, end_s, magnitude_uT]`, a world-frame field along east.
@@ -45,6 +48,7 @@ impl Default for MagConfig {
             sigma: 0.4,
             reference_field: [0.0, total * incl.cos(), -total * incl.sin()],
             hard_iron: [0.0; 3],
+            hard_iron_from_s: 0.0,
             soft_iron: [0.0; 9],
             disturbances: Vec::new(),
             rotated: Vec::new(),
@@ -76,9 +80,12 @@ impl Mag {
             }
         }
         let a = Matrix3::identity() + Matrix3::from_row_slice(&c.soft_iron);
-        let m = a * k.attitude.inverse_act(&world)
-            + Vector3::from(c.hard_iron)
-            + self.noise.normal3() * c.sigma;
+        let hard_iron = if k.t >= c.hard_iron_from_s {
+            Vector3::from(c.hard_iron)
+        } else {
+            Vector3::zeros()
+        };
+        let m = a * k.attitude.inverse_act(&world) + hard_iron + self.noise.normal3() * c.sigma;
         let angle_deg: f64 = c
             .rotated
             .iter()

@@ -45,12 +45,31 @@ pub struct MagneticConfig<T: Real> {
     pub new_field_s: T,
     /// …while the body turned at a mean rate of at least this, rad/s.
     pub new_field_min_rate: T,
+    /// Learn the magnetometer's hard iron (a constant offset in the body frame) while the
+    /// body turns, and take it off every sample (the `hard_iron` module of the navigator).
+    pub hard_iron: bool,
+    /// The hard iron's prior 1σ per axis, as a fraction of the field's norm: what the
+    /// magnetometer's calibration leaves. Also the residual (beyond the white noise) up to
+    /// which a block counts as explained by the offset, and a new offset is taken once known
+    /// to a third of it.
+    pub hard_iron_sigma: T,
+    /// The largest offset ever taken, as a fraction of the field's norm; a field that only a
+    /// larger one would explain is a disturbance.
+    pub hard_iron_max: T,
+    /// How fast the offset may drift, as a fraction of the field's norm per √s (a random
+    /// walk).
+    pub hard_iron_drift: T,
 }
 
 impl<T: Real> MagneticConfig<T> {
     /// A magnetometer with white noise `sigma` per axis and an optional reference; the other
     /// values are the defaults listed on each field's use: heading-only fusion, 8°·√s heading noise, 1°
-    /// heading floor, 10 % norm and 10° dip tolerance, 20 s turning at 20 °/s or more for a new field.
+    /// heading floor, 10 % norm and 10° dip tolerance, 20 s turning at 20 °/s or more for a new field;
+    /// the hard iron learned online, with a prior of 3 % of the field per axis (a calibrated
+    /// magnetometer's residual offset: about 1.5 µT of the Earth's 25–65 µT), a bound of 3 times
+    /// the field (a magnet that strong at the sensor is a fault of the board, and near the
+    /// range of a MEMS magnetometer), and a drift of 0.1 % of the field per √s (1 % in 100 s:
+    /// a magnet's field changes by about 0.1 %/K, a battery's with its current).
     #[must_use]
     pub fn new(sigma: T, reference: Option<Vector3<T>>) -> Self {
         Self {
@@ -63,6 +82,10 @@ impl<T: Real> MagneticConfig<T> {
             dip_tolerance: T::lit(10.0_f64.to_radians()),
             new_field_s: T::lit(20.0),
             new_field_min_rate: T::lit(20.0_f64.to_radians()),
+            hard_iron: true,
+            hard_iron_sigma: T::lit(0.03),
+            hard_iron_max: T::lit(3.0),
+            hard_iron_drift: T::lit(0.001),
         }
     }
 
@@ -78,7 +101,10 @@ impl<T: Real> MagneticConfig<T> {
             && positive_finite(self.norm_tolerance)
             && positive_finite(self.dip_tolerance)
             && positive_finite(self.new_field_s)
-            && non_negative_finite(self.new_field_min_rate);
+            && non_negative_finite(self.new_field_min_rate)
+            && positive_finite(self.hard_iron_sigma)
+            && positive_finite(self.hard_iron_max)
+            && non_negative_finite(self.hard_iron_drift);
         if ok {
             Ok(())
         } else {

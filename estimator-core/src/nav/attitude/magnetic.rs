@@ -42,6 +42,7 @@
 
 use super::block::MagStats;
 use super::config::{AttitudeConfig, MagneticConfig, MagneticFusion};
+use super::hard_iron::{HardIron, HardIronOutcome};
 use super::report::{Event, Fusion, MagneticStatus};
 use super::tilt::{recovery_options, world_attitude_covariance};
 use crate::eskf::{AhrsAccelBias, MagneticHeading, Magnetometer, UpdateOptions};
@@ -72,6 +73,11 @@ pub(super) struct Magnetic<T: Real> {
     /// The run of consecutive gated-out blocks: how many, the first and the extreme heading
     /// innovations (rad, relative to the first), and how far the body turned meanwhile, rad.
     rejected: Rejections<T>,
+    /// The magnetometer's offset in the body frame, taken off every sample.
+    pub(super) hard_iron: HardIron<T>,
+    /// A heading update was fused since the start-up (whose heading came from the field read
+    /// with the offset of then).
+    pub(super) fused_since_start: bool,
 }
 
 /// A run of gated-out heading innovations.
@@ -122,6 +128,8 @@ impl<T: Real> Magnetic<T> {
             reference: config.reference,
             candidate: None,
             rejected: Rejections::none(),
+            hard_iron: HardIron::new(),
+            fused_since_start: false,
         }
     }
 
@@ -152,10 +160,31 @@ impl<T: Real> Magnetic<T> {
     ) -> Result<Outcome<T>, NavError> {
         let (m_body, n) = (&stats.body, stats.n);
         let c = filter.state().attitude.act(m_body);
+        let before = self.hard_iron.offset();
+        let learned = self
+            .hard_iron
+            .end_block(duration, self.reference.as_ref(), mag);
         let Some(reference) = self.reference else {
             self.reference = Some(Self::learn(&c));
             return Ok((MagneticStatus::Fused, None, Some(Event::NewMagneticField)));
         };
+        if learned == HardIronOutcome::Learned {
+            // Without a heading update since the start-up, the heading came from the start-up's
+            // field, read with the old offset: its error can be as large as the angle the
+            // change moves the horizontal field by, `|Δb| / ‖c_h‖` (at most π), and the
+            // covariance is widened to that. (After updates, the heading came from fields the
+            // old offset explained: a magnet fixed to the board since did not bias it.) This
+            // block's samples were corrected with the old offset: not fused.
+            self.candidate = None;
+            let (_, horizontal, _) = norm_dip(&reference);
+            let change = mat3::norm(&(self.hard_iron.offset() - before));
+            if !self.fused_since_start && crate::kernels::positive_finite(horizontal) {
+                let angle = change / horizontal;
+                let angle = if angle < T::pi() { angle } else { T::pi() };
+                filter.widen_attitude(T::zero(), angle)?;
+            }
+            return Ok((MagneticStatus::Disturbed, None, Some(Event::NewHardIron)));
+        }
         // Beyond the white noise, the field moved in the world during the block.
         let moving = stats.scatter_sq - T::lit(3.0) * mag.sigma * mag.sigma;
         let tolerance = mag.norm_tolerance * mat3::norm(&reference);
@@ -170,8 +199,13 @@ impl<T: Real> Magnetic<T> {
             return Ok((MagneticStatus::Disturbed, None, None));
         }
         let white = mag.sigma / horizontal;
+        // A learned offset's uncertainty moves the horizontal field as much as it is itself
+        // (before one is learned, the calibration's residual is in the heading noise).
+        let offset = self.hard_iron.learned_sigma();
+        let iron = (offset.dot(&offset) / T::lit(3.0)) / (horizontal * horizontal);
         let var = white * white / T::from_count(n.max(1))
-            + mag.heading_noise * mag.heading_noise / duration;
+            + mag.heading_noise * mag.heading_noise / duration
+            + iron;
         let model = MagneticHeading::new(*m_body, reference, var.sqrt_rn());
         let options = UpdateOptions::default();
         let mut event = None;
@@ -185,6 +219,7 @@ impl<T: Real> Magnetic<T> {
             }
         };
         if fusion.accepted {
+            self.fused_since_start = true;
             self.rejected = Rejections::none();
         } else {
             let (s, co) = (reference.y.arctan2(reference.x) - c.y.arctan2(c.x)).sincos();

@@ -25,7 +25,8 @@
 //!      or by the drift of a still one: a tilt error shows as a velocity that grows as
 //!      `g t δθ`; widened, never locked out, after repeated rejections;
 //!    * **heading** (`magnetic`): the magnetometer's heading only, when its norm and dip agree
-//!      with the reference; a steady new field becomes the reference.
+//!      with the reference; a steady new field becomes the reference. Every magnetometer
+//!      sample first loses the offset learned while the body turns (`hard_iron`).
 //!
 //! # Beside VQF and BROAD
 //!
@@ -58,6 +59,7 @@
 
 mod block;
 mod config;
+mod hard_iron;
 mod magnetic;
 mod report;
 mod rest;
@@ -290,6 +292,12 @@ impl<T: Real> AttitudeNavigator<T> {
             accel_bias: filter.state().accel_bias,
             sigma_tilt: tilt.sqrt_rn(),
             sigma_heading: w.m33.sqrt_rn(),
+            hard_iron: self
+                .magnetic
+                .map_or_else(Vector3::zeros, |m| m.hard_iron.offset()),
+            sigma_hard_iron: self
+                .magnetic
+                .map_or_else(Vector3::zeros, |m| m.hard_iron.sigma()),
         })
     }
 
@@ -338,7 +346,12 @@ impl<T: Real> AttitudeNavigator<T> {
         self.report.fused = Fusions::default();
         if self.magnetic.is_some() {
             let frame = self.frame_at(t_ns);
-            self.block.mag.add(&frame.act(field));
+            if let (Some(state), Some(config)) =
+                (self.magnetic.as_mut(), self.config.magnetometer.as_ref())
+            {
+                let corrected = state.hard_iron.take(field, config);
+                self.block.mag.add(&frame.act(&corrected));
+            }
         }
         Ok(self.report)
     }
@@ -554,6 +567,9 @@ impl<T: Real> AttitudeNavigator<T> {
             return;
         };
         self.running = true;
+        if let Some(state) = self.magnetic.as_mut() {
+            state.fused_since_start = false;
+        }
         self.still_s = if still { stats.duration } else { T::zero() };
         self.velocity_spread = Vector3::zeros();
         self.report.at_rest = still;
@@ -650,6 +666,9 @@ impl<T: Real> AttitudeNavigator<T> {
                                 }
                                 Some(Event::NewMagneticField) => {
                                     c.new_fields = c.new_fields.saturating_add(1);
+                                }
+                                Some(Event::NewHardIron) => {
+                                    c.new_hard_irons = c.new_hard_irons.saturating_add(1);
                                 }
                                 _ => {}
                             }

@@ -73,6 +73,8 @@ pub enum Event {
     HeadingWidened,
     /// A steady field different from the reference was taken as the new reference.
     NewMagneticField,
+    /// A new magnetometer offset (hard iron) was learned and replaced the previous one.
+    NewHardIron,
 }
 
 /// The outcome of one aiding update: its normalized innovation squared and whether it was
@@ -155,6 +157,12 @@ pub struct AttitudeEstimate<T: Real> {
     pub sigma_tilt: T,
     /// 1σ of the heading (about world up), rad.
     pub sigma_heading: T,
+    /// The magnetometer's hard iron, body frame, in its unit: taken off every sample (zero
+    /// without a magnetometer, or until learning begins).
+    pub hard_iron: Vector3<T>,
+    /// Its 1σ per axis: small once the body has turned about two axes; it grows slowly while
+    /// the body does not turn (the offset is then frozen).
+    pub sigma_hard_iron: Vector3<T>,
 }
 
 /// Counts since construction, for logs and summaries.
@@ -184,6 +192,8 @@ pub struct Counters {
     pub realigned: u32,
     /// New reference fields taken.
     pub new_fields: u32,
+    /// New magnetometer offsets (hard iron) learned.
+    pub new_hard_irons: u32,
     /// Updates the filter refused (a numerical failure; the filter was left as it was and
     /// the update skipped).
     pub numerical_failures: u32,

@@ -385,7 +385,20 @@ fn bad_input_is_refused_and_leaves_the_navigator_unchanged() {
     let last = T0 + (k - 1) * STEP_NS;
     let nan = Vector3::new(f64::NAN, 0.0, 0.0);
     let inf = Vector3::new(0.0, f64::INFINITY, 0.0);
-    let cases: [(&str, Result<_, NavError>, NavError); 8] = [
+    let range = nav.config().gyro_range;
+    let far_gyro = Vector3::new(0.0, -1.02 * range, 0.0);
+    let far_accel = Vector3::new(1.02 * nav.config().accel_range, 0.0, 9.8);
+    let cases: [(&str, Result<_, NavError>, NavError); 10] = [
+        (
+            "gyro beyond its full scale",
+            nav.clone().imu(s.t_ns, &far_gyro, &s.accel),
+            NavError::OutOfRange,
+        ),
+        (
+            "accelerometer beyond its full scale",
+            nav.clone().imu(s.t_ns, &s.gyro, &far_accel),
+            NavError::OutOfRange,
+        ),
         (
             "NaN gyro",
             nav.clone().imu(s.t_ns, &nan, &s.accel),
@@ -440,6 +453,123 @@ fn bad_input_is_refused_and_leaves_the_navigator_unchanged() {
     // And the stream goes on.
     nav.imu(s.t_ns, &s.gyro, &s.accel)
         .expect("a good sample after bad ones");
+}
+
+/// A hand-held body whose accelerometer clips for 0.1 s (a knock at 20 g on a ±16 g part), then
+/// whose gyro clips for 0.05 s (a flick beyond ±2000 °/s): each sample says so, the clipped
+/// block's tilt is not fused, the gyro's clipping widens the attitude, and the estimate stays
+/// within its reported uncertainty.
+#[test]
+fn samples_at_the_rail_are_flagged_and_not_trusted() {
+    let mut rng = Rng::new(8);
+    let mut nav = AttitudeNavigator::new(config()).expect("config");
+    let mut body = Body {
+        attitude: So3::identity(),
+        t: 0.0,
+    };
+    let bias = Vector3::zeros();
+    let (_, mut k) = run(
+        &mut nav, &mut body, 0, 5, 2.0, &wave, &shake, &bias, &mut rng,
+    );
+    let rail = nav.config().accel_range;
+    // A twin fed the accelerometer as it should have read: the clipped blocks are the tilt
+    // updates the navigator makes fewer than the twin.
+    let mut twin = nav;
+    let tilt_updates =
+        |n: &AttitudeNavigator<f64>| n.counters().gravity_fused + n.counters().gravity_rejected;
+    for i in 0..RATE_HZ * 3 / 5 {
+        let s = body.step(k, &wave, &shake, &bias, &mut rng);
+        k += 1;
+        // The knock, over the first 0.1 s: x reads its full scale.
+        let knock = i < RATE_HZ / 10;
+        let accel = if knock {
+            Vector3::new(rail, s.accel.y, s.accel.z)
+        } else {
+            s.accel
+        };
+        let r = nav
+            .imu(s.t_ns, &s.gyro, &accel)
+            .expect("a clipped sample is taken");
+        assert_eq!(r.clipped, knock, "sample {i}");
+        twin.imu(s.t_ns, &s.gyro, &s.accel).expect("imu");
+        nav.magnetometer(s.t_ns + 1, &s.mag).expect("mag");
+        twin.magnetometer(s.t_ns + 1, &s.mag).expect("mag");
+    }
+    // 0.1 s of clipping lies in one or two 0.25 s blocks.
+    let skipped = tilt_updates(&twin) - tilt_updates(&nav);
+    assert!((1..=2).contains(&skipped), "{skipped} tilt updates skipped");
+    let sigma_before = nav.estimate().expect("started").sigma_tilt;
+    let range = nav.config().gyro_range;
+    // The flick: 2,500 °/s about y for 0.05 s; the gyro reads its full scale (25° short).
+    let flick = |_: f64| Vector3::new(0.0, 2500.0_f64.to_radians(), 0.0);
+    for _ in 0..10 {
+        let s = body.step(k, &flick, &shake, &bias, &mut rng);
+        k += 1;
+        let gyro = Vector3::new(s.gyro.x, s.gyro.y.min(range), s.gyro.z);
+        let r = nav
+            .imu(s.t_ns, &gyro, &s.accel)
+            .expect("a clipped sample is taken");
+        assert!(r.clipped);
+    }
+    let e = nav.estimate().expect("started");
+    assert!(
+        e.sigma_tilt > sigma_before,
+        "{} against {sigma_before}",
+        e.sigma_tilt
+    );
+    assert_eq!(u64::from(nav.counters().clipped), RATE_HZ / 10 + 10);
+    // The turn was short by 25°; the widened covariance (a full-scale turn per interval, 1σ
+    // 0.55 rad over the ten) lets the aiding pull the attitude back.
+    let (worst, _) = run(
+        &mut nav, &mut body, k, 20, 15.0, &wave, &shake, &bias, &mut rng,
+    );
+    assert!(
+        worst < 4.0,
+        "attitude error {worst}° 15 s after the clipping"
+    );
+}
+
+/// A magnetometer that repeats its last sample bit for bit (stuck, or saturated) is not used
+/// once it has for `stuck_s`, and is again once it changes.
+#[test]
+fn a_stuck_magnetometer_is_flagged_and_not_used() {
+    let mut rng = Rng::new(9);
+    let mut nav = AttitudeNavigator::new(config()).expect("config");
+    let mut body = Body {
+        attitude: So3::identity(),
+        t: 0.0,
+    };
+    let bias = Vector3::zeros();
+    let (_, mut k) = run(
+        &mut nav, &mut body, 0, 5, 2.0, &wave, &still, &bias, &mut rng,
+    );
+    let frozen = body.step(k, &wave, &still, &bias, &mut rng).mag;
+    let fused_before = nav.counters().heading_fused;
+    let mut stuck = 0;
+    for _ in 0..5 * RATE_HZ {
+        let s = body.step(k, &wave, &still, &bias, &mut rng);
+        k += 1;
+        nav.imu(s.t_ns, &s.gyro, &s.accel).expect("imu");
+        let r = nav.magnetometer(s.t_ns + 1, &frozen).expect("mag");
+        stuck += u32::from(r.magnetic == MagneticStatus::Stuck);
+    }
+    // Stuck after 0.5 s of the 5 s; one block's heading may still be fused from the samples
+    // before.
+    assert_eq!(nav.counters().magnetometer_stuck, stuck);
+    let stuck_after = u64::from(stuck);
+    assert!(
+        stuck_after >= 4 * RATE_HZ,
+        "{stuck} of {} samples stuck",
+        5 * RATE_HZ
+    );
+    assert!(nav.counters().heading_fused <= fused_before + 3);
+    // Working again: fused again.
+    let (worst, _) = run(
+        &mut nav, &mut body, k, 10, 0.0, &wave, &still, &bias, &mut rng,
+    );
+    assert!(nav.report().magnetic != MagneticStatus::Stuck);
+    assert!(nav.counters().heading_fused > fused_before + 10);
+    assert!(worst < 3.0, "attitude error {worst}°");
 }
 
 #[test]

@@ -39,6 +39,8 @@
 //! | `magnetometer.hard_iron` (on), `hard_iron_sigma` (3 % of the field), `hard_iron_max` (3 fields), `hard_iron_drift` (0.1 %/√s) | a constant offset in the body frame (a magnet or a battery on the board) learned while the body turns about two axes and taken off every sample; offsets within 3 `hard_iron_sigma` of the calibration's are left to it | `hard_iron_sigma`: what the magnetometer's calibration leaves; off for a magnetometer calibrated on the finished device |
 //! | `magnetometer.fusion` (`Heading`) | heading only, or the whole field | `Vector` only for a calibrated magnetometer in a clean field (it then also corrects the tilt) |
 //! | `max_rejected_blocks` (8) | how many rejected blocks in a row before the estimate is taken for wrong | lower recovers faster from a wrong estimate, higher resists long disturbances |
+//! | `gyro_range`, `accel_range` (±2000 °/s, ±16 g) | the sensors' full scale: a sample at the rail is flagged (`AttitudeReport::clipped`), a clipped gyro widens the attitude by a full-scale turn over its interval, a clipped accelerometer's block is not fused; a sample beyond the scale by more than 1 % is refused | the range the IMU is configured to |
+//! | `magnetometer.stuck_s` (0.5 s) | a magnetometer repeating its sample bit for bit this long is stuck or saturated (`MagneticStatus::Stuck`): not used until it changes | above the magnetometer's output interval |
 //! | `tilt_valid_sigma`, `heading_valid_sigma` (5°, 10°) | when the report calls a quantity valid | what the application can use |
 //!
 //! Check a tuning on recordings with truth: `host-sim replay` prints the attitude RMSE and the

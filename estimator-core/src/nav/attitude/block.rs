@@ -24,6 +24,8 @@ pub(super) struct Block<T: Real> {
     pub(super) mag: VectorMean<T>,
     /// Length so far, ns.
     pub(super) elapsed_ns: u32,
+    /// An accelerometer sample of the block was at the rail.
+    pub(super) clipped: bool,
 }
 
 /// The statistics of a finished block, seen in the body at its end.
@@ -83,6 +85,7 @@ impl<T: Real> Default for Block<T> {
             gyro: VectorMean::default(),
             mag: VectorMean::default(),
             elapsed_ns: 0,
+            clipped: false,
         }
     }
 }

@@ -59,6 +59,11 @@ pub struct MagneticConfig<T: Real> {
     /// How fast the offset may drift, as a fraction of the field's norm per √s (a random
     /// walk).
     pub hard_iron_drift: T,
+    /// A magnetometer whose samples repeat bit for bit for this long, s, is stuck or saturated
+    /// (its noise alone changes the last bits of a working one; one that holds its output
+    /// between conversions repeats it for one output interval): its samples are not used
+    /// until they change.
+    pub stuck_s: T,
 }
 
 impl<T: Real> MagneticConfig<T> {
@@ -86,6 +91,7 @@ impl<T: Real> MagneticConfig<T> {
             hard_iron_sigma: T::lit(0.03),
             hard_iron_max: T::lit(3.0),
             hard_iron_drift: T::lit(0.001),
+            stuck_s: T::lit(0.5),
         }
     }
 
@@ -104,7 +110,9 @@ impl<T: Real> MagneticConfig<T> {
             && non_negative_finite(self.new_field_min_rate)
             && positive_finite(self.hard_iron_sigma)
             && positive_finite(self.hard_iron_max)
-            && non_negative_finite(self.hard_iron_drift);
+            && non_negative_finite(self.hard_iron_drift)
+            && positive_finite(self.stuck_s)
+            && self.stuck_s < T::lit(4.0);
         if ok {
             Ok(())
         } else {
@@ -171,6 +179,12 @@ pub struct AttitudeConfig<T: Real> {
     pub tilt_valid_sigma: T,
     /// Heading reported valid while its 1σ is below this, rad.
     pub heading_valid_sigma: T,
+    /// The gyro's full scale, rad/s: a sample with an axis within 0.1 % of it is at the rail
+    /// (the body turned at least that fast, by how much more is unknown), one beyond it by more
+    /// than 1 % is no reading the sensor can give, and is refused.
+    pub gyro_range: T,
+    /// The accelerometer's full scale, m/s² (as `gyro_range`).
+    pub accel_range: T,
     /// The magnetometer, if any.
     pub magnetometer: Option<MagneticConfig<T>>,
 }
@@ -182,7 +196,8 @@ impl<T: Real> AttitudeConfig<T> {
     /// over 5 s; 0.1 m/s² accelerometer bias (0.6° of
     /// tilt); 0.5 % gyro scale and cross-axis error; 0.5 °/s gyro bias at switch-on; rest below 2 °/s and 0.5 m/s² for 1.5 s with a
     /// 0.1 °/s floor; widen after 8 rejected blocks (2 s); valid below 5° tilt and 10° heading;
-    /// no magnetometer.
+    /// a ±2000 °/s gyro and a ±16 g accelerometer (the widest ranges of MEMS IMUs); no
+    /// magnetometer.
     #[must_use]
     pub fn new(filter: FilterConfig<T>) -> Self {
         Self {
@@ -203,6 +218,8 @@ impl<T: Real> AttitudeConfig<T> {
             max_rejected_blocks: 8,
             tilt_valid_sigma: T::lit(5.0_f64.to_radians()),
             heading_valid_sigma: T::lit(10.0_f64.to_radians()),
+            gyro_range: T::lit(2000.0_f64.to_radians()),
+            accel_range: T::lit(16.0 * 9.806_65),
             magnetometer: None,
         }
     }
@@ -227,6 +244,8 @@ impl<T: Real> AttitudeConfig<T> {
             && positive_finite(self.accelerometer_bias_sigma)
             && non_negative_finite(self.gyro_scale_sigma)
             && non_negative_finite(self.gyro_bias_sigma)
+            && positive_finite(self.gyro_range)
+            && positive_finite(self.accel_range)
             && positive_finite(self.rest_gyro)
             && positive_finite(self.rest_accel)
             && non_negative_finite(self.rest_min_s)

@@ -78,6 +78,8 @@ pub(super) struct Magnetic<T: Real> {
     /// A heading update was fused since the start-up (whose heading came from the field read
     /// with the offset of then).
     pub(super) fused_since_start: bool,
+    /// The last sample and when it was first read, ns (a stuck magnetometer repeats it).
+    last: Option<(Vector3<T>, u64)>,
 }
 
 /// A run of gated-out heading innovations.
@@ -130,6 +132,27 @@ impl<T: Real> Magnetic<T> {
             rejected: Rejections::none(),
             hard_iron: HardIron::new(),
             fused_since_start: false,
+            last: None,
+        }
+    }
+
+    /// `true` when `field` (at `t_ns`) repeats the previous sample bit for bit and has since
+    /// `stuck_s` or longer: a stuck or saturated magnetometer.
+    pub(super) fn stuck(
+        &mut self,
+        t_ns: u64,
+        field: &Vector3<T>,
+        config: &MagneticConfig<T>,
+    ) -> bool {
+        match self.last {
+            Some((last, since)) if last == *field => {
+                let ns = u32::try_from(t_ns.saturating_sub(since)).unwrap_or(u32::MAX);
+                T::from_count(ns) * T::lit(1e-9) >= config.stuck_s
+            }
+            _ => {
+                self.last = Some((*field, t_ns));
+                false
+            }
         }
     }
 
@@ -160,31 +183,10 @@ impl<T: Real> Magnetic<T> {
     ) -> Result<Outcome<T>, NavError> {
         let (m_body, n) = (&stats.body, stats.n);
         let c = filter.state().attitude.act(m_body);
-        let before = self.hard_iron.offset();
-        let learned = self
-            .hard_iron
-            .end_block(duration, self.reference.as_ref(), mag);
         let Some(reference) = self.reference else {
             self.reference = Some(Self::learn(&c));
             return Ok((MagneticStatus::Fused, None, Some(Event::NewMagneticField)));
         };
-        if learned == HardIronOutcome::Learned {
-            // Without a heading update since the start-up, the heading came from the start-up's
-            // field, read with the old offset: its error can be as large as the angle the
-            // change moves the horizontal field by, `|Δb| / ‖c_h‖` (at most π), and the
-            // covariance is widened to that. (After updates, the heading came from fields the
-            // old offset explained: a magnet fixed to the board since did not bias it.) This
-            // block's samples were corrected with the old offset: not fused.
-            self.candidate = None;
-            let (_, horizontal, _) = norm_dip(&reference);
-            let change = mat3::norm(&(self.hard_iron.offset() - before));
-            if !self.fused_since_start && crate::kernels::positive_finite(horizontal) {
-                let angle = change / horizontal;
-                let angle = if angle < T::pi() { angle } else { T::pi() };
-                filter.widen_attitude(T::zero(), angle)?;
-            }
-            return Ok((MagneticStatus::Disturbed, None, Some(Event::NewHardIron)));
-        }
         // Beyond the white noise, the field moved in the world during the block.
         let moving = stats.scatter_sq - T::lit(3.0) * mag.sigma * mag.sigma;
         let tolerance = mag.norm_tolerance * mat3::norm(&reference);
@@ -250,6 +252,41 @@ impl<T: Real> Magnetic<T> {
             MagneticStatus::Rejected
         };
         Ok((status, Some(fusion), event))
+    }
+
+    /// The hard iron's part of a block (its own update, before the heading's): the offset
+    /// drifts and the window of recent samples is fitted ([`HardIron::end_block`]). A new
+    /// offset returns [`Event::NewHardIron`], and the block's heading is not fused (its
+    /// samples were corrected with the old offset). Without a heading update since the
+    /// start-up, the heading came from the start-up's field, read with the old offset: its
+    /// error can be as large as the angle the change moves the horizontal field by,
+    /// `|Δb| / ‖m_h‖` (at most π), and the covariance is widened to that. (After heading
+    /// updates, the heading came from fields the old offset explained: a magnet fixed to the
+    /// board since did not bias it.)
+    #[inline(never)] // its own stack frame, not the caller's
+    pub(super) fn hard_iron_stage(
+        &mut self,
+        filter: &mut AhrsAccelBias<T>,
+        duration: T,
+        mag: &MagneticConfig<T>,
+    ) -> Result<Option<Event>, NavError> {
+        let before = self.hard_iron.offset();
+        let outcome = self
+            .hard_iron
+            .end_block(duration, self.reference.as_ref(), mag);
+        if outcome != HardIronOutcome::Learned {
+            return Ok(None);
+        }
+        self.candidate = None;
+        if let (Some(reference), false) = (self.reference, self.fused_since_start) {
+            let (_, horizontal, _) = norm_dip(&reference);
+            if crate::kernels::positive_finite(horizontal) {
+                let angle = mat3::norm(&(self.hard_iron.offset() - before)) / horizontal;
+                let angle = if angle < T::pi() { angle } else { T::pi() };
+                filter.widen_attitude(T::zero(), angle)?;
+            }
+        }
+        Ok(Some(Event::NewHardIron))
     }
 
     /// A disturbed block: tracks a run of similar, steady fields and takes it as the new

@@ -24,9 +24,10 @@
 //!    * **tilt** (`tilt`): the velocity is bounded, by the spread of a moving body's velocity
 //!      or by the drift of a still one: a tilt error shows as a velocity that grows as
 //!      `g t δθ`; widened, never locked out, after repeated rejections;
+//!    * **hard iron** (`hard_iron`): every magnetometer sample loses the offset learned while
+//!      the body turns; at a block's end, the window of recent samples is fitted for it;
 //!    * **heading** (`magnetic`): the magnetometer's heading only, when its norm and dip agree
-//!      with the reference; a steady new field becomes the reference. Every magnetometer
-//!      sample first loses the offset learned while the body turns (`hard_iron`).
+//!      with the reference; a steady new field becomes the reference.
 //!
 //! # Beside VQF and BROAD
 //!
@@ -90,6 +91,8 @@ enum Stage {
     ZeroRate,
     /// The accelerometer.
     Gravity,
+    /// The magnetometer's hard iron.
+    HardIron,
     /// The magnetometer.
     Heading,
 }
@@ -102,6 +105,8 @@ struct Pending<T: Real> {
     /// The velocity bound's variance per axis, (m/s)².
     variance: Vector3<T>,
     stage: Stage,
+    /// An accelerometer sample of the block was at the rail: no tilt update.
+    clipped: bool,
 }
 
 /// How long a body keeps turning one way, s: the attitude error that the gyro's scale and
@@ -124,6 +129,18 @@ fn integrate_block<T: Real>(
     match block.world_sums() {
         Some((force, frames, duration)) => filter.integrate_velocity(&force, &frames, duration),
         None => Ok(()),
+    }
+}
+
+/// `Ok(true)` when an axis of `v` is within 0.1 % of the sensor's full scale `range` (at its
+/// rail: a 16-bit converter's last 32 codes), `Ok(false)` below; an axis beyond the range by
+/// more than 1 % is no reading the sensor can give: [`NavError::OutOfRange`].
+fn at_rail<T: Real>(v: &Vector3<T>, range: T) -> Result<bool, NavError> {
+    let largest = v.x.abs().max(v.y.abs()).max(v.z.abs());
+    if largest > range * T::lit(1.01) {
+        Err(NavError::OutOfRange)
+    } else {
+        Ok(largest >= range * T::lit(0.999))
     }
 }
 
@@ -242,6 +259,7 @@ impl<T: Real> AttitudeNavigator<T> {
                 },
                 event: None,
                 fused: Fusions::default(),
+                clipped: false,
             },
             magnetic,
             counters: Counters::default(),
@@ -283,15 +301,14 @@ impl<T: Real> AttitudeNavigator<T> {
     #[must_use]
     pub fn estimate(&self) -> Option<AttitudeEstimate<T>> {
         let filter = self.filter()?;
-        let w = tilt::world_attitude_covariance(filter);
-        let tilt = if w.m11 > w.m22 { w.m11 } else { w.m22 };
+        let (sigma_tilt, sigma_heading) = self.sigmas()?;
         Some(AttitudeEstimate {
             t_ns: self.report.t_ns,
             attitude: filter.state().attitude,
             gyro_bias: filter.state().gyro_bias,
             accel_bias: filter.state().accel_bias,
-            sigma_tilt: tilt.sqrt_rn(),
-            sigma_heading: w.m33.sqrt_rn(),
+            sigma_tilt,
+            sigma_heading,
             hard_iron: self
                 .magnetic
                 .map_or_else(Vector3::zeros, |m| m.hard_iron.offset()),
@@ -299,6 +316,13 @@ impl<T: Real> AttitudeNavigator<T> {
                 .magnetic
                 .map_or_else(Vector3::zeros, |m| m.hard_iron.sigma()),
         })
+    }
+
+    /// The 1σ of the tilt (the larger horizontal axis) and of the heading, rad, once started.
+    fn sigmas(&self) -> Option<(T, T)> {
+        let w = tilt::world_attitude_covariance(self.filter()?);
+        let tilt = if w.m11 > w.m22 { w.m11 } else { w.m22 };
+        Some((tilt.sqrt_rn(), w.m33.sqrt_rn()))
     }
 
     /// Takes one IMU sample: gyro (rad/s) and accelerometer (m/s², specific force) in the body
@@ -344,7 +368,14 @@ impl<T: Real> AttitudeNavigator<T> {
         self.counters.magnetometer = self.counters.magnetometer.saturating_add(1);
         self.report.event = None;
         self.report.fused = Fusions::default();
-        if self.magnetic.is_some() {
+        let stuck = match (self.magnetic.as_mut(), self.config.magnetometer.as_ref()) {
+            (Some(state), Some(config)) => state.stuck(t_ns, field, config),
+            _ => false,
+        };
+        if stuck {
+            self.counters.magnetometer_stuck = self.counters.magnetometer_stuck.saturating_add(1);
+            self.report.magnetic = MagneticStatus::Stuck;
+        } else if self.magnetic.is_some() {
             let frame = self.frame_at(t_ns);
             if let (Some(state), Some(config)) =
                 (self.magnetic.as_mut(), self.config.magnetometer.as_ref())
@@ -388,6 +419,8 @@ impl<T: Real> AttitudeNavigator<T> {
         accel: &Vector3<T>,
     ) -> Result<(), NavError> {
         check_imu(gyro, accel)?;
+        let gyro_clipped = at_rail(gyro, self.config.gyro_range)?;
+        let accel_clipped = at_rail(accel, self.config.accel_range)?;
         let tick = self.imu_clock.tick(t_ns, self.durations.max_step)?;
         let mut event = None;
         let dt_ns = match tick {
@@ -415,6 +448,14 @@ impl<T: Real> AttitudeNavigator<T> {
                 })?;
                 // The rotation since the pending block's end, by the same increments.
                 self.carry = self.carry.compose(&So3::exp(&((g_mid - bias) * dt)));
+                if gyro_clipped {
+                    // The body turned faster than the gyro reads, by an unknown amount: up to
+                    // one more full-scale turn over the interval is taken as 1σ.
+                    let turn = self.config.gyro_range * dt;
+                    if self.filter.widen_attitude(turn, turn).is_err() {
+                        self.failed();
+                    }
+                }
             } else {
                 let w = (g_mid - self.bias_prior) * dt;
                 self.frame = self.frame.compose(&So3::exp(&w)).normalize();
@@ -423,6 +464,11 @@ impl<T: Real> AttitudeNavigator<T> {
         }
         self.report.event = event;
         self.report.fused = Fusions::default();
+        self.report.clipped = gyro_clipped || accel_clipped;
+        if self.report.clipped {
+            self.counters.clipped = self.counters.clipped.saturating_add(1);
+        }
+        self.block.clipped |= accel_clipped;
         // At most one update of the pending block per call (the cost of a call stays that of
         // one update).
         self.fuse_pending_stage();
@@ -488,8 +534,11 @@ impl<T: Real> AttitudeNavigator<T> {
         let stats = self.block.stats(&frame);
         // The velocity over a running block (in free fall nothing is fused: below), from the
         // block's world-frame sums, before the block is emptied.
+        // A block with a clipped accelerometer sample has the wrong specific force: it is not
+        // integrated or fused, and the velocity starts again from the bound.
+        let clipped = self.block.clipped;
         let integrated = match &stats {
-            Some(s) if self.running && tilt::has_direction(&s.accel_body) => {
+            Some(s) if self.running && !clipped && tilt::has_direction(&s.accel_body) => {
                 integrate_block(&mut self.filter, &self.block)
             }
             _ => Ok(()),
@@ -538,6 +587,16 @@ impl<T: Real> AttitudeNavigator<T> {
             &self.velocity_spread,
             self.report.at_rest,
         );
+        if clipped {
+            let sigma = variance.max().sqrt_rn();
+            if self
+                .filter
+                .restart_velocity(Vector3::zeros(), sigma)
+                .is_err()
+            {
+                self.failed();
+            }
+        }
         self.pending = Some(Pending {
             stats,
             variance,
@@ -546,6 +605,7 @@ impl<T: Real> AttitudeNavigator<T> {
             } else {
                 Stage::Gravity
             },
+            clipped,
         });
         self.carry = So3::identity();
     }
@@ -612,6 +672,9 @@ impl<T: Real> AttitudeNavigator<T> {
                 }
                 Some(Stage::Gravity)
             }
+            Stage::Gravity if pending.clipped => {
+                (stats.mag.is_some() && self.magnetic.is_some()).then_some(Stage::HardIron)
+            }
             Stage::Gravity => {
                 let fused = tilt::fuse(
                     filter,
@@ -635,7 +698,26 @@ impl<T: Real> AttitudeNavigator<T> {
                     }
                     Err(_) => c.numerical_failures = c.numerical_failures.saturating_add(1),
                 }
-                (stats.mag.is_some() && self.magnetic.is_some()).then_some(Stage::Heading)
+                (stats.mag.is_some() && self.magnetic.is_some()).then_some(Stage::HardIron)
+            }
+            Stage::HardIron => {
+                let learned = match (self.magnetic.as_mut(), self.config.magnetometer.as_ref()) {
+                    (Some(state), Some(mag)) => state.hard_iron_stage(filter, stats.duration, mag),
+                    _ => Ok(None),
+                };
+                match learned {
+                    Ok(Some(event)) => {
+                        c.new_hard_irons = c.new_hard_irons.saturating_add(1);
+                        report.event = Some(event);
+                        report.magnetic = MagneticStatus::Disturbed;
+                        None
+                    }
+                    Ok(None) => Some(Stage::Heading),
+                    Err(_) => {
+                        c.numerical_failures = c.numerical_failures.saturating_add(1);
+                        Some(Stage::Heading)
+                    }
+                }
             }
             Stage::Heading => {
                 if let (Some(state), Some(mag), Some(ms)) = (
@@ -658,7 +740,9 @@ impl<T: Real> AttitudeNavigator<T> {
                                 MagneticStatus::Disturbed => {
                                     c.magnetic_disturbed = c.magnetic_disturbed.saturating_add(1);
                                 }
-                                MagneticStatus::NotConfigured | MagneticStatus::Waiting => {}
+                                MagneticStatus::NotConfigured
+                                | MagneticStatus::Waiting
+                                | MagneticStatus::Stuck => {}
                             }
                             match event {
                                 Some(Event::HeadingWidened) => {
@@ -666,9 +750,6 @@ impl<T: Real> AttitudeNavigator<T> {
                                 }
                                 Some(Event::NewMagneticField) => {
                                     c.new_fields = c.new_fields.saturating_add(1);
-                                }
-                                Some(Event::NewHardIron) => {
-                                    c.new_hard_irons = c.new_hard_irons.saturating_add(1);
                                 }
                                 _ => {}
                             }
@@ -690,19 +771,19 @@ impl<T: Real> AttitudeNavigator<T> {
 
     /// The validity of tilt and heading from the current covariance.
     fn refresh_validity(&mut self) {
-        let Some(e) = self.estimate() else {
+        let Some((sigma_tilt, sigma_heading)) = self.sigmas() else {
             self.report.tilt = Validity::Invalid(Reason::Starting);
             self.report.heading = Validity::Invalid(Reason::Starting);
             return;
         };
-        self.report.tilt = if e.sigma_tilt <= self.config.tilt_valid_sigma {
+        self.report.tilt = if sigma_tilt <= self.config.tilt_valid_sigma {
             Validity::Valid
         } else {
             Validity::Invalid(Reason::Uncertain)
         };
         self.report.heading = if self.magnetic_reference().is_none() {
             Validity::Invalid(Reason::NoMagnetometer)
-        } else if e.sigma_heading <= self.config.heading_valid_sigma {
+        } else if sigma_heading <= self.config.heading_valid_sigma {
             Validity::Valid
         } else {
             Validity::Invalid(Reason::Uncertain)

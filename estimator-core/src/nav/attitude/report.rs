@@ -57,6 +57,9 @@ pub enum MagneticStatus {
     /// The last block was consistent with the reference but its heading innovation failed
     /// the gate.
     Rejected,
+    /// The magnetometer's samples have repeated bit for bit for `stuck_s` (stuck or
+    /// saturated): not used until they change.
+    Stuck,
 }
 
 /// Something the navigator did on its own in the last call.
@@ -140,6 +143,10 @@ pub struct AttitudeReport<T: Real> {
     pub event: Option<Event>,
     /// The updates made in this call.
     pub fused: Fusions<T>,
+    /// This call's IMU sample was at the rail of the gyro or the accelerometer (`gyro_range`,
+    /// `accel_range`): a clipped gyro widens the attitude by a full-scale turn over its
+    /// interval; a clipped accelerometer's block is not fused and the velocity starts again.
+    pub clipped: bool,
 }
 
 /// The attitude estimate with its uncertainty.
@@ -194,6 +201,10 @@ pub struct Counters {
     pub new_fields: u32,
     /// New magnetometer offsets (hard iron) learned.
     pub new_hard_irons: u32,
+    /// IMU samples at the rail of the gyro or the accelerometer.
+    pub clipped: u32,
+    /// Magnetometer samples not used because they repeated (stuck).
+    pub magnetometer_stuck: u32,
     /// Updates the filter refused (a numerical failure; the filter was left as it was and
     /// the update skipped).
     pub numerical_failures: u32,

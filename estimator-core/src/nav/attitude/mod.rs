@@ -78,7 +78,7 @@ use crate::kernels::mat3;
 use crate::lie::{LieGroup, So3};
 use crate::nav::clock::{Clock, Tick};
 use crate::nav::error::NavError;
-use crate::nav::sample::{check_imu, check_vector};
+use crate::nav::sample::{check_imu_range, check_vector};
 use crate::Real;
 use block::Block;
 use magnetic::Magnetic;
@@ -129,18 +129,6 @@ fn integrate_block<T: Real>(
     match block.world_sums() {
         Some((force, frames, duration)) => filter.integrate_velocity(&force, &frames, duration),
         None => Ok(()),
-    }
-}
-
-/// `Ok(true)` when an axis of `v` is within 0.1 % of the sensor's full scale `range` (at its
-/// rail: a 16-bit converter's last 32 codes), `Ok(false)` below; an axis beyond the range by
-/// more than 1 % is no reading the sensor can give: [`NavError::OutOfRange`].
-fn at_rail<T: Real>(v: &Vector3<T>, range: T) -> Result<bool, NavError> {
-    let largest = v.x.abs().max(v.y.abs()).max(v.z.abs());
-    if largest > range * T::lit(1.01) {
-        Err(NavError::OutOfRange)
-    } else {
-        Ok(largest >= range * T::lit(0.999))
     }
 }
 
@@ -418,9 +406,8 @@ impl<T: Real> AttitudeNavigator<T> {
         gyro: &Vector3<T>,
         accel: &Vector3<T>,
     ) -> Result<(), NavError> {
-        check_imu(gyro, accel)?;
-        let gyro_clipped = at_rail(gyro, self.config.gyro_range)?;
-        let accel_clipped = at_rail(accel, self.config.accel_range)?;
+        let (gyro_clipped, accel_clipped) =
+            check_imu_range(gyro, accel, self.config.gyro_range, self.config.accel_range)?;
         let tick = self.imu_clock.tick(t_ns, self.durations.max_step)?;
         let mut event = None;
         let dt_ns = match tick {

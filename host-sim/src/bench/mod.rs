@@ -1235,26 +1235,15 @@ mod tests {
                 .unwrap_or_else(|| panic!("no row {name}:\n{text}"))
                 .to_string()
         };
-        assert!(
-            row("a ").trim_end().ends_with("1.500     0.500"),
-            "{}",
-            row("a ")
-        );
-        assert!(
-            row("b ").trim_end().ends_with("2.000         –"),
-            "{}",
-            row("b ")
-        );
-        assert!(
-            row("c ").trim_end().ends_with("–         –"),
-            "{}",
-            row("c ")
-        );
-        assert!(
-            row("mean").trim_end().ends_with("–         –"),
-            "{}",
-            row("mean")
-        );
+        for (name, last_columns) in [
+            ("a ", "1.500     0.500"),
+            ("b ", "2.000         –"),
+            ("c ", "–         –"),
+            ("mean", "–         –"),
+        ] {
+            let r = row(name);
+            assert!(r.trim_end().ends_with(last_columns), "{r}");
+        }
         assert!(text.contains("no VQF 6D figure for b, c"), "{text}");
         assert!(
             text.contains("c: the run without the magnetometer failed: boom"),

@@ -362,6 +362,8 @@ for v in demo3:$DEMO3 demo_s:$DEMOS nopanic3:target/$TARGET/release/nopanic \
   echo "$name: vector_table $vt text $text rodata $ro data $data bss $bss ($elf)"
   echo "flash.$name $((vt + text + ro + data))" >> "$OUT/extra.txt"
   echo "bss.$name $((bss))" >> "$OUT/extra.txt"
+  # Alignment padding between functions: the part of flash that moves with the checkout's path.
+  echo "padding.$name $(python3 tools/text_padding.py "$elf")" >> "$OUT/extra.txt"
 done
 echo "-- opt-level \"s\" (stack budgeted in firmware/budgets-s.txt; instruction counts informational)"
 if ! python3 tools/check_budgets.py budgets-s.txt "$OUT/demo-s.txt" "$OUT/icount-s.txt" > "$OUT/budgets-s.out"; then

@@ -627,6 +627,28 @@ fn an_invalid_configuration_is_refused() {
         AttitudeNavigator::new(c).err(),
         Some(NavError::InvalidConfig)
     );
+    // The magnetometer's delay: not negative, at most 0.25 s, within the bound it is learned
+    // up to (where it is learned).
+    for (delay, max, valid) in [
+        (-0.001, 0.05, false),
+        (0.3, 0.0, false),
+        (0.0, 0.3, false),
+        (0.06, 0.05, false),
+        (0.06, 0.0, true),
+        (0.01, 0.05, true),
+        (f64::NAN, 0.05, false),
+    ] {
+        let mut c = config();
+        let mut m = MagneticConfig::new(0.5, None);
+        m.delay_s = delay;
+        m.delay_max_s = max;
+        c.magnetometer = Some(m);
+        assert_eq!(
+            AttitudeNavigator::new(c).is_ok(),
+            valid,
+            "delay {delay} s, learned up to {max} s"
+        );
+    }
 }
 
 #[test]

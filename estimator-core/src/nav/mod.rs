@@ -40,6 +40,7 @@
 //! | `magnetometer.fusion` (`Heading`) | heading only, or the whole field | `Vector` only for a calibrated magnetometer in a clean field (it then also corrects the tilt) |
 //! | `max_rejected_blocks` (8) | how many rejected blocks in a row before the estimate is taken for wrong | lower recovers faster from a wrong estimate, higher resists long disturbances |
 //! | `gyro_range`, `accel_range` (±2000 °/s, ±16 g) | the sensors' full scale: a sample at the rail is flagged (`AttitudeReport::clipped`), a clipped gyro widens the attitude by a full-scale turn over its interval, a clipped accelerometer's block is not fused; a sample beyond the scale by more than 1 % is refused | the range the IMU is configured to |
+//! | `magnetometer.delay_s` (0), `delay_max_s` (50 ms) | the magnetometer's delay behind the gyro (its conversion and output filter), learned between 0 and `delay_max_s` from blocks that turn fast enough about the vertical for the largest delay to show above a block's heading noise; each sample is rotated with the frame of its true time | `delay_s`: a delay measured beforehand; `delay_max_s = 0` for a magnetometer sampled with the gyro |
 //! | `magnetometer.stuck_s` (0.5 s) | a magnetometer repeating its sample bit for bit this long is stuck or saturated (`MagneticStatus::Stuck`): not used until it changes | above the magnetometer's output interval |
 //! | `tilt_valid_sigma`, `heading_valid_sigma` (5°, 10°) | when the report calls a quantity valid | what the application can use |
 //!

@@ -220,7 +220,7 @@ fn write_all(sc: &Scenario, traj: &Trajectory, seed: u64, out: &Out) -> Result<(
         let mut mag = Mag::new(c.clone(), Noise::new(seed, STREAM_MAG));
         for j in 0..samples(sc.duration_s, c.rate_hz) {
             let ns = stamp_ns(t0, j, c.rate_hz);
-            let m = mag.sample(&at((ns - t0) as f64 * 1e-9));
+            let m = mag.sample(&at(((ns - t0) as f64 * 1e-9 - c.delay_s).max(0.0)));
             writeln!(f, "{ns},{:.6},{:.6},{:.6}", m.x, m.y, m.z).map_err(io(&path))?;
         }
         f.flush().map_err(io(&path))?;

@@ -46,6 +46,8 @@ pub(super) fn navigator_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> Att
         mc.heading_noise = T::lit(cfg.heading_noise_deg.to_radians());
         mc.heading_floor = T::lit(cfg.heading_floor_deg.to_radians());
         mc.hard_iron = cfg.magnetometer_hard_iron;
+        mc.delay_s = T::lit(cfg.magnetometer_delay_s);
+        mc.delay_max_s = T::lit(cfg.magnetometer_delay_max_s);
         if cfg.magnetometer_vector {
             mc.fusion = MagneticFusion::Vector;
         }

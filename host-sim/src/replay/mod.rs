@@ -77,6 +77,12 @@ pub struct ReplayConfig {
     /// frame: a magnet or a battery on the board) while the body turns, and take it off every
     /// sample.
     pub magnetometer_hard_iron: bool,
+    /// Attitude navigator: the magnetometer's delay behind the gyro known beforehand, s (a
+    /// sample stamped `t` is the field at `t − delay`); where it is learned, where it starts.
+    pub magnetometer_delay_s: f64,
+    /// Attitude navigator: the largest magnetometer delay learned while the body turns about
+    /// the vertical, s; 0: not learned (it stays `magnetometer_delay_s`).
+    pub magnetometer_delay_max_s: f64,
     /// Attitude navigator: the body only rotates in place (no linear acceleration).
     pub rotation_only: bool,
     /// Attitude navigator: memory of the velocity spread, s.
@@ -156,10 +162,28 @@ impl ReplayConfig {
             ("gyro_scale_sigma", self.gyro_scale_sigma),
             ("heading_noise_deg", self.heading_noise_deg),
             ("heading_floor_deg", self.heading_floor_deg),
+            ("magnetometer_delay_s", self.magnetometer_delay_s),
+            ("magnetometer_delay_max_s", self.magnetometer_delay_max_s),
         ] {
             if !(x.is_finite() && x >= 0.0) {
                 return Err(format!("{name} = {x}: must be 0 or more"));
             }
+        }
+        for (name, x) in [
+            ("magnetometer_delay_s", self.magnetometer_delay_s),
+            ("magnetometer_delay_max_s", self.magnetometer_delay_max_s),
+        ] {
+            if x > 0.25 {
+                return Err(format!("{name} = {x}: must be at most 0.25 s"));
+            }
+        }
+        if self.magnetometer_delay_max_s > 0.0
+            && self.magnetometer_delay_s > self.magnetometer_delay_max_s
+        {
+            return Err(format!(
+                "magnetometer_delay_s = {}: must not exceed magnetometer_delay_max_s = {}",
+                self.magnetometer_delay_s, self.magnetometer_delay_max_s
+            ));
         }
         for (name, x) in [
             ("align_window_s", self.align_window_s),
@@ -212,6 +236,8 @@ impl Default for ReplayConfig {
             use_magnetometer: true,
             magnetometer_vector: false,
             magnetometer_hard_iron: true,
+            magnetometer_delay_s: 0.0,
+            magnetometer_delay_max_s: 0.05,
             accelerometer_bias_sigma: 0.1,
             gyro_bias_sigma_dps: 0.5,
             gyro_scale_sigma: 0.005,

@@ -4,7 +4,8 @@
 //! iron, µT, from `hard_iron_from_s` on), `d(t)` a world-frame disturbance that is non-zero during episodes (a steel structure
 //! nearby), `σ` the per-sample white noise (µT), and `R_z(α)` a rotation by `α` about the body z
 //! axis, the identity outside `rotated` intervals (a sensor remounted or its axes mislabelled).
-//! Defaults: an ICM-20948 class magnetometer (AK09916: 0.15 µT/LSB, about 0.4 µT rms noise) under
+//! A sample stamped `t` is taken at the true state of `t − delay_s` (the sensor's delay
+//! behind the IMU). Defaults: an ICM-20948 class magnetometer (AK09916: 0.15 µT/LSB, about 0.4 µT rms noise) under
 //! a mid-latitude field of 48 µT, 60° inclination, with calibrated (zero) iron terms and no
 //! faults.
 
@@ -34,6 +35,9 @@ pub struct MagConfig {
     pub soft_iron: [f64; 9],
     /// Disturbance episodes `[start_s, end_s, magnitude_uT]`, a world-frame field along east.
     pub disturbances: Vec<[f64; 3]>,
+    /// How long the sample lags its timestamp, s: the row stamped `t` is the field at
+    /// `t − delay_s` (a magnetometer's conversion and output filter, behind the IMU's stamps).
+    pub delay_s: f64,
     /// Rotated output `[start_s, end_s, angle_deg]`: a sample taken in `[start_s, end_s)`
     /// (seconds from the scenario's start) is rotated by `angle_deg` about the body z axis,
     /// `(x, y) ← (x cos α − y sin α, x sin α + y cos α)` (overlapping intervals add).
@@ -51,6 +55,7 @@ impl Default for MagConfig {
             hard_iron_from_s: 0.0,
             soft_iron: [0.0; 9],
             disturbances: Vec::new(),
+            delay_s: 0.0,
             rotated: Vec::new(),
         }
     }

@@ -59,12 +59,25 @@ pub struct MagneticConfig<T: Real> {
     /// How fast the offset may drift, as a fraction of the field's norm per √s (a random
     /// walk).
     pub hard_iron_drift: T,
+    /// The magnetometer's delay behind the gyro known beforehand, s: a sample stamped `t` is
+    /// the field at `t − delay_s` (its conversion and output filter). Where the delay is
+    /// learned (`delay_max_s > 0`), the value it starts from.
+    pub delay_s: T,
+    /// The largest delay learned, s; 0: the delay is not learned and stays `delay_s`. The
+    /// delay is learned from the heading innovations while the body turns about the vertical
+    /// (the `magnetic` module of the navigator).
+    pub delay_max_s: T,
     /// A magnetometer whose samples repeat bit for bit for this long, s, is stuck or saturated
     /// (its noise alone changes the last bits of a working one; one that holds its output
     /// between conversions repeats it for one output interval): its samples are not used
     /// until they change.
     pub stuck_s: T,
 }
+
+/// The longest magnetometer delay a configuration may give, s: the frame of a delayed sample
+/// is carried back from the newest IMU sample by its rate, which holds over a fraction of a
+/// second, not longer.
+const MAX_DELAY_S: f64 = 0.25;
 
 impl<T: Real> MagneticConfig<T> {
     /// A magnetometer with white noise `sigma` per axis and an optional reference; the other
@@ -74,7 +87,10 @@ impl<T: Real> MagneticConfig<T> {
     /// magnetometer's residual offset: about 1.5 µT of the Earth's 25–65 µT), a bound of 3 times
     /// the field (a magnet that strong at the sensor is a fault of the board, and near the
     /// range of a MEMS magnetometer), and a drift of 0.1 % of the field per √s (1 % in 100 s:
-    /// a magnet's field changes by about 0.1 %/K, a battery's with its current).
+    /// a magnet's field changes by about 0.1 %/K, a battery's with its current); the delay
+    /// behind the gyro learned from 0 up to 50 ms (a MEMS magnetometer's conversion and output
+    /// filter at the 20 Hz and faster output rates used beside an IMU: one output interval at
+    /// most).
     #[must_use]
     pub fn new(sigma: T, reference: Option<Vector3<T>>) -> Self {
         Self {
@@ -91,6 +107,8 @@ impl<T: Real> MagneticConfig<T> {
             hard_iron_sigma: T::lit(0.03),
             hard_iron_max: T::lit(3.0),
             hard_iron_drift: T::lit(0.001),
+            delay_s: T::zero(),
+            delay_max_s: T::lit(0.05),
             stuck_s: T::lit(0.5),
         }
     }
@@ -111,6 +129,11 @@ impl<T: Real> MagneticConfig<T> {
             && positive_finite(self.hard_iron_sigma)
             && positive_finite(self.hard_iron_max)
             && non_negative_finite(self.hard_iron_drift)
+            && non_negative_finite(self.delay_s)
+            && non_negative_finite(self.delay_max_s)
+            && self.delay_s <= T::lit(MAX_DELAY_S)
+            && self.delay_max_s <= T::lit(MAX_DELAY_S)
+            && (self.delay_max_s == T::zero() || self.delay_s <= self.delay_max_s)
             && positive_finite(self.stuck_s)
             && self.stuck_s < T::lit(4.0);
         if ok {

@@ -34,6 +34,29 @@
 //! ([`Magnetometer`], per axis `σ² = σ_m²/n + ‖c_h‖² N_hd²/T`), which also corrects the tilt:
 //! for a calibrated magnetometer in a clean field.
 //!
+//! **The magnetometer's delay.** A sample stamped `t` that is the field at `t − τ` (the
+//! magnetometer's conversion and output filter, behind the gyro) is seen in the world, with
+//! the frame at `t`, turned by `τ ω_w` (`ω_w` the world-frame rate): its azimuth is off by
+//! `τ ω_up`, the rate about the vertical, which during fast turns is degrees (2.9° at 800 °/s
+//! and 3.5 ms). Each sample is therefore rotated with the frame at `t − τ̂`, carried back from
+//! the newest IMU sample by its rate, and `τ̂` is learned from every fused block: its heading
+//! innovation is `ν = −(τ − τ̂) r + e`, with `r` the block's mean rate about the vertical
+//! (`(ω̄ − b̂_g)·u_b`, `u_b` the up direction in the body) and `e` of the innovation's variance
+//! `S = P_ψψ + σ_ψ²` (the predicted heading's and the block's, `σ_ψ²` above), so the
+//! least-squares estimate with the prior `τ̂₀ = delay_s`, `σ₀ = delay_max_s`, is updated block
+//! by block as
+//!
+//! ```text
+//! I⁺ = I + r²/S,      τ̂⁺ = τ̂ − ν r / (S I⁺),      clamped to [0, delay_max_s]
+//! ```
+//!
+//! (`I = 1/σ₀²` at first), from the blocks where the largest delay would show above the
+//! innovation's noise, `(delay_max_s · r)² ≥ S`: slower turns carry less of the delay than
+//! of the heading errors that also follow the turns (an offset not yet learned, the gyro's
+//! scale). Turning about the vertical one way and the other makes it observable; a body that
+//! does not turn fast leaves it where it was. A new hard iron starts it again from its prior
+//! information. `delay_max_s = 0` keeps it at `delay_s`.
+//!
 //! **A new field.** A disturbed but steady field that stays the same (norm and dip within the
 //! tolerances of the first disturbed block) for `new_field_s`, while the body turned at a mean
 //! rate of at least `new_field_min_rate`, is taken as the new reference: its norm and dip, with
@@ -45,7 +68,7 @@ use super::config::{AttitudeConfig, MagneticConfig, MagneticFusion};
 use super::hard_iron::{HardIron, HardIronOutcome};
 use super::report::{Event, Fusion, MagneticStatus};
 use super::tilt::{recovery_options, world_attitude_covariance};
-use crate::eskf::{AhrsAccelBias, MagneticHeading, Magnetometer, UpdateOptions};
+use crate::eskf::{up_direction, AhrsAccelBias, MagneticHeading, Magnetometer, UpdateOptions};
 use crate::kernels::mat3;
 use crate::lie::LieGroup;
 use crate::nav::error::NavError;
@@ -56,6 +79,37 @@ use nalgebra::Vector3;
 fn norm_dip<T: Real>(c: &Vector3<T>) -> (T, T, T) {
     let h = (c.x * c.x + c.y * c.y).sqrt_rn();
     (mat3::norm(c), h, c.z.arctan2(h))
+}
+
+/// The heading innovation of a block whose field is `c` in the world, wrapped to `(−π, π]`:
+/// the reference's azimuth less the block's, `atan2(r_y c_x − r_x c_y, r_x c_x + r_y c_y)`
+/// (the sine and cosine of the difference of the two azimuths, times the two horizontal
+/// norms).
+fn heading_innovation<T: Real>(c: &Vector3<T>, reference: &Vector3<T>) -> T {
+    (reference.y * c.x - reference.x * c.y).arctan2(reference.x * c.x + reference.y * c.y)
+}
+
+/// The mean rate about the vertical of a block whose mean gyro is `gyro_mean`, rad/s:
+/// `(ω̄ − b̂_g)·u_b`, `u_b` the up direction in the body. Out of line: its vectors stay out of
+/// the caller's frame.
+#[inline(never)]
+pub(super) fn rate_up<T: Real>(
+    filter: &AhrsAccelBias<T>,
+    gyro_mean: &Vector3<T>,
+    gravity: &Vector3<T>,
+) -> T {
+    let up = up_direction(gravity).unwrap_or_else(Vector3::zeros);
+    let state = filter.state();
+    (gyro_mean - state.gyro_bias).dot(&state.attitude.inverse().act(&up))
+}
+
+/// How the body turned during a block: its length, s, the angle it turned by, rad, and its
+/// mean rate about the vertical, rad/s (counter-clockwise seen from above positive).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Turn<T: Real> {
+    pub(super) duration: T,
+    pub(super) rotation: T,
+    pub(super) rate_up: T,
 }
 
 /// What one block of the magnetometer did: its status, the heading update (if one was made)
@@ -80,6 +134,10 @@ pub(super) struct Magnetic<T: Real> {
     pub(super) fused_since_start: bool,
     /// The last sample and when it was first read, ns (a stuck magnetometer repeats it).
     last: Option<(Vector3<T>, u64)>,
+    /// The magnetometer's delay behind the gyro, s, as learned (module docs).
+    pub(super) delay: T,
+    /// What the delay is known with, s⁻²: the inverse of its variance.
+    delay_information: T,
 }
 
 /// A run of gated-out heading innovations.
@@ -133,6 +191,12 @@ impl<T: Real> Magnetic<T> {
             hard_iron: HardIron::new(),
             fused_since_start: false,
             last: None,
+            delay: config.delay_s,
+            delay_information: if config.delay_max_s > T::zero() {
+                T::one() / (config.delay_max_s * config.delay_max_s)
+            } else {
+                T::zero()
+            },
         }
     }
 
@@ -169,18 +233,18 @@ impl<T: Real> Magnetic<T> {
         Vector3::new(T::zero(), h, c.z)
     }
 
-    /// Fuses one block's magnetometer samples (a block of `duration` s during which the body
-    /// turned by `rotation` rad).
+    /// Fuses one block's magnetometer samples (a block of `turn.duration` s during which the
+    /// body turned by `turn.rotation` rad, at `turn.rate_up` rad/s about the vertical).
     #[inline(never)] // its own stack frame, not the caller's
     pub(super) fn fuse(
         &mut self,
         filter: &mut AhrsAccelBias<T>,
         stats: &MagStats<T>,
-        duration: T,
-        rotation: T,
+        turn: &Turn<T>,
         config: &AttitudeConfig<T>,
         mag: &MagneticConfig<T>,
     ) -> Result<Outcome<T>, NavError> {
+        let (duration, rotation) = (turn.duration, turn.rotation);
         let (m_body, n) = (&stats.body, stats.n);
         let c = filter.state().attitude.act(m_body);
         let Some(reference) = self.reference else {
@@ -220,12 +284,11 @@ impl<T: Real> Magnetic<T> {
                 Fusion::from(filter.update(&vector, &options)?)
             }
         };
+        let innovation = heading_innovation(&c, &reference);
         if fusion.accepted {
             self.fused_since_start = true;
             self.rejected = Rejections::none();
         } else {
-            let (s, co) = (reference.y.arctan2(reference.x) - c.y.arctan2(c.x)).sincos();
-            let innovation = s.arctan2(co);
             self.rejected.add(innovation, rotation);
             let run = &self.rejected;
             // The estimate is what is wrong when the magnetometer keeps telling the same heading
@@ -242,6 +305,14 @@ impl<T: Real> Magnetic<T> {
             }
         }
         let w = world_attitude_covariance(filter);
+        if fusion.accepted {
+            // The innovation's variance `S = P_ψψ + σ_ψ²` from the heading's variance after the
+            // update, `P⁺ = P_ψψ σ_ψ² / (P_ψψ + σ_ψ²)`: `S = σ_ψ⁴ / (σ_ψ² − P⁺)`.
+            let margin = var - w.m33;
+            if margin > T::zero() {
+                self.learn_delay(innovation, turn.rate_up, var * var / margin, mag);
+            }
+        }
         let deficit = mag.heading_floor * mag.heading_floor - w.m33;
         if deficit > T::zero() {
             filter.widen_attitude(T::zero(), deficit.sqrt_rn())?;
@@ -252,6 +323,27 @@ impl<T: Real> Magnetic<T> {
             MagneticStatus::Rejected
         };
         Ok((status, Some(fusion), event))
+    }
+
+    /// One block's step of the delay's least squares (module docs): heading innovation `ν`,
+    /// rate about the vertical `r`, the innovation's variance `S` (the predicted heading's and
+    /// the block's).
+    fn learn_delay(&mut self, innovation: T, rate_up: T, variance: T, mag: &MagneticConfig<T>) {
+        let shown = mag.delay_max_s * rate_up;
+        if !(mag.delay_max_s > T::zero() && variance > T::zero() && shown * shown >= variance) {
+            return;
+        }
+        let information = self.delay_information + rate_up * rate_up / variance;
+        let delay = self.delay - innovation * rate_up / (variance * information);
+        if crate::kernels::positive_finite(information) && delay.is_finite() {
+            let below_max = if delay < mag.delay_max_s {
+                delay
+            } else {
+                mag.delay_max_s
+            };
+            self.delay_information = information;
+            self.delay = crate::kernels::larger(T::zero(), below_max);
+        }
     }
 
     /// The hard iron's part of a block (its own update, before the heading's): the offset
@@ -278,6 +370,13 @@ impl<T: Real> Magnetic<T> {
             return Ok(None);
         }
         self.candidate = None;
+        // The delay was learned from fields read with the old offset, whose error turns with
+        // the body as a delay's does: it is learned again from its prior (from where it is).
+        self.delay_information = if mag.delay_max_s > T::zero() {
+            T::one() / (mag.delay_max_s * mag.delay_max_s)
+        } else {
+            T::zero()
+        };
         if let (Some(reference), false) = (self.reference, self.fused_since_start) {
             let (_, horizontal, _) = norm_dip(&reference);
             if crate::kernels::positive_finite(horizontal) {

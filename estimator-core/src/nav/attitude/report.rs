@@ -170,6 +170,9 @@ pub struct AttitudeEstimate<T: Real> {
     /// Its 1σ per axis: small once the body has turned about two axes; it grows slowly while
     /// the body does not turn (the offset is then frozen).
     pub sigma_hard_iron: Vector3<T>,
+    /// The magnetometer's delay behind the gyro, s, as learned while the body turns about the
+    /// vertical (zero without a magnetometer).
+    pub magnetometer_delay_s: T,
 }
 
 /// Counts since construction, for logs and summaries.

@@ -413,9 +413,9 @@ pub fn builtin_scenarios() -> Vec<Scenario> {
             description: "noise exactly as the filter models it (Monte-Carlo consistency); hand-held rotation in place, IMU, magnetometer".into(),
             shape: "rotate".into(),
             // In place, with an accelerometer bias drawn from the navigator's prior, no gyro scale
-            // error and an ideal magnetometer (its whole field fused, sampled with the gyro: no
-            // delay to learn): nothing beyond what the navigator models.
-            replay: ReplayConfig { rotation_only: true, magnetometer_vector: true, magnetometer_delay_max_s: 0.0, accelerometer_bias_sigma: 0.05, gyro_scale_sigma: 0.0, heading_floor_deg: 0.0, heading_noise_deg: 0.0, ..ReplayConfig::simulated() },
+            // error and an ideal magnetometer (its whole field fused): nothing beyond what the
+            // navigator models.
+            replay: ReplayConfig { rotation_only: true, magnetometer_vector: true, accelerometer_bias_sigma: 0.05, gyro_scale_sigma: 0.0, heading_floor_deg: 0.0, heading_noise_deg: 0.0, ..ReplayConfig::simulated() },
             imu: ImuConfig { accel_turn_on_bias: 0.05, accelerometer_random_walk: 0.0, ..matched_imu },
             mag: Some(MagConfig::default()),
             ceilings: Ceilings { ate_m: f64::INFINITY, attitude_deg: 1.2 },

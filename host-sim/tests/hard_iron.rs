@@ -3,13 +3,13 @@
 //! whether the magnet was there at power-on or is fixed to the board while it runs, and the
 //! magnetometer then fused again.
 
-use estimator_core::eskf::FilterConfig;
-use estimator_core::lie::{LieGroup, So3};
-use estimator_core::nav::{AttitudeConfig, AttitudeEstimate, AttitudeNavigator, MagneticConfig};
-use host_sim::dataset::read::{Dataset, Event, TruthStream};
+#[path = "common/attitude_run.rs"]
+mod attitude_run;
+
+use estimator_core::lie::LieGroup;
+use estimator_core::nav::AttitudeEstimate;
 use host_sim::dataset::write::simulate;
 use host_sim::scenario::{builtin_scenarios, Scenario, HARD_IRON_UT};
-use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
 
 fn tmp(name: &str) -> PathBuf {
@@ -38,60 +38,17 @@ struct Run {
 
 /// The navigator as host-sim's replay sets it up (f32), driven sample by sample over `ds`.
 fn run(ds: &Path, hard_iron: bool) -> Run {
-    let data = Dataset::open(ds).expect("dataset");
-    let mag = data.mag.as_ref().expect("a magnetometer");
-    let mut config = AttitudeConfig::<f32>::new(FilterConfig::default());
-    config.instantaneous_imu = true;
-    let r = mag.reference_field;
-    let mut mc = MagneticConfig::new(
-        mag.sigma as f32,
-        Some(Vector3::new(r.x as f32, r.y as f32, r.z as f32)),
+    let (nav, late_rmse_deg) = attitude_run::drive(
+        ds,
+        |mc| mc.hard_iron = hard_iron,
+        40.0,
+        |truth, estimate| truth.inverse().compose(estimate).log().norm(),
     );
-    mc.hard_iron = hard_iron;
-    config.magnetometer = Some(mc);
-    let mut nav = AttitudeNavigator::new(config).expect("navigator");
-    let f32v = |v: &Vector3<f64>| Vector3::new(v.x as f32, v.y as f32, v.z as f32);
-    let mut truth = TruthStream::open(ds).expect("truth");
-    let mut row = truth.next_truth().expect("truth row");
-    let (mut sum_sq, mut count) = (0.0, 0u32);
-    let mut first: Option<u64> = None;
-    for ev in data.events().expect("events") {
-        match ev.expect("event") {
-            Event::Imu { t_ns, gyro, accel } => {
-                let _ = nav.imu(t_ns, &f32v(&gyro), &f32v(&accel));
-                while row.as_ref().is_some_and(|r| r.t_ns < t_ns) {
-                    row = truth.next_truth().expect("truth row");
-                }
-                let t0 = *first.get_or_insert(t_ns);
-                let late = t_ns >= t0 + 40_000_000_000;
-                if let (Some(r), Some(e), true) = (row.as_ref(), nav.estimate(), late) {
-                    if r.t_ns == t_ns {
-                        let q = e.attitude.quaternion();
-                        let est = So3::<f64>::from_wxyz(
-                            f64::from(q.w),
-                            f64::from(q.i),
-                            f64::from(q.j),
-                            f64::from(q.k),
-                        )
-                        .expect("unit quaternion");
-                        let err = r.attitude.inverse().compose(&est).log().norm();
-                        sum_sq += err * err;
-                        count += 1;
-                    }
-                }
-            }
-            Event::Mag { t_ns, field } => {
-                let _ = nav.magnetometer(t_ns, &f32v(&field));
-            }
-            _ => {}
-        }
-    }
-    assert!(count > 0);
     Run {
         estimate: nav.estimate().expect("started"),
         learned: nav.counters().new_hard_irons,
         heading_fused: nav.counters().heading_fused,
-        late_rmse_deg: (sum_sq / f64::from(count)).sqrt().to_degrees(),
+        late_rmse_deg,
     }
 }
 

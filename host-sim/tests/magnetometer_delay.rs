@@ -2,15 +2,14 @@
 //! fast about the vertical: a simulated magnetometer whose sample stamped `t` is the field at
 //! `t − 10 ms`, on a body yawing back and forth at up to 540 °/s.
 
-use estimator_core::eskf::FilterConfig;
-use estimator_core::lie::{LieGroup, So3};
-use estimator_core::nav::{AttitudeConfig, AttitudeNavigator, MagneticConfig};
-use host_sim::dataset::read::{Dataset, Event, TruthStream};
+#[path = "common/attitude_run.rs"]
+mod attitude_run;
+
+use estimator_core::lie::LieGroup;
 use host_sim::dataset::write::simulate;
 use host_sim::scenario::{builtin_scenarios, Scenario};
 use host_sim::sensors::mag::MagConfig;
 use host_sim::trajectory::{builtin, Signal, Sine};
-use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
 
 /// The simulated magnetometer's delay, s.
@@ -64,61 +63,20 @@ struct Run {
 /// The navigator (f32) driven sample by sample over `ds`; `learn`: the delay is learned (the
 /// default bound), else held at zero.
 fn run(ds: &Path, learn: bool) -> Run {
-    let data = Dataset::open(ds).expect("dataset");
-    let mag = data.mag.as_ref().expect("a magnetometer");
-    let mut config = AttitudeConfig::<f32>::new(FilterConfig::default());
-    config.instantaneous_imu = true;
-    let r = mag.reference_field;
-    let mut mc = MagneticConfig::new(
-        mag.sigma as f32,
-        Some(Vector3::new(r.x as f32, r.y as f32, r.z as f32)),
+    let (nav, heading_rmse_deg) = attitude_run::drive(
+        ds,
+        |mc| {
+            if !learn {
+                mc.delay_max_s = 0.0;
+            }
+        },
+        30.0,
+        // The world-frame error's rotation about the vertical.
+        |truth, estimate| estimate.compose(&truth.inverse()).log().z,
     );
-    if !learn {
-        mc.delay_max_s = 0.0;
-    }
-    config.magnetometer = Some(mc);
-    let mut nav = AttitudeNavigator::new(config).expect("navigator");
-    let f32v = |v: &Vector3<f64>| Vector3::new(v.x as f32, v.y as f32, v.z as f32);
-    let mut truth = TruthStream::open(ds).expect("truth");
-    let mut row = truth.next_truth().expect("truth row");
-    let (mut sum_sq, mut count) = (0.0, 0u32);
-    let mut first: Option<u64> = None;
-    for ev in data.events().expect("events") {
-        match ev.expect("event") {
-            Event::Imu { t_ns, gyro, accel } => {
-                let _ = nav.imu(t_ns, &f32v(&gyro), &f32v(&accel));
-                while row.as_ref().is_some_and(|r| r.t_ns < t_ns) {
-                    row = truth.next_truth().expect("truth row");
-                }
-                let t0 = *first.get_or_insert(t_ns);
-                let late = t_ns >= t0 + 30_000_000_000;
-                if let (Some(r), Some(e), true) = (row.as_ref(), nav.estimate(), late) {
-                    if r.t_ns == t_ns {
-                        let q = e.attitude.quaternion();
-                        let est = So3::<f64>::from_wxyz(
-                            f64::from(q.w),
-                            f64::from(q.i),
-                            f64::from(q.j),
-                            f64::from(q.k),
-                        )
-                        .expect("unit quaternion");
-                        // The world-frame error's rotation about the vertical.
-                        let world_error = est.compose(&r.attitude.inverse()).log();
-                        sum_sq += world_error.z * world_error.z;
-                        count += 1;
-                    }
-                }
-            }
-            Event::Mag { t_ns, field } => {
-                let _ = nav.magnetometer(t_ns, &f32v(&field));
-            }
-            _ => {}
-        }
-    }
-    assert!(count > 0);
     Run {
         delay_s: f64::from(nav.estimate().expect("started").magnetometer_delay_s),
-        heading_rmse_deg: (sum_sq / f64::from(count)).sqrt().to_degrees(),
+        heading_rmse_deg,
     }
 }
 

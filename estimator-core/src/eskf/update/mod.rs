@@ -48,9 +48,9 @@ use crate::Real;
 use commit::commit;
 use gain::{gate_step, noise_floor, padded_noise, step};
 pub use model::{Linearization, Measurement};
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SMatrix;
 pub use options::UpdateOptions;
-use work::{attitude_part, Gain, Work};
+use work::{attitude_part, Work};
 
 /// Row capacity of the shared update core (see the module docs).
 pub(crate) const CORE_ROWS: usize = 3;
@@ -129,16 +129,7 @@ where
     S: ErrorState<T, N>,
 {
     opts.validate()?;
-    let mut w = Work::<T, N, C> {
-        ht: SMatrix::zeros(),
-        r: SVector::zeros(),
-        g: Gain {
-            w: SMatrix::zeros(),
-            l: SMatrix::identity(),
-        },
-        dx: SVector::zeros(),
-        m,
-    };
+    let mut w = Work::<T, N, C>::new(m);
     if !noise_is_spd::<T, C, N>(noise, m) {
         return Err(EskfError::NoiseNotPositiveDefinite);
     }

@@ -19,6 +19,25 @@ pub(super) struct Work<T: Real, const N: usize, const C: usize> {
 }
 
 /// The gain part of the working set, saved and restored as one block by the iterated update.
+impl<T: Real, const N: usize, const C: usize> Work<T, N, C> {
+    /// Zeros, `L = I`, `m` active rows. Out of line: built inline, the `Gain` is a temporary
+    /// copied into place, which opt-level "s" keeps in the update's frame, on its deepest stack
+    /// path; returned, it is written straight into the caller's slot.
+    #[inline(never)]
+    pub(super) fn new(m: usize) -> Self {
+        Self {
+            ht: SMatrix::zeros(),
+            r: SVector::zeros(),
+            g: Gain {
+                w: SMatrix::zeros(),
+                l: SMatrix::identity(),
+            },
+            dx: SVector::zeros(),
+            m,
+        }
+    }
+}
+
 #[derive(Clone, Copy)]
 pub(super) struct Gain<T: Real, const N: usize, const C: usize> {
     /// `W = P H̃ᵀ L⁻ᵀ` (`U = P H̃ᵀ` while it is computed): `K = W L⁻¹`, `P⁺ = P − W Wᵀ`.

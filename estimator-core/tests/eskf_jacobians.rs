@@ -71,6 +71,7 @@ fn ins_models_match_finite_differences() {
         );
         check("gnss velocity", &GnssVelocity::new(rng.vec3(2.0), 0.1), &x);
         check("zupt", &ZeroVelocity::new(0.01), &x);
+        check("lateral velocity", &LateralVelocity::new(0.05), &x);
         check("baro", &BaroAltitude::new(rng.normal(), 0.5), &x);
         check(
             "magnetometer",

@@ -115,14 +115,24 @@ const ATTITUDE_FLOOR: f64 = 16.0;
 /// ([`ATTITUDE_FLOOR`]) when the smallest eigenvalue of `A` may be below that, else zero. The
 /// caller adds it to the diagonal of `A`, keeping the block representable in the scalar.
 ///
-/// The test is the bound `λ_min ≥ det A / (λ₁ λ₂) ≥ 4 det A / (tr A)²` (the two larger
-/// eigenvalues have a product at most `(tr A / 2)²`), so it costs a determinant, not an
-/// eigen-decomposition. It may floor a block whose smallest eigenvalue is larger; that changes
-/// it by at most `f·tr A`, below the block's own rounding. Adding `c I` to a positive
-/// semi-definite block of a positive semi-definite `P` keeps `P` so, and `c I` is the same in
-/// every frame: the tilt and the heading are widened alike. In `f64` the floor is
-/// `3.6e-15 tr A`: it never acts on a usable filter. In `f32` it acts only when the heading is
-/// unknown, and then keeps the tilt's σ at least `√(f tr A)`: 3.4 mrad when σ_ψ = 2.4 rad.
+/// Two tests, the second only when the first cannot tell:
+///
+/// 1. `λ_min ≥ det A / (λ₁ λ₂) ≥ 4 det A / (tr A)²` (the two larger eigenvalues have a product
+///    at most `(tr A / 2)²`): a determinant, not an eigen-decomposition. It settles every block
+///    whose eigenvalues are of one size (a known heading), but not one where the heading's
+///    eigenvalue is `10⁵` of the tilt's: there `(tr A)²` overstates `λ₁ λ₂` by that ratio, and
+///    the determinant itself, products of the heading's size cancelling to the tilt's, has
+///    lost the tilt to rounding in `f32`.
+/// 2. [`schur_floor`]: the Schur complement of `A` on its largest diagonal entry, computed
+///    from differences of the heading's size, which holds the tilt to `ε tr A / λ_min`.
+///
+/// It may floor a block whose smallest eigenvalue is larger; that changes it by at most
+/// `f·tr A`, below the block's own rounding. Adding `c I` to a positive semi-definite block of
+/// a positive semi-definite `P` keeps `P` so, and `c I` is the same in every frame: the tilt and
+/// the heading are widened alike. In `f64` the floor is `3.6e-15 tr A`: it never acts on a
+/// usable filter. In `f32` it acts when a variance comes within about `4f` of the trace (with an
+/// unknown heading, σ_ψ = 2.4 rad, a tilt σ of about 7 mrad); test 1 alone floored every
+/// prediction of a filter without a heading, a random walk of the tilt of `f tr A` per sample.
 #[inline(never)] // one copy per scalar type, not one per filter and call site
 pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
     let tr = a.m11 + a.m22 + a.m33;
@@ -130,10 +140,41 @@ pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
     // The symmetric block's determinant by cofactors of its first row (upper triangle only).
     let det = a.m11 * (a.m22 * a.m33 - a.m23 * a.m23) - a.m12 * (a.m12 * a.m33 - a.m23 * a.m13)
         + a.m13 * (a.m12 * a.m23 - a.m22 * a.m13);
-    if det * T::lit(4.0) <= floor * tr * tr {
-        floor
+    if det * T::lit(4.0) > floor * tr * tr {
+        return T::zero();
+    }
+    schur_floor(a, floor)
+}
+
+/// Test 2 of [`attitude_floor`]: `floor`, unless the Schur complement of `A` on its largest
+/// diagonal entry `a_kk`, the 2 × 2 block `S = A_rr − a_rk a_rkᵀ / a_kk` (`r` the other two
+/// axes; the second and third pivots of a Cholesky factorization), has `det S > 4 floor tr S`.
+///
+/// The eigenvalues of `S` bound `A`'s from above (`S⁻¹` is a block of `A⁻¹`):
+/// `λ_min(S) ≤ λ_min(A) / (1 − v_k²)` with `v` the eigenvector of `λ_min(A)`, and `v_k² ≤ 3/4`
+/// when `a_kk` is the largest diagonal entry and `λ_min` far below the other two eigenvalues
+/// (the only case the floor is for); with `λ_min(S) ≥ det S / tr S`, `det S > 4 floor tr S`
+/// keeps `λ_min(A)` above the floor. Written without the division, with `M = a_kk S`:
+/// `det M > 4 floor a_kk tr M`. Inlined into [`attitude_floor`], a leaf: a call of its own
+/// would add its frame at the deepest point of every update.
+#[inline(always)]
+fn schur_floor<T: Real>(a: &Matrix3<T>, floor: T) -> T {
+    // (pivot, the two other diagonal entries, their covariances with the pivot, their own).
+    let (p, d1, d2, c1, c2, c12) = if a.m11 >= a.m22 && a.m11 >= a.m33 {
+        (a.m11, a.m22, a.m33, a.m12, a.m13, a.m23)
+    } else if a.m22 >= a.m33 {
+        (a.m22, a.m11, a.m33, a.m12, a.m23, a.m13)
     } else {
+        (a.m33, a.m11, a.m22, a.m13, a.m23, a.m12)
+    };
+    let m11 = d1 * p - c1 * c1;
+    let m22 = d2 * p - c2 * c2;
+    let m12 = c12 * p - c1 * c2;
+    // A block without a positive diagonal (or with a NaN) fails the comparison: floored.
+    if p > T::zero() && m11 * m22 - m12 * m12 > T::lit(4.0) * floor * p * (m11 + m22) {
         T::zero()
+    } else {
+        floor
     }
 }
 
@@ -286,6 +327,45 @@ fn scale_attitude<T: Real, const N: usize>(p: &mut SMatrix<T, N, N>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The body-frame attitude block of a heading of 1σ `heading` about the body axis `u` and a
+    /// tilt of 1σ `tilt` on the two axes across it.
+    fn heading_and_tilt(u: nalgebra::Vector3<f32>, heading: f32, tilt: f32) -> Matrix3<f32> {
+        let u = u.normalize();
+        Matrix3::identity() * (tilt * tilt) + u * u.transpose() * (heading * heading - tilt * tilt)
+    }
+
+    /// With the heading unknown (σ = 2.4 rad about a tipped axis), a tilt known to 10 mrad is
+    /// far above the block's rounding (`ε tr A` = 8·10⁻⁷ against a variance of 10⁻⁴): no floor,
+    /// where a test through `det A` floors it. A tilt of 1 mrad (10⁻⁶, within `4·16 ε tr A`
+    /// = 3.5·10⁻⁵) is floored; a known heading is not.
+    #[test]
+    fn the_floor_acts_on_the_tilt_only_where_rounding_reaches_it() {
+        let axes = [
+            nalgebra::Vector3::new(1.0f32, 1.0, 0.0),
+            nalgebra::Vector3::new(0.2, -0.3, 1.0),
+            nalgebra::Vector3::new(0.0, 0.0, 1.0),
+            nalgebra::Vector3::new(1.0, 0.0, 0.0),
+        ];
+        for u in axes {
+            let a = heading_and_tilt(u, 2.4, 1e-2);
+            let (tr, floor) = (a.trace(), attitude_resolution(&a));
+            assert!(
+                a.determinant() * 4.0 <= floor * tr * tr,
+                "a test through det A cannot tell ({u:?})"
+            );
+            assert_eq!(attitude_floor(&a), 0.0, "a 10 mrad tilt is kept ({u:?})");
+            let fine = heading_and_tilt(u, 2.4, 1e-3);
+            assert_eq!(
+                attitude_floor(&fine),
+                attitude_resolution(&fine),
+                "1 mrad ({u:?})"
+            );
+        }
+        // A known heading: no floor.
+        let known = heading_and_tilt(nalgebra::Vector3::z(), 2e-2, 1e-2);
+        assert_eq!(attitude_floor(&known), 0.0);
+    }
 
     /// A start whose attitude block is singular to the pivot test but floored (heading unknown,
     /// tilt known, body pitched) is usable; one whose velocity is the position's to a

@@ -534,6 +534,93 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
         self.widen_blocks(&[(3, gyro), (4, accel)])
     }
 
+    /// Turns the attitude about the world's up direction `u = −g/‖g‖` by `turn` (rad, positive
+    /// counter-clockwise seen from above: east towards north in ENU) and replaces what the
+    /// filter knew of its heading by a heading of 1σ `sigma`, uncorrelated with every other
+    /// state: the heading from a source the filter's own aiding does not see (a bank of yaw
+    /// hypotheses resolved by GNSS, an operator's entry). Velocity, position and the biases
+    /// are left as they are.
+    ///
+    /// With the attitude error in the body frame (`R = R̂ Exp(δθ)`), the heading error is
+    /// `u_bᵀ δθ`, `u_b = R̂ᵀ u` (unchanged by the turn), and the reset maps the error to
+    /// `δθ⁺ = (I − u_b u_bᵀ) δθ + u_b η`, `η ~ N(0, σ²)`:
+    ///
+    /// ```text
+    /// R̂⁺ = Exp(turn · u) R̂,    P⁺ = T P Tᵀ + σ² e eᵀ,    T = blockdiag(I − u_b u_bᵀ, I₁₂),  e = [u_b; 0]
+    /// ```
+    ///
+    /// `T P Tᵀ` is positive semi-definite with `e` its only null direction, which `σ² e eᵀ`
+    /// fills: `P⁺` is positive definite for `σ > 0`. The tilt (the attitude error orthogonal
+    /// to `u_b`) keeps its variance and its covariance with the other states.
+    ///
+    /// ```
+    /// use estimator_core::eskf::{Alignment, FilterConfig, InitialSigmas, Ins};
+    /// use estimator_core::lie::{LieGroup, So3};
+    /// use nalgebra::Vector3;
+    ///
+    /// let start = Alignment {
+    ///     attitude: So3::identity(),
+    ///     gyro_bias: Vector3::zeros(),
+    ///     heading_from_magnetometer: true,
+    /// };
+    /// let sigmas = InitialSigmas::default();
+    /// let mut ins =
+    ///     Ins::<f64>::from_alignment(&start, Vector3::zeros(), &sigmas, FilterConfig::default())
+    ///         .unwrap();
+    /// ins.reset_heading(0.5, 0.02).unwrap();
+    /// let heading = ins.state().attitude.rotation_matrix();
+    /// assert!((heading[(1, 0)].atan2(heading[(0, 0)]) - 0.5).abs() < 1e-12);
+    /// assert!((ins.covariance()[(2, 2)] - 0.02 * 0.02).abs() < 1e-15);
+    /// ```
+    ///
+    /// # Errors
+    /// [`EskfError::NonFinite`] for a non-finite turn, or a sigma whose square is not positive
+    /// or is above the variance ceiling; [`EskfError::ZeroNorm`] for a zero gravity;
+    /// [`EskfError::NumericalFailure`] when the result is not finite. The filter is then
+    /// unchanged.
+    pub fn reset_heading(&mut self, turn: T, sigma: T) -> Result<(), EskfError> {
+        if !(turn.is_finite() && usable_variance(sigma * sigma)) {
+            return Err(EskfError::NonFinite);
+        }
+        let Some(up) = up_direction(&self.config.gravity) else {
+            return Err(EskfError::ZeroNorm);
+        };
+        let attitude = So3::exp(&(up * turn)).compose(&self.state.attitude);
+        let u = mat3::mul_vec(&self.state.attitude.rotation_matrix().transpose(), &up);
+        let project = Matrix3::identity() - u * u.transpose();
+        // T P Tᵀ: the attitude rows, then the attitude columns, multiplied by I − u uᵀ.
+        let mut p = self.covariance;
+        let cols = &mut p.data.0;
+        for col in cols.iter_mut() {
+            if let Some(head) = col.first_chunk_mut::<3>() {
+                *head = mat3::mul_vec(&project, &Vector3::from(*head)).into();
+            }
+        }
+        // Mirror the attitude rows into the attitude columns (column-major: cols[j][i] = P_ij).
+        for j in 0..15 {
+            for k in 0..3 {
+                let v = cols.get(j).and_then(|c| c.get(k)).copied();
+                if let (Some(v), Some(e)) = (v, cols.get_mut(k).and_then(|c| c.get_mut(j))) {
+                    *e = v;
+                }
+            }
+        }
+        // The attitude block itself: (I − u uᵀ) P_θθ (I − u uᵀ) + σ² u uᵀ, made exactly symmetric.
+        let a = mat3::mul(
+            &mat3::mul(&project, &block(&self.covariance, 0, 0)),
+            &project,
+        );
+        let a = (a + a.transpose()) * T::lit(0.5) + u * u.transpose() * (sigma * sigma);
+        let a = a + Matrix3::from_diagonal_element(attitude_floor(&a));
+        set_block(&mut p, 0, 0, &a);
+        if !(attitude.is_finite() && all_finite(p.as_slice())) {
+            return Err(EskfError::NumericalFailure);
+        }
+        self.state.attitude = attitude;
+        self.covariance = p;
+        Ok(())
+    }
+
     /// Adds `σ² I` to each listed diagonal block; checks every sum before the first change.
     fn widen_blocks(&mut self, blocks: &[(usize, T)]) -> Result<(), EskfError> {
         for (b, sigma) in blocks {

@@ -189,8 +189,8 @@ pub use error::{EskfError, UpdateOutcome};
 pub use filter::{Ahrs, AhrsAccelBias, Filter, Ins};
 pub use models::{
     AccelerometerAtRest, BaroAltitude, CameraLandmark, GnssPosition, GnssVelocity,
-    GravityDirection, Heading, MagneticHeading, Magnetometer, PinholeIntrinsics, ZeroRate,
-    ZeroVelocity,
+    GravityDirection, Heading, LateralVelocity, MagneticHeading, Magnetometer, PinholeIntrinsics,
+    ZeroRate, ZeroVelocity,
 };
 pub use state::{AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 pub use update::gate::{Gate, GateProbability, CHI_SQUARE_TABLE};

@@ -1,8 +1,9 @@
 //! `host-sim simulate`: a scenario and a seed into a dataset folder, byte-for-byte reproducible.
 //!
 //! Each sensor is sampled at its own exact times `start + round(j·10⁹/rate)` ns from the analytic
-//! trajectory; the IMU loop also writes the ground truth. The folder is written under a
-//! temporary name and renamed when complete, so a failed run leaves nothing that looks finished.
+//! trajectory, those in `[record_from_s, duration_s]` (see [`Scenario::record_from_s`]); the IMU
+//! loop also writes the ground truth. The folder is written under a temporary name and renamed
+//! when complete, so a failed run leaves nothing that looks finished.
 //!
 //! A scenario with faults also gets `faults.csv` at the dataset root, one interval of the rows
 //! each fault changes a line ([`faults`], read back by [`super::read::read_faults`]); other tools
@@ -38,6 +39,21 @@ pub fn stamp_ns(start_ns: u64, j: u64, rate_hz: f64) -> u64 {
 
 fn samples(duration_s: f64, rate_hz: f64) -> u64 {
     (duration_s * rate_hz).floor() as u64 + 1
+}
+
+/// The indices `j` of the samples of a `rate_hz` stream that `sc` records: those stamped from
+/// `record_from_s` to `duration_s`.
+fn recorded(sc: &Scenario, rate_hz: f64) -> std::ops::Range<u64> {
+    let from_ns = (sc.record_from_s.max(0.0) * 1e9).round() as u64;
+    let mut j = (sc.record_from_s.max(0.0) * rate_hz).ceil() as u64;
+    // Settle the rounding of the stamps: the first j stamped at or after the start.
+    while j > 0 && stamp_ns(0, j - 1, rate_hz) >= from_ns {
+        j -= 1;
+    }
+    while stamp_ns(0, j, rate_hz) < from_ns {
+        j += 1;
+    }
+    j..samples(sc.duration_s, rate_hz)
 }
 
 struct Out {
@@ -148,12 +164,12 @@ pub fn faults(scenario: &Scenario) -> Vec<FaultInterval> {
     if let Some(c) = scenario
         .gnss
         .as_ref()
-        .filter(|c| c.outlier_probability > 0.0)
+        .filter(|c| c.outlier_probability > 0.0 && !recorded(scenario, c.rate_hz).is_empty())
     {
-        let last = samples(scenario.duration_s, c.rate_hz) - 1;
+        let fixes = recorded(scenario, c.rate_hz);
         rows.push(FaultInterval {
-            start_ns: t0,
-            end_ns: stamp_ns(t0, last, c.rate_hz) + 1,
+            start_ns: stamp_ns(t0, fixes.start, c.rate_hz),
+            end_ns: stamp_ns(t0, fixes.end - 1, c.rate_hz) + 1,
             sensor: "gnss".into(),
             kind: "outliers".into(),
         });
@@ -183,7 +199,7 @@ fn write_all(sc: &Scenario, traj: &Trajectory, seed: u64, out: &Out) -> Result<(
     let mut fg = out.create("state_groundtruth_estimate0/data.csv")?;
     writeln!(fi, "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]").map_err(io(&imu_path))?;
     writeln!(fg, "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]").map_err(io(&gt_path))?;
-    for j in 0..samples(sc.duration_s, c.rate_hz) {
+    for j in recorded(sc, c.rate_hz) {
         let ns = stamp_ns(t0, j, c.rate_hz);
         let k = at((ns - t0) as f64 * 1e-9);
         let s = imu.sample(&k);
@@ -218,7 +234,7 @@ fn write_all(sc: &Scenario, traj: &Trajectory, seed: u64, out: &Out) -> Result<(
         let mut f = out.create("mag0/data.csv")?;
         writeln!(f, "#timestamp [ns],m_x [uT],m_y [uT],m_z [uT]").map_err(io(&path))?;
         let mut mag = Mag::new(c.clone(), Noise::new(seed, STREAM_MAG));
-        for j in 0..samples(sc.duration_s, c.rate_hz) {
+        for j in recorded(sc, c.rate_hz) {
             let ns = stamp_ns(t0, j, c.rate_hz);
             let m = mag.sample(&at(((ns - t0) as f64 * 1e-9 - c.delay_s).max(0.0)));
             writeln!(f, "{ns},{:.6},{:.6},{:.6}", m.x, m.y, m.z).map_err(io(&path))?;
@@ -249,7 +265,7 @@ fn write_all(sc: &Scenario, traj: &Trajectory, seed: u64, out: &Out) -> Result<(
         let mut f = out.create("gnss0/data.csv")?;
         writeln!(f, "#timestamp [ns],p_x [m],p_y [m],p_z [m],v_x [m s^-1],v_y [m s^-1],v_z [m s^-1],sigma_p [m],sigma_v [m s^-1]").map_err(io(&path))?;
         let mut gnss = Gnss::new(c.clone(), Noise::new(seed, STREAM_GNSS));
-        for j in 0..samples(sc.duration_s, c.rate_hz) {
+        for j in recorded(sc, c.rate_hz) {
             let ns = stamp_ns(t0, j, c.rate_hz);
             let t = (ns - t0) as f64 * 1e-9;
             if let Some(fix) = gnss.sample(&at((t - c.latency_s).max(0.0)), t) {
@@ -277,7 +293,7 @@ fn write_all(sc: &Scenario, traj: &Trajectory, seed: u64, out: &Out) -> Result<(
         let mut f = out.create("baro0/data.csv")?;
         writeln!(f, "#timestamp [ns],altitude [m]").map_err(io(&path))?;
         let mut baro = Baro::new(c.clone(), Noise::new(seed, STREAM_BARO));
-        for j in 0..samples(sc.duration_s, c.rate_hz) {
+        for j in recorded(sc, c.rate_hz) {
             let ns = stamp_ns(t0, j, c.rate_hz);
             let h = baro.sample(&at((ns - t0) as f64 * 1e-9));
             writeln!(f, "{ns},{h:.4}").map_err(io(&path))?;
@@ -300,7 +316,7 @@ fn write_all(sc: &Scenario, traj: &Trajectory, seed: u64, out: &Out) -> Result<(
                 c.rate_hz, c.resolution[0], c.resolution[1], c.sigma_px
             ),
         )?;
-        let centre = at(0.0).position;
+        let centre = at(sc.record_from_s).position;
         let mut cam = Camera::new(c.clone(), Noise::new(seed, STREAM_CAMERA), centre);
         let lpath = out.dir.join("cam0/landmarks.csv");
         let mut fl = out.create("cam0/landmarks.csv")?;
@@ -312,7 +328,7 @@ fn write_all(sc: &Scenario, traj: &Trajectory, seed: u64, out: &Out) -> Result<(
         let path = out.dir.join("cam0/observations.csv");
         let mut f = out.create("cam0/observations.csv")?;
         writeln!(f, "#timestamp [ns],id,u [px],v [px]").map_err(io(&path))?;
-        for j in 0..samples(sc.duration_s, c.rate_hz) {
+        for j in recorded(sc, c.rate_hz) {
             let ns = stamp_ns(t0, j, c.rate_hz);
             for o in cam.sample(&at((ns - t0) as f64 * 1e-9)) {
                 writeln!(f, "{ns},{},{:.3},{:.3}", o.id, o.pixel.x, o.pixel.y)

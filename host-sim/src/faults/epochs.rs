@@ -20,6 +20,8 @@ pub enum Validity {
     Uncertain,
     /// `no_magnetometer`.
     NoMagnetometer,
+    /// `heading_unresolved`.
+    HeadingUnresolved,
     /// `no_fix`.
     NoFix,
     /// `fixes_disagree`.
@@ -32,11 +34,12 @@ pub enum Validity {
 
 /// `validity.csv`'s validity words, written by the replay and read here: the file's format,
 /// defined once.
-const VALIDITY_WORDS: [(Validity, &str); 8] = [
+const VALIDITY_WORDS: [(Validity, &str); 9] = [
     (Validity::Valid, "valid"),
     (Validity::Starting, "starting"),
     (Validity::Uncertain, "uncertain"),
     (Validity::NoMagnetometer, "no_magnetometer"),
+    (Validity::HeadingUnresolved, "heading_unresolved"),
     (Validity::NoFix, "no_fix"),
     (Validity::FixesDisagree, "fixes_disagree"),
     (Validity::Reset, "reset"),
@@ -70,6 +73,7 @@ impl From<nav::Validity> for Validity {
             nav::Validity::Invalid(Reason::Starting) => Self::Starting,
             nav::Validity::Invalid(Reason::Uncertain) => Self::Uncertain,
             nav::Validity::Invalid(Reason::NoMagnetometer) => Self::NoMagnetometer,
+            nav::Validity::Invalid(Reason::HeadingUnresolved) => Self::HeadingUnresolved,
             nav::Validity::Invalid(Reason::NoFix) => Self::NoFix,
             nav::Validity::Invalid(Reason::FixesDisagree) => Self::FixesDisagree,
             nav::Validity::Invalid(Reason::Reset) => Self::Reset,

@@ -402,8 +402,8 @@ enum Job<'a> {
     /// A scored bench run.
     Bench(&'a Scenario, u64),
     /// A latency variant: its index in [`LatencyResult::ate_m`], the scenario to simulate, the
-    /// configuration, the seed; only the ATE is kept.
-    Ate(usize, &'a Scenario, ReplayConfig, u64),
+    /// configuration (boxed: large beside a bench run's), the seed; only the ATE is kept.
+    Ate(usize, &'a Scenario, Box<ReplayConfig>, u64),
 }
 
 enum JobOut {
@@ -620,8 +620,8 @@ pub fn run(opts: &Options) -> Result<FaultBench, String> {
             ..bench_config(sc)
         };
         for &s in &seeds {
-            jobs.push(Job::Ate(1, sc, on_arrival.clone(), s));
-            jobs.push(Job::Ate(2, zero, bench_config(zero), s));
+            jobs.push(Job::Ate(1, sc, Box::new(on_arrival.clone()), s));
+            jobs.push(Job::Ate(2, zero, Box::new(bench_config(zero)), s));
         }
     }
     let outs = run_pool(&jobs, opts.workers, &opts.scratch, opts.progress)?;

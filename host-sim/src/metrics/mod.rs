@@ -18,6 +18,7 @@
 //! on those two files reproduces the figures; they take 120 bytes per scored sample.
 
 pub mod broad;
+pub mod heading;
 pub mod trajectory;
 
 use crate::dataset::check::DataWarning;
@@ -253,6 +254,8 @@ pub struct Scorer {
     heading_reference: Option<bool>,
     /// Where the run comes from (copied to `metrics.json`).
     pub provenance: Provenance,
+    /// The heading's settling and false-valid tallies ([`heading`]).
+    heading: heading::HeadingAccumulator,
 }
 
 /// Where a run comes from, recorded in `metrics.json`.
@@ -365,6 +368,9 @@ pub struct Metrics {
     pub data_warnings: Vec<DataWarning>,
     /// Where the run comes from.
     pub provenance: Provenance,
+    /// The heading after the first motion, for a navigator's run whose body moves
+    /// ([`heading::HeadingScore`]); `None` (`null`) otherwise.
+    pub heading: Option<heading::HeadingScore>,
 }
 
 impl Scorer {
@@ -450,6 +456,7 @@ impl Scorer {
             truth: written_pose(&truth.position, &truth.attitude),
         });
         let truth_start = *self.truth_start_ns.get_or_insert(truth.t_ns);
+        self.heading.add(e, truth);
         let errs = errors(e, truth);
         if truth.t_ns >= truth_start.saturating_add(AFTER_START_NS) {
             self.after_start.0 += errs[0].norm_squared();
@@ -627,6 +634,7 @@ impl Scorer {
             warnings: self.warnings.clone(),
             data_warnings: self.data_warnings.clone(),
             provenance: self.provenance.clone(),
+            heading: self.heading.score(),
         }
     }
 }

@@ -21,6 +21,7 @@
 
 use crate::dataset::check::collate;
 use crate::dataset::write::simulate;
+use crate::metrics::heading::HeadingScore;
 use crate::metrics::{Metrics, Scorer, BLOCKS};
 use crate::progress::{Mode, Progress};
 use crate::replay::{replay_scored, ReplayConfig};
@@ -197,6 +198,9 @@ impl Report {
                 if r.holds() { "yes" } else { "NO" }
             );
         }
+        if let Some(h) = self.heading_summary() {
+            t.push_str(&h.table());
+        }
         if self.nees.is_empty() && self.nis.is_empty() {
             let _ = writeln!(
                 t,
@@ -247,6 +251,10 @@ impl Report {
         .map(|s| (*s).to_string())
         .collect();
         header.extend(blocks.iter().map(|b| format!("anees_{b}")));
+        let heading = self.per_run.iter().any(|r| r.metrics.heading.is_some());
+        if heading {
+            header.extend(HEADING_COLUMNS.iter().map(|c| (*c).to_string()));
+        }
         for s in &sensors {
             header.extend(
                 ["nis_mean", "accepted", "gated_out", "refused"]
@@ -268,6 +276,9 @@ impl Report {
                     Some(m.velocity_rmse_mps),
                 ];
                 row.extend(blocks.iter().map(|b| m.nees_mean.get(*b).copied()));
+                if heading {
+                    row.extend(heading_cells(m.heading.as_ref()));
+                }
                 for s in &sensors {
                     row.push(m.nis_mean.get(s).copied());
                     row.push(count(&m.updates_accepted, s));
@@ -367,7 +378,7 @@ impl Report {
                     // Counts are whole numbers; write them as integers.
                     let v = match c {
                         Some(n)
-                            if ["accepted_", "gated_out_", "refused_"]
+                            if ["accepted_", "gated_out_", "refused_", "heading_valid_"]
                                 .iter()
                                 .any(|p| name.starts_with(p)) =>
                         {
@@ -390,6 +401,7 @@ impl Report {
             "seeds": self.seeds(),
             "holds": self.holds(),
             "bands": bands,
+            "heading": self.heading_summary().map(|h| h.json()),
             "per_run": per_run,
         })
     }
@@ -410,6 +422,158 @@ impl Report {
             std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
         }
         Ok(())
+    }
+}
+
+/// The heading's columns of `runs.csv` ([`crate::metrics::heading::HeadingScore`]).
+const HEADING_COLUMNS: [&str; 6] = [
+    "heading_valid_after_motion_s",
+    "heading_within_2deg_after_motion_s",
+    "heading_within_5deg_after_motion_s",
+    "heading_max_error_from_60s_deg",
+    "heading_valid_samples",
+    "heading_valid_outside_4sigma",
+];
+
+/// A run's cells under [`HEADING_COLUMNS`].
+fn heading_cells(h: Option<&HeadingScore>) -> Vec<Option<f64>> {
+    let Some(h) = h else {
+        return vec![None; HEADING_COLUMNS.len()];
+    };
+    let settled = |deg: &str| h.settled_after_motion_s.get(deg).copied().flatten();
+    vec![
+        h.valid_after_motion_s,
+        settled("2"),
+        settled("5"),
+        h.max_error_from_60s_deg,
+        Some(h.valid_samples as f64),
+        Some(h.valid_outside_4sigma as f64),
+    ]
+}
+
+/// The heading over the runs whose body moved: the latest of each settling time (with the
+/// runs that never got there), the largest error from 60 s after the first motion, and the
+/// samples reported valid with the heading outside 3σ and 4σ.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeadingSummary {
+    /// Runs with a heading score.
+    pub runs: usize,
+    /// The latest first-valid time after the first motion, s, and the runs never valid.
+    pub valid_after_motion_s: (Option<f64>, usize),
+    /// Per settling threshold (degrees as `"2"`, `"5"`): the latest time after the first
+    /// motion from which the error stayed within it, s, and the runs where it did not end so.
+    pub settled_after_motion_s: Vec<(String, Option<f64>, usize)>,
+    /// The largest heading error from 60 s after the first motion over the runs, degrees.
+    pub max_error_from_60s_deg: Option<f64>,
+    /// Samples reported valid, and those with the heading outside 3σ and 4σ.
+    pub valid_samples: u64,
+    /// See `valid_samples`.
+    pub valid_outside_3sigma: u64,
+    /// See `valid_samples`.
+    pub valid_outside_4sigma: u64,
+}
+
+impl HeadingSummary {
+    fn latest(values: impl Iterator<Item = Option<f64>>) -> (Option<f64>, usize) {
+        let mut latest: Option<f64> = None;
+        let mut never = 0;
+        for v in values {
+            match v {
+                Some(x) => latest = Some(latest.map_or(x, |l| l.max(x))),
+                None => never += 1,
+            }
+        }
+        (latest, never)
+    }
+
+    fn table(&self) -> String {
+        let s = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.1}"));
+        let mut t = format!(
+            "  heading after the first motion ({} runs; latest over the runs, s):\n    reported valid {} (never: {})\n",
+            self.runs,
+            s(self.valid_after_motion_s.0),
+            self.valid_after_motion_s.1
+        );
+        for (deg, latest, never) in &self.settled_after_motion_s {
+            t.push_str(&format!(
+                "    within {deg}° to the end {} (not at the end: {never})\n",
+                s(*latest)
+            ));
+        }
+        t.push_str(&format!(
+            "    largest error from 60 s after the first motion {} °\n    samples reported valid {}, with the heading outside 3σ {} ({:.3} %) and 4σ {} ({:.4} %; a consistent Gaussian filter 0.27 % and 0.0063 %)\n",
+            s(self.max_error_from_60s_deg),
+            self.valid_samples,
+            self.valid_outside_3sigma,
+            100.0 * self.valid_outside_3sigma as f64 / self.valid_samples.max(1) as f64,
+            self.valid_outside_4sigma,
+            100.0 * self.valid_outside_4sigma as f64 / self.valid_samples.max(1) as f64,
+        ));
+        t
+    }
+
+    fn json(&self) -> Value {
+        let settled: Map<String, Value> = self
+            .settled_after_motion_s
+            .iter()
+            .map(|(deg, latest, never)| {
+                (
+                    deg.clone(),
+                    json!({ "latest_s": number(*latest), "runs_not_within_at_end": never }),
+                )
+            })
+            .collect();
+        json!({
+            "runs": self.runs,
+            "valid_after_motion_latest_s": number(self.valid_after_motion_s.0),
+            "runs_never_valid": self.valid_after_motion_s.1,
+            "within_deg_after_motion": settled,
+            "max_error_from_60s_deg": number(self.max_error_from_60s_deg),
+            "valid_samples": self.valid_samples,
+            "valid_outside_3sigma": self.valid_outside_3sigma,
+            "valid_outside_4sigma": self.valid_outside_4sigma,
+        })
+    }
+}
+
+impl Report {
+    /// The heading over the runs ([`HeadingSummary`]); `None` when no run has a heading
+    /// score.
+    #[must_use]
+    pub fn heading_summary(&self) -> Option<HeadingSummary> {
+        let scores: Vec<&HeadingScore> = self
+            .per_run
+            .iter()
+            .filter_map(|r| r.metrics.heading.as_ref())
+            .collect();
+        if scores.is_empty() {
+            return None;
+        }
+        let degs = crate::metrics::heading::SETTLE_DEG.map(|d| format!("{d}"));
+        Some(HeadingSummary {
+            runs: scores.len(),
+            valid_after_motion_s: HeadingSummary::latest(
+                scores.iter().map(|h| h.valid_after_motion_s),
+            ),
+            settled_after_motion_s: degs
+                .iter()
+                .map(|deg| {
+                    let (latest, never) = HeadingSummary::latest(
+                        scores
+                            .iter()
+                            .map(|h| h.settled_after_motion_s.get(deg).copied().flatten()),
+                    );
+                    (deg.clone(), latest, never)
+                })
+                .collect(),
+            max_error_from_60s_deg: scores
+                .iter()
+                .filter_map(|h| h.max_error_from_60s_deg)
+                .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x)))),
+            valid_samples: scores.iter().map(|h| h.valid_samples).sum(),
+            valid_outside_3sigma: scores.iter().map(|h| h.valid_outside_3sigma).sum(),
+            valid_outside_4sigma: scores.iter().map(|h| h.valid_outside_4sigma).sum(),
+        })
     }
 }
 

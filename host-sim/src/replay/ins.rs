@@ -32,6 +32,8 @@ pub(super) fn ins_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> InsConfig
     }
     let mut c = InsConfig::new(attitude);
     c.horizon_s = T::lit(cfg.horizon_s);
+    c.lateral_velocity_sigma =
+        (cfg.lateral_velocity_sigma > 0.0).then(|| T::lit(cfg.lateral_velocity_sigma));
     if let Some(g) = &ds.gnss {
         c.gnss_lever_arm = lit3(&g.lever_arm);
     }
@@ -74,6 +76,7 @@ fn event_word(e: Option<InsEvent>) -> &'static str {
         Some(InsEvent::Started) => "started",
         Some(InsEvent::Realigned) => "realigned",
         Some(InsEvent::PositionReset) => "position_reset",
+        Some(InsEvent::HeadingFromGnss) => "heading_from_gnss",
         Some(InsEvent::ImuFault) => "imu_fault",
     }
 }

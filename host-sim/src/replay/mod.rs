@@ -108,6 +108,11 @@ pub struct ReplayConfig {
     /// INS navigator: how far in the past a measurement may be stamped, s (the filter runs
     /// this far behind the newest IMU sample).
     pub horizon_s: f64,
+    /// INS navigator: the vehicle does not move sideways (a car, a rover): 1σ of its lateral
+    /// body velocity, m/s, with the body's x axis along its track; 0: it may (a drone, a
+    /// hand-held device). Without a magnetometer, this is what finds the heading of a slow
+    /// ground vehicle from its GNSS track.
+    pub lateral_velocity_sigma: f64,
     /// Take every GNSS fix as valid when its row is stamped, ignoring `latency_s` (to see
     /// what the latency costs).
     pub ignore_gnss_latency: bool,
@@ -194,6 +199,12 @@ impl ReplayConfig {
                 return Err(format!("{name} = {x}: must be below 4 s"));
             }
         }
+        if !(self.lateral_velocity_sigma.is_finite() && self.lateral_velocity_sigma >= 0.0) {
+            return Err(format!(
+                "lateral_velocity_sigma = {}: must be a finite value, 0 or more",
+                self.lateral_velocity_sigma
+            ));
+        }
         if !(self.horizon_s.is_finite() && (0.0..=1.0).contains(&self.horizon_s)) {
             return Err(format!(
                 "horizon_s = {}: must be between 0 and 1 s",
@@ -250,6 +261,7 @@ impl Default for ReplayConfig {
             heading_floor_deg: 1.0,
             instantaneous_imu: false,
             horizon_s: 0.3,
+            lateral_velocity_sigma: 0.0,
             ignore_gnss_latency: false,
             plots: true,
         }

@@ -46,6 +46,11 @@ pub struct Scenario {
     pub duration_s: f64,
     /// Static period at the start, s.
     pub static_s: f64,
+    /// When the recording begins, s from the trajectory's start: every sensor stream and the
+    /// ground truth hold only the samples stamped in `[record_from_s, duration_s]`, on the same
+    /// clock (the first stamp is `start_ns` plus this), so a scenario can start while the
+    /// vehicle already moves. Fault times stay in seconds from the trajectory's start.
+    pub record_from_s: f64,
     /// A built-in trajectory shape (see `trajectory::SHAPES`), used when `trajectory` is absent.
     pub shape: String,
     /// An explicit trajectory, overriding `shape`.
@@ -78,6 +83,7 @@ impl Default for Scenario {
             description: String::new(),
             duration_s: 60.0,
             static_s: 5.0,
+            record_from_s: 0.0,
             shape: "figure8".into(),
             trajectory: None,
             gravity: [0.0, 0.0, -9.81],
@@ -143,9 +149,10 @@ impl Scenario {
     }
 
     /// `Ok` when every value is in its domain: a positive finite duration, a non-negative static
-    /// period, positive sensor rates, a finite gravity, fault intervals with finite values and
-    /// `0 ≤ start_s < end_s` (a stuck gyro axis 0, 1 or 2, a positive clipping limit, an outlier
-    /// probability in `[0, 1]`), and a valid replay configuration.
+    /// period, a recording start `0 ≤ record_from_s < duration_s`, positive sensor rates, a
+    /// finite gravity, fault intervals with finite values and `0 ≤ start_s < end_s` (a stuck gyro
+    /// axis 0, 1 or 2, a positive clipping limit, an outlier probability in `[0, 1]`), and a valid
+    /// replay configuration.
     ///
     /// # Errors
     /// The first value out of its domain, named.
@@ -160,6 +167,12 @@ impl Scenario {
         positive("duration_s", self.duration_s)?;
         if !(self.static_s.is_finite() && self.static_s >= 0.0) {
             return Err(format!("static_s = {}: must be 0 or more", self.static_s));
+        }
+        if !(self.record_from_s >= 0.0 && self.record_from_s < self.duration_s) {
+            return Err(format!(
+                "record_from_s = {}: must be 0 or more and below duration_s = {}",
+                self.record_from_s, self.duration_s
+            ));
         }
         if !self.gravity.iter().all(|g| g.is_finite()) {
             return Err("gravity: must be finite".into());
@@ -282,6 +295,9 @@ pub const HARD_IRON_UT: [f64; 3] = [15.0, -10.0, 25.0];
 /// When the magnet of the `handheld_hard_iron` scenario is fixed to the board, s.
 pub const HARD_IRON_FROM_S: f64 = 20.0;
 
+/// When the `rover_moving` scenario's recording begins, s: the rover has been driving for 20 s.
+pub const ROVER_MOVING_FROM_S: f64 = 30.0;
+
 /// The built-in scenarios. `default` is what `host-sim run` runs with no arguments.
 #[must_use]
 pub fn builtin_scenarios() -> Vec<Scenario> {
@@ -297,6 +313,25 @@ pub fn builtin_scenarios() -> Vec<Scenario> {
         ..ImuConfig::default()
     };
     let faults = fault_scenarios(&base);
+    let car = Scenario {
+        name: "car".into(),
+        description: "60 s planar drive on a 15 m circle at 2.5 m/s; IMU, GNSS with 0.3 m lever arm, magnetometer".into(),
+        shape: "car".into(),
+        mag: Some(MagConfig::default()),
+        gnss: Some(GnssConfig { lever_arm: [0.3, 0.0, 0.5], ..GnssConfig::default() }),
+        ceilings: Ceilings { ate_m: 0.6, attitude_deg: 1.5 },
+        ..base.clone()
+    };
+    let rover = Scenario {
+        name: "rover".into(),
+        description: "360 s slow rover on rough ground, 15 m circle at 0.23-0.47 m/s, tilts to ±13°; IMU 200 Hz, GNSS 1.5 m at 5 Hz, no magnetometer".into(),
+        duration_s: 360.0,
+        static_s: 10.0,
+        shape: "rover".into(),
+        gnss: Some(GnssConfig { sigma_horizontal: 1.5, ..GnssConfig::default() }),
+        replay: ReplayConfig { lateral_velocity_sigma: 0.05, ..ReplayConfig::simulated() },
+        ..base.clone()
+    };
     let mut all = vec![
         Scenario {
             name: "default".into(),
@@ -325,14 +360,21 @@ pub fn builtin_scenarios() -> Vec<Scenario> {
             ceilings: Ceilings { ate_m: 0.6, attitude_deg: 1.0 },
             ..base.clone()
         },
+        car.clone(),
         Scenario {
-            name: "car".into(),
-            description: "60 s planar drive on a 15 m circle at 2.5 m/s; IMU, GNSS with 0.3 m lever arm, magnetometer".into(),
-            shape: "car".into(),
-            mag: Some(MagConfig::default()),
-            gnss: Some(GnssConfig { lever_arm: [0.3, 0.0, 0.5], ..GnssConfig::default() }),
-            ceilings: Ceilings { ate_m: 0.6, attitude_deg: 1.5 },
-            ..base.clone()
+            name: "car_no_mag".into(),
+            description: "car without its magnetometer: 60 s planar drive on a 15 m circle at 2.5 m/s; IMU, GNSS with 0.3 m lever arm, no magnetometer".into(),
+            mag: None,
+            ceilings: Ceilings::default(),
+            replay: ReplayConfig { lateral_velocity_sigma: 0.1, ..ReplayConfig::simulated() },
+            ..car
+        },
+        rover.clone(),
+        Scenario {
+            name: "rover_moving".into(),
+            description: "the rover recorded from 30 s, while it drives (never seen at rest): 330 s; IMU 200 Hz, GNSS 1.5 m at 5 Hz, no magnetometer".into(),
+            record_from_s: ROVER_MOVING_FROM_S,
+            ..rover
         },
         Scenario {
             name: "coning".into(),

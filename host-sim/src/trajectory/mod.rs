@@ -1,12 +1,15 @@
 //! Smooth ground-truth trajectories with exact derivatives.
 //!
 //! A trajectory is a position `p(τ)` and ZYX Euler angles `(φ, θ, ψ)(τ)` (roll, pitch, yaw), each a
-//! sum of sinusoids and a linear term in a warped time `τ(t)`. The warp holds `τ = 0` during the
-//! initial static period and then accelerates smoothly to `τ̇ = 1` (a quintic smoothstep on `τ̇`,
-//! so position, velocity and acceleration are continuous), which makes every trajectory start at
-//! rest whatever its shape. Derivatives follow from the chain rule, never from differencing:
+//! sum of sinusoids and a linear term in a warped time `τ(t)`, plus optionally a circular [`Track`]
+//! in `x, y` whose along-track phase `α(τ)` is itself such a signal (a vehicle driving a circle
+//! at a varying speed). The warp holds `τ = 0` during the initial static period and then
+//! accelerates smoothly to `τ̇ = 1` (a quintic smoothstep on `τ̇`, so position, velocity and
+//! acceleration are continuous), which makes every trajectory start at rest whatever its shape. Derivatives follow from the chain rule, never from differencing:
 //!
 //! * `ṗ = p'(τ) τ̇`, `p̈ = p''(τ) τ̇² + p'(τ) τ̈`;
+//! * a track adds `r (sin α, −cos α)` to `(x, y)`, so `(x, y)' = r α' (cos α, sin α)` and
+//!   `(x, y)'' = r α'' (cos α, sin α) + r α'² (−sin α, cos α)`;
 //! * `R = R_z(ψ) R_y(θ) R_x(φ)` maps body into world (`world_from_body`);
 //! * body angular rate `ω_b = [φ̇ − ψ̇ sθ, θ̇ cφ + ψ̇ cθ sφ, −θ̇ sφ + ψ̇ cθ cφ]`.
 //!
@@ -80,6 +83,32 @@ impl Signal {
     }
 }
 
+/// A circle of radius `r` about the origin of `x, y`, driven along: `(x, y) += r (sin α, −cos α)`
+/// with the along-track phase `α(τ)` a [`Signal`] (module docs). The direction of travel is `α`
+/// (for `α' > 0`, counter-clockwise) and the speed along the track `r α'(τ) τ̇`, so a yaw equal
+/// to `α` keeps the body's x axis along the track. Move the circle with the position's offsets.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Track {
+    /// Radius, m.
+    pub radius: f64,
+    /// Along-track phase `α`, rad.
+    pub phase: Signal,
+}
+
+impl Track {
+    /// `(x, y)` and their first two derivatives in `τ`, as `[(x, x', x''), (y, y', y'')]`.
+    fn eval(&self, tau: f64) -> [(f64, f64, f64); 2] {
+        let r = self.radius;
+        let (a, d1, d2) = self.phase.eval(tau);
+        let (sn, cs) = a.sin_cos();
+        [
+            (r * sn, r * d1 * cs, r * (d2 * cs - d1 * d1 * sn)),
+            (-r * cs, r * d1 * sn, r * (d2 * sn + d1 * d1 * cs)),
+        ]
+    }
+}
+
 /// The true state at one instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Kinematics {
@@ -109,6 +138,9 @@ pub struct Trajectory {
     pub position: [Signal; 3],
     /// Roll, pitch, yaw (ZYX), rad.
     pub euler: [Signal; 3],
+    /// A circular track added to `x, y`, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub track: Option<Track>,
 }
 
 impl Trajectory {
@@ -138,8 +170,14 @@ impl Trajectory {
         let mut position = Vector3::zeros();
         let mut velocity = Vector3::zeros();
         let mut acceleration = Vector3::zeros();
+        let track = self.track.as_ref().map(|t| t.eval(tau));
         for (i, s) in self.position.iter().enumerate() {
-            let (v, d1, d2) = s.eval(tau);
+            let (mut v, mut d1, mut d2) = s.eval(tau);
+            if let Some((tv, t1, t2)) = track.and_then(|t| t.get(i).copied()) {
+                v += tv;
+                d1 += t1;
+                d2 += t2;
+            }
             position[i] = v;
             velocity[i] = d1 * dtau;
             acceleration[i] = d2 * dtau * dtau + d1 * ddtau;
@@ -189,6 +227,7 @@ pub fn builtin(shape: &str, static_s: f64) -> Option<Trajectory> {
                 Signal::constant(-0.03),
                 Signal::constant(0.5),
             ],
+            track: None,
         },
         // Hover with small attitude oscillations and a 23–27 Hz vibration of 0.1 mm (about 0.25 g).
         "hover" => Trajectory {
@@ -206,6 +245,7 @@ pub fn builtin(shape: &str, static_s: f64) -> Option<Trajectory> {
                 zero().with(0.05, 0.25, 1.0),
                 Signal::constant(0.3).with(0.4, 0.03, 0.0),
             ],
+            track: None,
         },
         // Figure-eight flight at ~3 m/s with banking.
         "figure8" => {
@@ -223,6 +263,7 @@ pub fn builtin(shape: &str, static_s: f64) -> Option<Trajectory> {
                     zero().with(0.15, 2.0 * f, 0.3),
                     Signal::constant(0.4).with(1.0, f, 1.2),
                 ],
+                track: None,
             }
         }
         // A car-like planar drive: a circle of radius 15 m at ~2.5 m/s with the heading along
@@ -249,6 +290,45 @@ pub fn builtin(shape: &str, static_s: f64) -> Option<Trajectory> {
                     }
                     .with(0.05, 0.2, 0.0),
                 ],
+                track: None,
+            }
+        }
+        // A slow rover on rough ground: a 15 m circle (a `Track`) at 0.35 m/s on average, the
+        // along-track phase α = Ωτ + two sines taking the speed over 0.23–0.47 m/s; yaw = α plus
+        // a 1° crab. Terrain waves of height h at frequency f come with the pitch of their slope
+        // at the mean speed, θ = −ż/v̄ (8° and 5°, body z velocity near zero); roll 8° and 5°.
+        "rover" => {
+            use std::f64::consts::{FRAC_PI_2, TAU};
+            let deg = std::f64::consts::PI / 180.0;
+            let (radius, speed) = (15.0, 0.35);
+            // A speed swing of `dv` m/s at `f` Hz is a phase sine of dv / (r·2πf) rad.
+            let swing = |dv: f64, f: f64| dv / (radius * TAU * f);
+            let phase = Signal {
+                offset: 0.0,
+                rate: speed / radius,
+                sines: vec![],
+            }
+            .with(swing(0.08, 0.02), 0.02, 0.0)
+            .with(swing(0.04, 0.07), 0.07, 1.0);
+            // Height h·sin(2πfτ + p) for a pitch amplitude θ: h = θ·v̄ / 2πf.
+            let terrain = [(8.0 * deg, 0.05, 0.3), (5.0 * deg, 0.2, 2.0)];
+            let mut height = Signal::constant(0.5);
+            let mut pitch = zero();
+            for (theta, f, p) in terrain {
+                height = height.with(theta * speed / (TAU * f), f, p);
+                pitch = pitch.with(-theta, f, p + FRAC_PI_2);
+            }
+            let yaw = phase.clone().with(1.0 * deg, 0.1, 0.5);
+            Trajectory {
+                static_s,
+                ramp_s,
+                position: [zero(), Signal::constant(radius), height],
+                euler: [
+                    zero().with(8.0 * deg, 0.07, 0.0).with(5.0 * deg, 0.29, 1.3),
+                    pitch,
+                    yaw,
+                ],
+                track: Some(Track { radius, phase }),
             }
         }
         // Aggressive coning: roll and pitch in quadrature at 2 Hz, 0.3 rad.
@@ -261,6 +341,7 @@ pub fn builtin(shape: &str, static_s: f64) -> Option<Trajectory> {
                 zero().with(0.3, 2.0, 0.0),
                 Signal::constant(0.2),
             ],
+            track: None,
         },
         // Pitch through ±90°: pitch amplitude 1.9 rad.
         "pitch90" => Trajectory {
@@ -276,6 +357,7 @@ pub fn builtin(shape: &str, static_s: f64) -> Option<Trajectory> {
                 zero().with(1.9, 0.08, 0.0),
                 Signal::constant(0.7).with(0.5, 0.05, 0.0),
             ],
+            track: None,
         },
         // Hand-held-like motion: several incommensurate frequencies on every axis.
         "handheld" => Trajectory {
@@ -301,6 +383,7 @@ pub fn builtin(shape: &str, static_s: f64) -> Option<Trajectory> {
                     .with(1.2, 0.05, 0.0)
                     .with(0.2, 0.6, 0.7),
             ],
+            track: None,
         },
         // The hand-held rotations, in place (no linear acceleration).
         "rotate" => {
@@ -314,8 +397,8 @@ pub fn builtin(shape: &str, static_s: f64) -> Option<Trajectory> {
 }
 
 /// Names of the built-in shapes.
-pub const SHAPES: [&str; 8] = [
-    "static", "hover", "figure8", "car", "coning", "pitch90", "handheld", "rotate",
+pub const SHAPES: [&str; 9] = [
+    "static", "hover", "figure8", "car", "rover", "coning", "pitch90", "handheld", "rotate",
 ];
 
 #[cfg(test)]

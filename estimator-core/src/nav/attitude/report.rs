@@ -14,6 +14,9 @@ pub enum Reason {
     Uncertain,
     /// Heading without a magnetometer: only relative to the start.
     NoMagnetometer,
+    /// Heading without a magnetometer, in an INS: the GNSS track has not yet told it (the
+    /// bank of yaw hypotheses is not yet sure of one).
+    HeadingUnresolved,
     /// No position fix has been fused yet (an INS navigator aligns its attitude meanwhile).
     NoFix,
     /// The position fixes have disagreed with the estimate for the last second or more: one

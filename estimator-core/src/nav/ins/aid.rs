@@ -48,7 +48,7 @@ fn count(c: &mut u32) {
 impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     fn ins_mut(&mut self) -> Option<&mut Ins<T>> {
         match &mut self.mode {
-            Mode::Running(ins) => Some(ins),
+            Mode::Running(ins, _) => Some(ins),
             Mode::Aligning(_) => None,
         }
     }
@@ -192,19 +192,24 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// A GNSS velocity valid at `t_m`, `dt` before the filter's time: the antenna's,
     /// `v + R(ω × ℓ)`, so `z − R((ω_m − b_g) × ℓ) + a dt` with `a = R(f_m − b_a) + g` (the last
     /// interval's rate and specific force) against `h(x) = v` ([`GnssVelocity`]). After a
-    /// position reset, the velocity is reset to it instead.
-    pub(super) fn fuse_gnss_velocity(&mut self, t_m: u64, dt: T, z: Vector3<T>, sigma: T) {
+    /// position reset, the velocity is reset to it instead. Returns that body velocity (`None`
+    /// for a frozen receiver's), which the bank of yaw hypotheses takes too.
+    pub(super) fn fuse_gnss_velocity(
+        &mut self,
+        t_m: u64,
+        dt: T,
+        z: Vector3<T>,
+        sigma: T,
+    ) -> Option<Vector3<T>> {
         let (rate, specific_force, lever) = (
             self.filter_rate,
             self.filter_accel,
             self.config.gnss_lever_arm,
         );
         let (frozen, reset) = (self.gnss.frozen, self.gnss.reset_velocity);
-        let Some(ins) = self.ins_mut() else {
-            return;
-        };
+        let ins = self.ins_mut()?;
         if frozen {
-            return;
+            return None;
         }
         let s = *ins.state();
         let omega = rate - s.gyro_bias;
@@ -216,10 +221,11 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             if !ok {
                 count(&mut self.counters.numerical_failures);
             }
-            return;
+            return Some(body);
         }
         let r = ins.update(&GnssVelocity::new(body, sigma), &UpdateOptions::default());
         self.record(Aiding::GnssVelocity, t_m, r);
+        Some(body)
     }
 
     /// A magnetometer sample valid at `t_m`, `dt` before the filter's time, carried by the

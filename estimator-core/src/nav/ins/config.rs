@@ -47,6 +47,12 @@ pub struct InsConfig<T: Real> {
     pub gyro_bias_valid_sigma: T,
     /// Accelerometer bias valid below this 1σ, m/s².
     pub accel_bias_valid_sigma: T,
+    /// A vehicle that does not move sideways (a car, a rover), with its body `x` axis along
+    /// its track: the 1σ of its lateral body velocity, m/s (slip, crab on rough ground).
+    /// Without a magnetometer, the heading is then found from the GNSS track at any speed
+    /// above the velocity's noise (`nav/ins/yaw.rs`), not only while accelerating. `None`
+    /// (the default): a vehicle that may move sideways (a drone, a hand-held device).
+    pub lateral_velocity_sigma: Option<T>,
 }
 
 impl<T: Real> InsConfig<T> {
@@ -72,13 +78,14 @@ impl<T: Real> InsConfig<T> {
             heading_valid_sigma: T::lit(10.0_f64.to_radians()),
             gyro_bias_valid_sigma: T::lit(0.05_f64.to_radians()),
             accel_bias_valid_sigma: T::lit(0.05),
+            lateral_velocity_sigma: None,
         }
     }
 
     /// `Ok` when every value is in its domain: the attitude configuration valid; `horizon_s`
     /// in `[0, 10]` s; the lever arm finite; ranges, stuck time and
     /// thresholds not negative; `gnss_reset_s` positive; a barometer sigma between 1 mm and
-    /// 1 km.
+    /// 1 km; a lateral velocity sigma between 1 mm/s and 100 m/s.
     ///
     /// # Errors
     /// [`NavError::InvalidConfig`] (or the attitude configuration's error).
@@ -88,6 +95,9 @@ impl<T: Real> InsConfig<T> {
         let baro = self
             .barometer_sigma
             .is_none_or(|s| crate::nav::sample::within_limits(s, 1e-3, 1e3));
+        let lateral = self
+            .lateral_velocity_sigma
+            .is_none_or(|s| crate::nav::sample::within_limits(s, 1e-3, 1e2));
         let non_negative = [
             self.accelerometer_range,
             self.gyro_range,
@@ -103,6 +113,7 @@ impl<T: Real> InsConfig<T> {
         .all(|x| non_negative_finite(*x));
         let ok = horizon
             && baro
+            && lateral
             && non_negative
             && positive_finite(self.gnss_reset_s)
             && self.gnss_reset_s <= T::lit(3600.0)

@@ -127,7 +127,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             .gyro_range
             .max(peak * T::lit(2.0))
             .max(T::lit(STUCK_RATE_FLOOR));
-        let (Mode::Running(ins), Some(interval)) = (&mut self.mode, interval) else {
+        let (Mode::Running(ins, _), Some(interval)) = (&mut self.mode, interval) else {
             return;
         };
         let dt = interval.dt;

@@ -64,11 +64,13 @@ mod aid;
 mod buffer;
 mod config;
 mod faults;
+mod heading;
 mod report;
 mod start;
 mod validity;
 mod vibration;
 mod window;
+mod yaw;
 
 pub use config::InsConfig;
 pub use report::{
@@ -86,8 +88,9 @@ use crate::nav::sample::{check_imu, check_vector, within_limits};
 use crate::nav::{FIX_POSITION_SIGMA, FIX_VELOCITY_SIGMA};
 use crate::Real;
 use buffer::{Aid, AidQueue, FixSigma, ImuRing, QueueError, Queued};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Vector2, Vector3};
 use window::{Increment, Interval};
+use yaw::YawBank;
 
 /// An aiding sensor with nothing due for 2.5 of its own last intervals between measurements
 /// ([`AID_STALE_INTERVALS`]) is [`AidStatus::Stale`]; before an interval is known, for this
@@ -103,7 +106,9 @@ pub const AID_STALE_INTERVALS: u64 = 5;
 #[allow(clippy::large_enum_variant)] // one of the two is always there; they share the space
 enum Mode<T: Real> {
     Aligning(AttitudeNavigator<T>),
-    Running(Ins<T>),
+    /// The INS, and the bank of yaw hypotheses that finds its heading without a magnetometer
+    /// (`nav/ins/yaw.rs`; in the space the alignment used).
+    Running(Ins<T>, YawBank<T>),
 }
 
 /// The GNSS policy's memory.
@@ -402,7 +407,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     #[must_use]
     pub fn filter(&self) -> Option<&Ins<T>> {
         match &self.mode {
-            Mode::Running(ins) => Some(ins),
+            Mode::Running(ins, _) => Some(ins),
             Mode::Aligning(_) => None,
         }
     }
@@ -412,7 +417,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     pub fn aligning(&self) -> Option<&AttitudeNavigator<T>> {
         match &self.mode {
             Mode::Aligning(a) => Some(a),
-            Mode::Running(_) => None,
+            Mode::Running(..) => None,
         }
     }
 
@@ -424,7 +429,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// (`σ_g² T`, `σ_a² T`, `σ_a² T³/3`); the bias blocks are the filter's.
     #[must_use]
     pub fn estimate(&self) -> Option<InsEstimate<T>> {
-        let Mode::Running(ins) = &self.mode else {
+        let Mode::Running(ins, _) = &self.mode else {
             return None;
         };
         let s = ins.state();
@@ -717,16 +722,21 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         self.filter_t = Some(interval.t_ns);
         self.filter_rate = interval.gyro;
         self.filter_accel = interval.accel;
-        if let Mode::Running(ins) = &mut self.mode {
+        if let Mode::Running(ins, bank) = &mut self.mode {
             let imu = ImuSample {
                 gyro: interval.gyro,
                 accel: interval.accel,
                 dt: interval.dt,
             };
+            let before = ins.state().velocity;
             // Every buffered sample passed `check_imu` (finite, within range).
             if ins.predict_finite(&imu).is_err() {
                 self.counters.numerical_failures =
                     self.counters.numerical_failures.saturating_add(1);
+            } else if bank.active() {
+                // The horizontal velocity increment, `(R̂ (f − b̂_a) + g) Δt` east and north.
+                let dv = ins.state().velocity - before;
+                bank.accumulate(&Vector2::new(dv.x, dv.y), interval.dt);
             }
         }
         // The fresh window starts where this one ends; when the filter reaches its start, it
@@ -753,7 +763,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// The biases the output predictor integrates with: the filter's, or the alignment's.
     fn bias(&self) -> (Vector3<T>, Vector3<T>) {
         match &self.mode {
-            Mode::Running(ins) => (ins.state().gyro_bias, ins.state().accel_bias),
+            Mode::Running(ins, _) => (ins.state().gyro_bias, ins.state().accel_bias),
             Mode::Aligning(att) => att
                 .estimate()
                 .map_or((Vector3::zeros(), Vector3::zeros()), |e| {
@@ -799,14 +809,27 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
                 }
                 _ => self.counters.unused = self.counters.unused.saturating_add(1),
             },
-            Mode::Running(_) => match item.aid {
-                Aid::Gnss(position, sigma) => {
-                    self.fuse_gnss(t_f, item.t_ns, dt, position, sigma);
-                }
-                Aid::GnssVelocity(v, sigma) => self.fuse_gnss_velocity(item.t_ns, dt, v, sigma),
-                Aid::Magnetometer(field) => self.fuse_magnetometer(item.t_ns, dt, field),
-                Aid::Barometer(altitude) => self.fuse_barometer(item.t_ns, dt, altitude),
-            },
+            Mode::Running(ins, _) => {
+                let before = ins.state().attitude;
+                let velocity = match item.aid {
+                    Aid::Gnss(position, sigma) => {
+                        self.fuse_gnss(t_f, item.t_ns, dt, position, sigma);
+                        None
+                    }
+                    Aid::GnssVelocity(v, sigma) => self
+                        .fuse_gnss_velocity(item.t_ns, dt, v, sigma)
+                        .map(|body| (body, sigma)),
+                    Aid::Magnetometer(field) => {
+                        self.fuse_magnetometer(item.t_ns, dt, field);
+                        None
+                    }
+                    Aid::Barometer(altitude) => {
+                        self.fuse_barometer(item.t_ns, dt, altitude);
+                        None
+                    }
+                };
+                self.track_heading(&before, velocity);
+            }
         }
     }
 }

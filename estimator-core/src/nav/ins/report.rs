@@ -40,6 +40,10 @@ pub enum InsEvent {
     /// A clipped or stuck IMU sample: the velocity (clipped accelerometer) or the attitude
     /// (stuck or clipped gyro) covariance was widened by what the sample may hide.
     ImuFault,
+    /// Without a magnetometer, the heading was set from the bank of yaw hypotheses that the
+    /// GNSS velocities weigh (`nav/ins/yaw.rs`): first resolved, or the INS's own had grown
+    /// wider than the bank's or disagreed with it.
+    HeadingFromGnss,
 }
 
 /// The validity of each quantity of the estimate.
@@ -152,6 +156,13 @@ pub struct InsCounters {
     pub realigned: u32,
     /// IMU samples taken as clipped or stuck.
     pub imu_faults: u32,
+    /// Headings set from the GNSS track's bank of yaw hypotheses ([`InsEvent::HeadingFromGnss`]).
+    pub heading_resets: u32,
+    /// A ground vehicle's zero lateral velocity ([`crate::eskf::LateralVelocity`]), fused at a
+    /// GNSS velocity.
+    pub lateral_fused: u32,
+    /// … and rejected by the gate (the vehicle slid, or the heading is wrong).
+    pub lateral_rejected: u32,
     /// Updates or predictions the filter refused (a numerical failure: skipped, the filter
     /// left as it was).
     pub numerical_failures: u32,

@@ -2,8 +2,10 @@
 //! IMU gap sends it back to aligning.
 
 use super::buffer::FixSigma;
+use super::heading::UNKNOWN_HEADING_VARIANCE;
 use super::report::{AidStatus, InsEvent};
 use super::window::Increment;
+use super::yaw::YawBank;
 use super::{InsNavigator, Mode, INVALID_START};
 use crate::eskf::Ins;
 use crate::kernels::{all_finite, mat3, positive_finite};
@@ -77,8 +79,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             return;
         }
         let report = att.report();
-        let heading_ready =
-            self.config.attitude.magnetometer.is_none() || report.heading.is_valid();
+        let has_magnetometer = self.config.attitude.magnetometer.is_some();
+        let heading_ready = !has_magnetometer || report.heading.is_valid();
         let (Some(filter), true) = (att.filter(), report.tilt.is_valid() && heading_ready) else {
             self.counters.unused = self.counters.unused.saturating_add(1);
             return;
@@ -107,9 +109,10 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             && positive_finite(square(sigma_v))
             && position_sigma.iter().all(|s| positive_finite(square(*s)));
         let started = if ok {
-            self.mode = Mode::Running(Ins::unstarted(*aligned.config()));
+            let bank = YawBank::new(!has_magnetometer);
+            self.mode = Mode::Running(Ins::unstarted(*aligned.config()), bank);
             match &mut self.mode {
-                Mode::Running(ins) => ins
+                Mode::Running(ins, _) => ins
                     .restart_from_attitude_filter_per_axis(
                         &aligned,
                         &carry,
@@ -129,6 +132,15 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
                                 T::lit(MOVING_YAW_SIGMA),
                             )?;
                             ins.widen_biases(gyro_bias_sigma, accel_bias_sigma)?;
+                        }
+                        if !has_magnetometer {
+                            // The alignment's heading is relative to where it started: the
+                            // INS's is unknown, uniform over the circle, until the GNSS track
+                            // resolves it (`nav/ins/heading.rs`).
+                            ins.reset_heading(
+                                T::zero(),
+                                T::lit(UNKNOWN_HEADING_VARIANCE).sqrt_rn(),
+                            )?;
                         }
                         Ok(())
                     }),

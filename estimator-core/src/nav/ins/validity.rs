@@ -31,7 +31,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// Marks an aid as stale when its last measurement came due more than 2.5 of its own
     /// measurement intervals before the filter's time ([`AID_STALE_NS`] before one is known).
     fn refresh_staleness(&mut self) {
-        let (Some(t_f), Mode::Running(_)) = (self.filter_t, &self.mode) else {
+        let (Some(t_f), Mode::Running(..)) = (self.filter_t, &self.mode) else {
             return;
         };
         let statuses = [
@@ -56,6 +56,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     pub(super) fn refresh_validity(&mut self) {
         self.refresh_staleness();
         let c = &self.config;
+        let unresolved = self.heading_unresolved();
         let v = &mut self.report.validity;
         match &self.mode {
             Mode::Aligning(att) => {
@@ -63,7 +64,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
                 v.tilt = att.report().tilt;
                 v.heading = att.report().heading;
             }
-            Mode::Running(ins) => {
+            Mode::Running(ins, _) => {
                 let p = ins.covariance();
                 let r = ins.state().attitude.rotation_matrix();
                 // The world-frame attitude variances, `W_kk = r_kᵀ P_θθ r_k` with `r_k` row k
@@ -75,7 +76,11 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
                     row.dot(&mat3::mul_vec(&ptt, &row))
                 };
                 v.tilt = within(larger(world(0), world(1)), c.tilt_valid_sigma);
-                v.heading = within(world(2), c.heading_valid_sigma);
+                v.heading = if unresolved {
+                    Validity::Invalid(Reason::HeadingUnresolved)
+                } else {
+                    within(world(2), c.heading_valid_sigma)
+                };
                 v.velocity = within(largest(p, 1), c.velocity_valid_sigma);
                 v.position = if self.gnss.rejected >= DISAGREEING_FIXES {
                     Validity::Invalid(Reason::FixesDisagree)

@@ -44,7 +44,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         {
             return;
         }
-        if let Mode::Running(ins) = &mut self.mode {
+        if let Mode::Running(ins, _) = &mut self.mode {
             let sigma = dt * d2_sq.sqrt_rn() / T::lit(12.0);
             if ins.widen_velocity(sigma).is_err() {
                 self.counters.numerical_failures =

@@ -1,0 +1,578 @@
+//! The heading when no sensor measures it: a bank of yaw hypotheses weighted by how well
+//! each explains the GNSS velocities (a Gaussian sum over the yaw, the idea behind PX4 EKF2's
+//! yaw estimator), with the track of a vehicle that does not move sideways as a second source.
+//!
+//! Without a magnetometer the INS's heading is only as good as its start, and at constant
+//! velocity GNSS does not observe it: the velocity error a heading error `ψ` makes is `ψ`
+//! times the horizontal velocity change the IMU measured. A filter started with the wrong
+//! heading then converges to whatever the first accelerations suggest, 180° included.
+//!
+//! **Hypotheses.** `K` = [`HYPOTHESES`] small filters, each with its own yaw offset `c_k` from
+//! the INS's attitude (hypothesis `k` holds the attitude `Exp(c_k u) R̂`, `u` the world's up),
+//! spread evenly over the circle with 1σ `π/K`, and its own horizontal velocity `v_k`
+//! (east, north). The INS's predictions accumulate the horizontal part of their velocity
+//! increments between two GNSS velocities, `Δ = Σ (R̂ (f − b̂_a) Δt)_h` (gravity is vertical and
+//! drops out), and each hypothesis sees them turned by its offset:
+//!
+//! ```text
+//! v_k⁺ = v_k + R(c_k) Δ,      F = [I₂  J R(c_k) Δ; 0  1],      J = [0 −1; 1 0]
+//! Q = diag(q_v, q_v, q_c),    q_v = n_a² τ + (g² σ_t² + σ_b²) τ²,    q_c = n_g² τ + σ_bu² τ²
+//! ```
+//!
+//! (`R(c)` the 2-D rotation by `c`, `τ` the time since the last velocity, `n_a`, `n_g` the
+//! IMU's noise densities, `σ_t`, `σ_b`, `σ_bu` the INS's tilt, accelerometer-bias and
+//! vertical gyro-bias 1σ: the errors every hypothesis shares, which act alike over `τ`). A
+//! GNSS velocity `z` (horizontal, σ_v per axis) updates each with `H = [I₂ 0]`, and each
+//! weight by its likelihood, in logarithms:
+//!
+//! ```text
+//! ν = z − v_k,   S = P_vv + σ_v² I,   ln w_k += −½ νᵀ S_w⁻¹ ν − ½ ln det S_w,   S_w = S + σ_a² τ T_c I
+//! ```
+//!
+//! with `σ_a² = g² σ_t² + σ_b²` the accelerations' error every hypothesis shares: it
+//! persists for `T_c` (10 s: the INS corrects its tilt and bias over tens of seconds), so
+//! the innovations of successive steps are not independent, and summed as if they were they
+//! would pick a hypothesis as surely from a tilt error as from the motion (a rover cruising
+//! at a slowly varying speed would lock on backwards as often as forwards). The states
+//! themselves are updated with `S`.
+//!
+//!
+//! **A vehicle that does not move sideways** (a car, a rover: [`InsConfig::lateral_velocity_sigma`](super::InsConfig::lateral_velocity_sigma)),
+//! adds at each velocity, once the hypothesis's speed is above 3σ of its velocity, the
+//! pseudo-measurement "no lateral body velocity": with `d` the
+//! horizontal forward direction (body `x`) of the INS's attitude, `d_k = R(c_k) d` and
+//! `l_k = J d_k`, `0 = l_kᵀ v_k + e`, `e ~ N(0, σ_l²)`, `H = [l_kᵀ, −d_kᵀ v_k]`. It observes
+//! the yaw at any speed above its noise, not only while accelerating, but cannot tell forward
+//! from backward (`c` and `c + π` satisfy it alike): the accelerations do, through the
+//! likelihoods (a speed change is along `+d` for one and `−d` for the other).
+//!
+//! **The estimate.** With normalized weights, the circular mean and the variance about it,
+//!
+//! ```text
+//! ĉ = atan2(Σ w_k sin c_k, Σ w_k cos c_k),    σ_ĉ² = Σ w_k (P_k,cc + wrap(c_k − ĉ)²)
+//! ```
+//!
+//! (the spread of the hypotheses counts: two at 180° from each other give `σ_ĉ ≈ π/2`).
+//! Without the lateral constraint, `σ_ĉ²` gets the floor `σ_a² Σ τ² / Σ ‖Δ‖²`, with
+//! `σ_a² = g² σ_t² + σ_b²` the accelerations' error every hypothesis shares (a tilt error
+//! leaks gravity, a bias adds to every sample): a yaw found from accelerations is no better
+//! than their shared error over their RMS size, however many fixes agree on it. A
+//! log-weight is never let below the best one's by more than [`LOG_WEIGHT_FLOOR`], so a
+//! hypothesis the data first disfavoured can still win later.
+//!
+//! **Keeping up with the INS.** The offsets are relative to the INS's attitude: when an
+//! update or a reset turns it about `u` by `δ`, every offset moves by `−δ`, and the increments
+//! accumulated so far turn by `δ` (`R(c) Δ = R(c − δ) R(δ) Δ`: [`YawBank::shift`]).
+
+use crate::kernels::mat3;
+use crate::Real;
+use nalgebra::{Matrix3, Vector2, Vector3};
+
+/// The number of yaw hypotheses (even: each has one at 180° from it, which only the
+/// accelerations tell apart).
+pub(crate) const HYPOTHESES: usize = 6;
+
+/// The lowest log-weight below the best one's (`e⁻²⁰ ≈ 2·10⁻⁹`): low enough not to matter
+/// in the mean, high enough for a hypothesis to come back when the data turn for it.
+pub(crate) const LOG_WEIGHT_FLOOR: f64 = 20.0;
+
+/// How long an acceleration error every hypothesis shares persists, s (`T_c`, module docs):
+/// the INS's tilt and accelerometer-bias errors, which its GNSS aiding corrects over tens of
+/// seconds, not from one fix to the next.
+const SHARED_ERROR_PERSISTENCE_S: f64 = 10.0;
+
+/// A forward direction whose horizontal part is shorter than this (body `x` within 30° of
+/// the vertical) gives no track direction.
+const MIN_FORWARD_HORIZONTAL: f64 = 0.5;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Hypothesis<T: Real> {
+    /// Yaw offset from the INS's attitude, rad, in `(−π, π]`.
+    offset: T,
+    /// Horizontal velocity (east, north), m/s.
+    velocity: Vector2<T>,
+    /// Covariance of `(v_e, v_n, c)`.
+    covariance: Matrix3<T>,
+    log_weight: T,
+}
+
+/// The process noise of the bank ([`YawBank::fuse_velocity`]), as densities: over `τ`,
+/// `q_v = white_velocity τ + drift_velocity τ²` and `q_c = white_yaw τ + drift_yaw τ²`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct StepNoise<T: Real> {
+    /// `n_a²`, (m/s²)²/Hz.
+    pub white_velocity: T,
+    /// `g² σ_t² + σ_b²`, (m/s²)².
+    pub drift_velocity: T,
+    /// `n_g²`, (rad/s)²/Hz.
+    pub white_yaw: T,
+    /// `σ_bu²`, (rad/s)².
+    pub drift_yaw: T,
+}
+
+/// The bank of yaw hypotheses (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct YawBank<T: Real> {
+    hypotheses: [Hypothesis<T>; HYPOTHESES],
+    /// The INS's horizontal velocity increments since the last velocity, m/s.
+    increment: Vector2<T>,
+    /// Their duration, s.
+    duration: T,
+    /// The hypotheses have their first velocity.
+    started: bool,
+    /// GNSS velocities fused since the start.
+    fixes: u16,
+    /// `Σ ‖Δ‖²` and `Σ τ²` over the bank's steps, and the latest `g² σ_t² + σ_b²`: the
+    /// floor of a yaw found from the accelerations alone (module docs).
+    increments_squared: T,
+    durations_squared: T,
+    systematic: T,
+    /// The lateral constraint was used (the yaw is not from the accelerations alone).
+    track: bool,
+    /// Nothing else measures the heading (no magnetometer): the bank runs.
+    active: bool,
+    /// The INS's heading has been set from the bank.
+    resolved: bool,
+}
+
+/// `x` wrapped into `(−π, π]`.
+fn wrap<T: Real>(x: T) -> T {
+    let two_pi = T::two_pi();
+    let turns = (x / two_pi).round();
+    let y = x - two_pi * turns;
+    if y <= -T::pi() {
+        y + two_pi
+    } else if y > T::pi() {
+        y - two_pi
+    } else {
+        y
+    }
+}
+
+/// `R(c) a` for `(sin c, cos c)`.
+fn rotate<T: Real>((s, c): (T, T), a: &Vector2<T>) -> Vector2<T> {
+    Vector2::new(c * a.x - s * a.y, s * a.x + c * a.y)
+}
+
+impl<T: Real> Hypothesis<T> {
+    /// The velocity update `H = [I₂ 0]` (σ_v² per axis); returns the log-likelihood of its
+    /// innovation with `shared` added to each axis of its covariance (module docs).
+    fn fuse_velocity(&mut self, z: &Vector2<T>, variance: T, shared: T) -> T {
+        let p = &self.covariance;
+        let (a, b, d) = (p.m11 + variance, p.m12, p.m22 + variance);
+        let det = a * d - b * b;
+        // S⁻¹ = [d −b; −b a] / det S; the gain K = P[:, 0..2] S⁻¹.
+        let inv = |x: T, y: T| Vector2::new(d * x - b * y, a * y - b * x) / det;
+        let nu = z - self.velocity;
+        let s_inv_nu = inv(nu.x, nu.y);
+        let rows = [
+            Vector2::new(p.m11, p.m12),
+            Vector2::new(p.m21, p.m22),
+            Vector2::new(p.m31, p.m32),
+        ];
+        // δx = P[:, 0..2] S⁻¹ ν; P⁺ = P − P[:, 0..2] S⁻¹ P[0..2, :].
+        let gain_rows = rows.map(|r| inv(r.x, r.y));
+        let dx = Vector3::new(
+            rows[0].dot(&s_inv_nu),
+            rows[1].dot(&s_inv_nu),
+            rows[2].dot(&s_inv_nu),
+        );
+        let mut down = Matrix3::zeros();
+        for (i, gi) in gain_rows.iter().enumerate() {
+            for (j, rj) in rows.iter().enumerate() {
+                if let Some(e) = down.get_mut((i, j)) {
+                    *e = gi.dot(rj);
+                }
+            }
+        }
+        self.apply(&dx, &down);
+        let (a, d) = (a + shared, d + shared);
+        let det = a * d - b * b;
+        let s_inv_nu = Vector2::new(d * nu.x - b * nu.y, a * nu.y - b * nu.x) / det;
+        -T::lit(0.5) * (nu.dot(&s_inv_nu) + det.ln())
+    }
+
+    /// The scalar update `0 = h x + e`, `e ~ N(0, variance)`, linearized at the estimate with
+    /// the row `h` and the value `y = h(x̂)`; returns the log-likelihood.
+    fn fuse_scalar(&mut self, h: &Vector3<T>, y: T, variance: T) -> T {
+        let ph = mat3::mul_vec(&self.covariance, h);
+        let s = h.dot(&ph) + variance;
+        let nu = -y;
+        let dx = ph * (nu / s);
+        let down = ph * ph.transpose() / s;
+        self.apply(&dx, &down);
+        -T::lit(0.5) * (nu * nu / s + s.ln())
+    }
+
+    /// `x += δx`, `P −= D`, `P` made exactly symmetric with a non-negative diagonal.
+    fn apply(&mut self, dx: &Vector3<T>, down: &Matrix3<T>) {
+        self.velocity += Vector2::new(dx.x, dx.y);
+        self.offset = wrap(self.offset + dx.z);
+        let p = self.covariance - down;
+        let p = (p + p.transpose()) * T::lit(0.5);
+        let floor = T::lit(T::EPSILON_F64);
+        let mut p = p;
+        for k in 0..3 {
+            if let Some(e) = p.get_mut((k, k)) {
+                *e = e.max(floor);
+            }
+        }
+        self.covariance = p;
+    }
+}
+
+impl<T: Real> YawBank<T> {
+    /// A bank without its first velocity; `active` when nothing else measures the heading.
+    pub(crate) fn new(active: bool) -> Self {
+        let h = Hypothesis {
+            offset: T::zero(),
+            velocity: Vector2::zeros(),
+            covariance: Matrix3::zeros(),
+            log_weight: T::zero(),
+        };
+        Self {
+            hypotheses: [h; HYPOTHESES],
+            increment: Vector2::zeros(),
+            duration: T::zero(),
+            started: false,
+            fixes: 0,
+            increments_squared: T::zero(),
+            durations_squared: T::zero(),
+            systematic: T::zero(),
+            track: false,
+            active,
+            resolved: false,
+        }
+    }
+
+    /// The bank runs: nothing else measures the heading.
+    pub(crate) fn active(&self) -> bool {
+        self.active
+    }
+
+    /// The INS's heading has been set from the bank.
+    pub(crate) fn resolved(&self) -> bool {
+        self.resolved
+    }
+
+    /// Marks the INS's heading as set from the bank.
+    pub(crate) fn set_resolved(&mut self) {
+        self.resolved = true;
+    }
+
+    /// Adds one INS prediction's horizontal velocity increment `(R̂ (f − b̂_a) Δt)_h` over `dt`.
+    pub(crate) fn accumulate(&mut self, increment: &Vector2<T>, dt: T) {
+        self.increment += increment;
+        self.duration += dt;
+    }
+
+    /// The INS's attitude turned by `turn` about the up direction: every offset moves by
+    /// `−turn`, so that each hypothesis keeps its own attitude.
+    pub(crate) fn shift(&mut self, turn: T) {
+        for h in &mut self.hypotheses {
+            h.offset = wrap(h.offset - turn);
+        }
+        // The increments so far were measured in the INS's frame before the turn: in the new
+        // one, `R(c) Δ = R(c − turn) R(turn) Δ`.
+        self.increment = rotate(turn.sincos(), &self.increment);
+    }
+
+    /// GNSS velocities fused since the first.
+    pub(crate) fn fixes(&self) -> u16 {
+        self.fixes
+    }
+
+    /// One GNSS velocity: horizontal `z` with `variance` per axis, the INS's horizontal
+    /// forward direction `forward` (body `x`, not normalized), and the lateral velocity's
+    /// variance of a vehicle that does not move sideways. The first starts the hypotheses at
+    /// `z`; each later one predicts them over the accumulated increments with `noise` and
+    /// updates them and their weights.
+    pub(crate) fn fuse_velocity(
+        &mut self,
+        z: &Vector2<T>,
+        variance: T,
+        forward: &Vector2<T>,
+        lateral_variance: Option<T>,
+        noise: &StepNoise<T>,
+    ) {
+        if !self.started {
+            let count = T::from_count(HYPOTHESES as u32);
+            let spread = T::pi() / count;
+            for (k, h) in self.hypotheses.iter_mut().enumerate() {
+                h.offset = wrap(T::two_pi() * T::from_count(k as u32) / count);
+                h.velocity = *z;
+                h.covariance =
+                    Matrix3::from_diagonal(&Vector3::new(variance, variance, spread * spread));
+                h.log_weight = T::zero();
+            }
+            self.started = true;
+        } else {
+            let (increment, tau) = (self.increment, self.duration);
+            let q_v = (noise.white_velocity + noise.drift_velocity * tau) * tau;
+            let q_c = (noise.white_yaw + noise.drift_yaw * tau) * tau;
+            // The weights see the error every hypothesis shares as what it is, one that
+            // persists: over its persistence `T_c` it adds `σ_a² τ T_c` to each innovation.
+            let shared = noise.drift_velocity * tau * T::lit(SHARED_ERROR_PERSISTENCE_S);
+            self.increments_squared += increment.norm_squared();
+            self.durations_squared += tau * tau;
+            self.systematic = noise.drift_velocity;
+            self.track = lateral_variance.is_some();
+            let track = forward.norm();
+            let d = (track >= T::lit(MIN_FORWARD_HORIZONTAL)).then(|| forward / track);
+            for h in &mut self.hypotheses {
+                let sc = h.offset.sincos();
+                let turned = rotate(sc, &increment);
+                h.velocity += turned;
+                // P ← F P Fᵀ + Q with F = I + f e₃ᵀ, f = (J R(c) Δ, 0).
+                let f = Vector3::new(-turned.y, turned.x, T::zero());
+                let p = h.covariance;
+                let pc = p.column(2).into_owned();
+                let fp = p + f * pc.transpose() + pc * f.transpose() + f * f.transpose() * p.m33;
+                h.covariance = fp + Matrix3::from_diagonal(&Vector3::new(q_v, q_v, q_c));
+                let log_likelihood = h.fuse_velocity(z, variance, shared);
+                // The constraint tells the yaw through the velocity's direction: only when the
+                // hypothesis's speed is above 3σ of its velocity (at rest, a velocity of noise
+                // would point the yaw anywhere).
+                let moving = h.velocity.norm_squared()
+                    >= T::lit(9.0) * h.covariance.m11.max(h.covariance.m22);
+                if let (Some(d), Some(sigma2), true) = (d, lateral_variance, moving) {
+                    let dk = rotate(h.offset.sincos(), &d);
+                    let lk = Vector2::new(-dk.y, dk.x);
+                    let row = Vector3::new(lk.x, lk.y, -dk.dot(&h.velocity));
+                    // The state only, not the weight: a hypothesis that started far from the
+                    // track would pay for its way there, and which of a forward and a backward
+                    // pair started nearer is chance.
+                    h.fuse_scalar(&row, lk.dot(&h.velocity), sigma2);
+                }
+                h.log_weight += log_likelihood;
+            }
+            self.normalize();
+            self.fixes = self.fixes.saturating_add(1);
+        }
+        self.increment = Vector2::zeros();
+        self.duration = T::zero();
+    }
+
+    /// Log-weights relative to the best, floored at [`LOG_WEIGHT_FLOOR`] below it; a
+    /// non-finite one (a failed update) starts the bank again at the next velocity.
+    fn normalize(&mut self) {
+        let best = self
+            .hypotheses
+            .iter()
+            .fold(T::lit(f64::NEG_INFINITY), |m, h| m.max(h.log_weight));
+        let finite = self.hypotheses.iter().all(|h| {
+            h.log_weight.is_finite()
+                && h.offset.is_finite()
+                && h.covariance.iter().all(|x| x.is_finite())
+        });
+        if !(finite && best.is_finite()) {
+            self.started = false;
+            self.fixes = 0;
+            return;
+        }
+        let floor = -T::lit(LOG_WEIGHT_FLOOR);
+        for h in &mut self.hypotheses {
+            h.log_weight = (h.log_weight - best).max(floor);
+        }
+    }
+
+    /// The weighted circular mean and variance about it of the hypotheses `keep` selects, with
+    /// their total weight (module docs).
+    fn mixture(&self, keep: impl Fn(&Hypothesis<T>) -> bool) -> (T, T, T) {
+        let (mut sum_w, mut sum_s, mut sum_c) = (T::zero(), T::zero(), T::zero());
+        for h in self.hypotheses.iter().filter(|h| keep(h)) {
+            let w = h.log_weight.exp();
+            let (s, c) = h.offset.sincos();
+            sum_w += w;
+            sum_s += w * s;
+            sum_c += w * c;
+        }
+        let mean = sum_s.arctan2(sum_c);
+        let spread = self
+            .hypotheses
+            .iter()
+            .filter(|h| keep(h))
+            .fold(T::zero(), |acc, h| {
+                let e = wrap(h.offset - mean);
+                acc + h.log_weight.exp() * (h.covariance.m33 + e * e)
+            });
+        (mean, (spread / sum_w).max(T::zero()), sum_w)
+    }
+
+    /// The bank's yaw offset from the INS's attitude and its 1σ, rad: `(ĉ, σ_ĉ)` (module docs),
+    /// once started.
+    pub(crate) fn estimate(&self) -> Option<(T, T)> {
+        if !self.started {
+            return None;
+        }
+        let (mean, variance, _) = self.mixture(|_| true);
+        // From the accelerations alone, a yaw is no better than the accelerations' shared
+        // error over their size: `σ_a² Σ τ² / Σ ‖Δ‖²` (at most a uniform heading's π²/3).
+        let uniform = T::pi() * T::pi() / T::lit(3.0);
+        let floor = if self.track {
+            T::zero()
+        } else if self.systematic * self.durations_squared < uniform * self.increments_squared {
+            self.systematic * self.durations_squared / self.increments_squared
+        } else {
+            uniform
+        };
+        Some((mean, (variance + floor).sqrt_rn()))
+    }
+
+    /// For a vehicle that moves along its track, with the INS's horizontal forward direction
+    /// `forward`: the hypotheses that see it moving forward (`R(c_k) d · v_k ≥ 0`), as
+    /// [`YawBank::estimate`], and whether those that see it moving backwards weigh more.
+    pub(crate) fn forward_estimate(&self, forward: &Vector2<T>) -> Option<(T, T, bool)> {
+        let track = forward.norm();
+        if !(self.started && track >= T::lit(MIN_FORWARD_HORIZONTAL)) {
+            return None;
+        }
+        let d = forward / track;
+        let ahead = |h: &Hypothesis<T>| rotate(h.offset.sincos(), &d).dot(&h.velocity) >= T::zero();
+        let (mean, variance, w_forward) = self.mixture(ahead);
+        let (_, _, w_backward) = self.mixture(|h| !ahead(h));
+        (w_forward > T::zero()).then(|| (mean, variance.sqrt_rn(), w_backward > w_forward))
+    }
+
+    /// The lateral constraint was used at the last step.
+    pub(crate) fn track(&self) -> bool {
+        self.track
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const NOISE: StepNoise<f64> = StepNoise {
+        white_velocity: 1e-4,
+        drift_velocity: 1e-4,
+        white_yaw: 1e-6,
+        drift_yaw: 1e-8,
+    };
+
+    /// A vehicle driven for `seconds` at 5 Hz fixes with world acceleration `accel(t)` from
+    /// rest, seen by an INS whose heading is off by `error` (so its increments are the true
+    /// ones turned by `error`), forward along its velocity; returns the bank.
+    fn drive(
+        error: f64,
+        seconds: f64,
+        lateral: Option<f64>,
+        accel: impl Fn(f64) -> Vector2<f64>,
+    ) -> YawBank<f64> {
+        let mut bank = YawBank::new(true);
+        let (dt, steps_per_fix) = (0.01, 20);
+        let mut v = Vector2::zeros();
+        let mut heading = 0.0_f64;
+        let mut t = 0.0;
+        let turn = |a: f64, x: &Vector2<f64>| rotate(a.sincos(), x);
+        while t < seconds {
+            for _ in 0..steps_per_fix {
+                let a = accel(t);
+                v += a * dt;
+                if v.norm() > 0.05 {
+                    heading = v.y.atan2(v.x);
+                }
+                bank.accumulate(&turn(error, &(a * dt)), dt);
+                t += dt;
+            }
+            // The INS's forward direction: the true one turned by the INS's heading error.
+            let forward = turn(error, &Vector2::new(heading.cos(), heading.sin()));
+            bank.fuse_velocity(&v, 0.01, &forward, lateral, &NOISE);
+        }
+        bank
+    }
+
+    #[test]
+    fn wrap_keeps_angles_in_the_half_open_circle() {
+        let pi = core::f64::consts::PI;
+        for (x, w) in [
+            (0.0, 0.0),
+            (pi, pi),
+            (-pi, pi),
+            (3.0 * pi, pi),
+            (2.5 * pi, 0.5 * pi),
+        ] {
+            assert!((wrap(x) - w).abs() < 1e-12, "{x}");
+        }
+    }
+
+    #[test]
+    fn accelerations_resolve_a_heading_off_by_150_degrees() {
+        let error = 150f64.to_radians();
+        // Accelerate east, then turn: a = 0.5 m/s² east for 4 s, then a centripetal 0.3 m/s².
+        let bank = drive(error, 30.0, None, |t| {
+            if t < 4.0 {
+                Vector2::new(0.5, 0.0)
+            } else {
+                let s = 0.15 * (t - 4.0);
+                Vector2::new(-s.sin(), s.cos()) * 0.3
+            }
+        });
+        let (offset, sigma) = bank.estimate().expect("started");
+        // The offset takes the INS's heading to the truth: −error.
+        assert!(
+            wrap(offset + error).abs() < 2f64.to_radians(),
+            "{}",
+            offset.to_degrees()
+        );
+        assert!(sigma < 2f64.to_radians(), "σ {}", sigma.to_degrees());
+    }
+
+    #[test]
+    fn the_track_alone_cannot_tell_forward_from_backward() {
+        // A start already moving (the bank starts at the first fix), then constant velocity:
+        // the lateral constraint finds the track, and nothing tells its sign.
+        let error = 100f64.to_radians();
+        let bank = drive(error, 20.0, Some(0.01), |t| {
+            if t < 0.2 {
+                Vector2::new(0.0, 5.0)
+            } else {
+                Vector2::zeros()
+            }
+        });
+        let (_, sigma) = bank.estimate().expect("started");
+        assert!(sigma > 60f64.to_radians(), "σ {}", sigma.to_degrees());
+        // Every hypothesis sits on the track, forward or backward.
+        for h in &bank.hypotheses {
+            let off = wrap(h.offset + error);
+            let on_track = off.abs().min(core::f64::consts::PI - off.abs());
+            assert!(on_track < 1f64.to_radians(), "{}", off.to_degrees());
+        }
+    }
+
+    #[test]
+    fn a_speed_change_on_the_track_tells_forward_from_backward() {
+        let error = -120f64.to_radians();
+        // 0.35 m/s north reached in 2 s, then slower and faster again (a rover's speed).
+        let bank = drive(error, 40.0, Some(0.05), |t| {
+            let along = if t < 2.0 {
+                0.175
+            } else {
+                0.05 * (0.5 * t).cos()
+            };
+            Vector2::new(0.0, along)
+        });
+        let (offset, sigma) = bank.estimate().expect("started");
+        // The yaw is known to the velocity's steady-state error over the speed: with the
+        // random walk q_v = 2.4e-5 (m/s)² per fix against the fixes' 0.01, (q_v r)^¼ ≈ 0.022
+        // m/s, over 0.35 m/s: 3.6°.
+        assert!(sigma < 5f64.to_radians(), "σ {}", sigma.to_degrees());
+        assert!(
+            wrap(offset + error).abs() < 3.0 * sigma,
+            "{}",
+            offset.to_degrees()
+        );
+    }
+
+    #[test]
+    fn a_turn_of_the_ins_moves_every_offset_and_the_increments() {
+        let mut bank = drive(0.3, 10.0, None, |_| Vector2::new(0.3, 0.0));
+        let (before, _) = bank.estimate().expect("started");
+        bank.accumulate(&Vector2::new(0.1, 0.0), 0.1);
+        bank.shift(0.2);
+        let (after, _) = bank.estimate().expect("started");
+        assert!((wrap(after - before) + 0.2).abs() < 1e-12);
+        assert!((bank.increment - rotate(0.2f64.sincos(), &Vector2::new(0.1, 0.0))).norm() < 1e-15);
+    }
+}

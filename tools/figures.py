@@ -21,6 +21,7 @@ a figure, `write` and commit the new figures with it.
 
 The blocks: `scenarios` (`host-sim run --scenario NAME --seed 1` for each built-in scenario),
 `montecarlo` (`host-sim montecarlo --scenario matched_ins|matched_ahrs --runs 60 --json`),
+`heading` (`host-sim montecarlo --scenario rover|rover_moving|car_no_mag --runs 50 --json`),
 `faults` (`host-sim faults --runs 50`), `bench` (`host-sim bench DATASETS`, only where the
 datasets are present: `--datasets`, default ../shared/datasets beside the checkout; without
 them the block is left as it is and the check says so).
@@ -63,6 +64,8 @@ SCENARIOS = [
     "handheld_ahrs",
 ]
 MONTECARLO = [("matched_ins", 60), ("matched_ahrs", 60)]
+# The INS without a magnetometer: the scenarios whose heading the GNSS track must resolve.
+HEADING = [("rover", 50), ("rover_moving", 50), ("car_no_mag", 50)]
 FAULT_RUNS = 50
 
 
@@ -136,6 +139,33 @@ def section_montecarlo(binary, tmp, _args):
                 f"| `{name}`, {runs} | {b['statistic']} | {fmt(b['value'], 3)} "
                 f"| [{fmt(b['lower'], 3)}, {fmt(b['upper'], 3)}] | {'yes' if b['holds'] else 'no'} |"
             )
+    return "\n".join(rows) + "\n"
+
+
+def section_heading(binary, tmp, _args):
+    rows = [
+        "| scenario, runs | heading valid, latest after the first motion [s] | within 5° for good, latest [s] | within 2° for good, latest [s] | largest error from 60 s after the first motion [°] | samples reported valid | … with the heading outside 3σ / 4σ | ANEES attitude (95 % band) |",
+        "|---|---:|---:|---:|---:|---:|---|---|",
+    ]
+    for name, runs in HEADING:
+        report = json.loads(
+            host_sim(binary, ["montecarlo", "--scenario", name, "--runs", str(runs), "--json"], tmp)
+        )
+        h = report["heading"]
+        within = h["within_deg_after_motion"]
+
+        def latest(key):
+            w = within[key]
+            text = fmt(w["latest_s"], 1)
+            return text if not w["runs_not_within_at_end"] else f"{text} ({w['runs_not_within_at_end']} runs not at the end)"
+
+        anees = next(b for b in report["bands"] if b["statistic"] == "ANEES attitude")
+        rows.append(
+            f"| `{name}`, {runs} | {fmt(h['valid_after_motion_latest_s'], 1)} | {latest('5')} | {latest('2')} "
+            f"| {fmt(h['max_error_from_60s_deg'], 1)} | {h['valid_samples']:,} "
+            f"| {h['valid_outside_3sigma']:,} / {h['valid_outside_4sigma']:,} "
+            f"| {fmt(anees['value'], 2)} ([{fmt(anees['lower'], 2)}, {fmt(anees['upper'], 2)}]) |"
+        )
     return "\n".join(rows) + "\n"
 
 
@@ -274,6 +304,7 @@ def section_bench(binary, tmp, args):
 SECTIONS = {
     "scenarios": section_scenarios,
     "montecarlo": section_montecarlo,
+    "heading": section_heading,
     "faults": section_faults,
     "bench": section_bench,
 }

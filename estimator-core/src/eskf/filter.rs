@@ -578,6 +578,7 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
     /// or is above the variance ceiling; [`EskfError::ZeroNorm`] for a zero gravity;
     /// [`EskfError::NumericalFailure`] when the result is not finite. The filter is then
     /// unchanged.
+    #[inline(never)] // rare: its matrices stay out of the caller's frame
     pub fn reset_heading(&mut self, turn: T, sigma: T) -> Result<(), EskfError> {
         if !(turn.is_finite() && usable_variance(sigma * sigma)) {
             return Err(EskfError::NonFinite);
@@ -587,17 +588,30 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
         };
         let attitude = So3::exp(&(up * turn)).compose(&self.state.attitude);
         let u = mat3::mul_vec(&self.state.attitude.rotation_matrix().transpose(), &up);
-        let project = Matrix3::identity() - u * u.transpose();
-        // T P Tᵀ: the attitude rows, then the attitude columns, multiplied by I − u uᵀ.
-        let mut p = self.covariance;
-        let cols = &mut p.data.0;
-        for col in cols.iter_mut() {
+        let project = Matrix3::identity() - mat3::sym_outer(&u, &u) * T::lit(0.5);
+        // The attitude block itself: (I − u uᵀ) P_θθ (I − u uᵀ) + σ² u uᵀ, made exactly
+        // symmetric, with the attitude floor.
+        let a = mat3::mul(
+            &mat3::mul(&project, &block(&self.covariance, 0, 0)),
+            &project,
+        );
+        let a = (a + a.transpose()) * T::lit(0.5)
+            + mat3::sym_outer(&u, &u) * (sigma * sigma * T::lit(0.5));
+        let a = a + Matrix3::from_diagonal_element(attitude_floor(&a));
+        // Checked before the first change: the projection does not lengthen a column of the
+        // (finite) P, so only the new block and the turned attitude can fail.
+        if !(attitude.is_finite() && all_finite(a.as_slice())) {
+            return Err(EskfError::NumericalFailure);
+        }
+        // T P Tᵀ in place: the attitude rows of the other columns multiplied by I − u uᵀ, then
+        // mirrored into the attitude columns (column-major: cols[j][i] = P_ij).
+        let cols = &mut self.covariance.data.0;
+        for col in cols.iter_mut().skip(3) {
             if let Some(head) = col.first_chunk_mut::<3>() {
                 *head = mat3::mul_vec(&project, &Vector3::from(*head)).into();
             }
         }
-        // Mirror the attitude rows into the attitude columns (column-major: cols[j][i] = P_ij).
-        for j in 0..15 {
+        for j in 3..15 {
             for k in 0..3 {
                 let v = cols.get(j).and_then(|c| c.get(k)).copied();
                 if let (Some(v), Some(e)) = (v, cols.get_mut(k).and_then(|c| c.get_mut(j))) {
@@ -605,19 +619,8 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
                 }
             }
         }
-        // The attitude block itself: (I − u uᵀ) P_θθ (I − u uᵀ) + σ² u uᵀ, made exactly symmetric.
-        let a = mat3::mul(
-            &mat3::mul(&project, &block(&self.covariance, 0, 0)),
-            &project,
-        );
-        let a = (a + a.transpose()) * T::lit(0.5) + u * u.transpose() * (sigma * sigma);
-        let a = a + Matrix3::from_diagonal_element(attitude_floor(&a));
-        set_block(&mut p, 0, 0, &a);
-        if !(attitude.is_finite() && all_finite(p.as_slice())) {
-            return Err(EskfError::NumericalFailure);
-        }
+        set_block(&mut self.covariance, 0, 0, &a);
         self.state.attitude = attitude;
-        self.covariance = p;
         Ok(())
     }
 

@@ -33,7 +33,9 @@ pub(crate) fn mul_vec<T: Real>(a: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
 #[inline(always)]
 #[must_use]
 pub(crate) fn norm<T: Real>(v: &Vector3<T>) -> T {
-    v.norm_squared().sqrt_rn()
+    // By components: nalgebra's `norm_squared` walks column views, whose bounds check an
+    // opt-level "z" build may keep out of line (a panic path the firmware check refuses).
+    (v.x * v.x + v.y * v.y + v.z * v.z).sqrt_rn()
 }
 
 /// `a bᵀ + b aᵀ`, exactly symmetric (`(ab)_ij + (ba)_ij` is computed once per pair).

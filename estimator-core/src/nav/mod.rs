@@ -44,6 +44,22 @@
 //! | `magnetometer.stuck_s` (0.5 s) | a magnetometer repeating its sample bit for bit this long is stuck or saturated (`MagneticStatus::Stuck`): not used until it changes | above the magnetometer's output interval |
 //! | `tilt_valid_sigma`, `heading_valid_sigma` (5°, 10°) | when the report calls a quantity valid | what the application can use |
 //!
+//! # The INS navigator without a magnetometer
+//!
+//! Its heading is unknown until the GNSS track resolves it (`nav/ins/heading.rs`,
+//! `nav/ins/yaw.rs`); in [`InsConfig`]:
+//!
+//! | parameter | what it does | how to choose it |
+//! |---|---|---|
+//! | `lateral_velocity_sigma` (`None`) | a vehicle that does not move sideways: its lateral body velocity's 1σ, m/s; the heading is then resolved along the track at any speed (forward, the one assumption: a run starts driving forward or from rest) and held to it | `None` for a drone or a hand-held device; for a car or a rover, its slip and crab on its ground: 0.05–0.1 m/s on a firm surface, more on loose soil or with a lane-changing wiggle |
+//! | `heading_valid_sigma` (10°) | also when the bank of yaw hypotheses is sure enough to resolve the heading (half of it) | what the application can use |
+//!
+//! Fixed by the physics, not tuned: the bank's 6 hypotheses (even, each with one at 180°), the
+//! heading's unknown variance `π²/3` (uniform over the circle), 10 GNSS velocities before a
+//! resolution (likelihoods need independent fixes), the shared acceleration error's 10 s
+//! persistence (the INS's tilt and bias errors, corrected over tens of seconds), and a log-weight
+//! floor of 20 below the best (a hypothesis can come back).
+//!
 //! Check a tuning on recordings with truth: `host-sim replay` prints the attitude RMSE and the
 //! ANEES (3 for a consistent filter: much above, the noise values are too small; much below,
 //! too large), and `host-sim bench` runs every dataset under a folder.

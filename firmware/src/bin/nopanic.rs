@@ -29,8 +29,8 @@ use estimator_core::eskf::{
     align_at_rest, AccelerometerAtRest, Ahrs, AhrsAccelBias, AhrsAccelBiasState, AhrsState,
     Alignment, BaroAltitude, CameraLandmark, ErrorState, FilterConfig, Gate, GateProbability,
     GnssPosition, GnssVelocity, GravityDirection, Heading, ImuNoise, ImuSample, InitialSigmas, Ins,
-    InsState, MagneticHeading, Magnetometer, MagnetometerWindow, Measurement, PinholeIntrinsics,
-    UpdateOptions, ZeroRate, ZeroVelocity,
+    InsState, LateralVelocity, MagneticHeading, Magnetometer, MagnetometerWindow, Measurement,
+    PinholeIntrinsics, UpdateOptions, ZeroRate, ZeroVelocity,
 };
 use estimator_core::gn::{
     check_point_spread, point_reprojection_error, reprojection_error, solve, solve_pnp,
@@ -258,6 +258,7 @@ fn eskf<T: Real>(x: &Seed<T>) {
     }
     ins_update!(GnssVelocity::new(w, b));
     ins_update!(ZeroVelocity::new(c));
+    ins_update!(LateralVelocity::new(c));
     ins_update!(BaroAltitude::new(h, d));
     ins_update!(Magnetometer::new(v, w, d));
     ins_update!(GravityDirection::new(w, g));
@@ -274,6 +275,7 @@ fn eskf<T: Real>(x: &Seed<T>) {
     keep(&ins.widen_biases(g, h));
     keep(&ins.reset_position(w, e));
     keep(&ins.reset_velocity(v, f));
+    keep(&ins.reset_heading(a, g));
     keep(&ins);
 }
 

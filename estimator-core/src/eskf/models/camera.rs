@@ -137,7 +137,9 @@ impl<T: Real> Measurement<T, InsState<T>, 15, 2> for CameraLandmark<T> {
         let d_position = -mat3::mul(&d_c, &r_t);
         let mut jacobian = SMatrix::<T, 2, 15>::zeros();
         for (col, block) in [(0, &d_attitude), (6, &d_position)] {
-            for (c, src) in block.column_iter().enumerate() {
+            // Column-major data, not `column_iter` (views whose bounds check an opt-level "z"
+            // build may keep).
+            for (c, src) in block.data.0.iter().enumerate() {
                 for (r, v) in src.iter().take(2).enumerate() {
                     if let Some(e) = jacobian.get_mut((r, col + c)) {
                         *e = *v;

@@ -3,6 +3,7 @@
 use crate::eskf::error::EskfError;
 use crate::eskf::state::InsState;
 use crate::eskf::update::{Linearization, Measurement};
+use crate::kernels::mat3;
 use crate::Real;
 use nalgebra::{Matrix1, SMatrix, Vector1};
 
@@ -50,7 +51,7 @@ impl<T: Real> LateralVelocity<T> {
 impl<T: Real> Measurement<T, InsState<T>, 15, 1> for LateralVelocity<T> {
     fn linearize(&self, x: &InsState<T>) -> Result<Linearization<T, 15, 1>, EskfError> {
         let r = x.attitude.rotation_matrix();
-        let w = r.transpose() * x.velocity;
+        let w = mat3::mul_vec(&r.transpose(), &x.velocity);
         let mut jacobian = SMatrix::<T, 1, 15>::zeros();
         let row = [w.z, T::zero(), -w.x, r.m12, r.m22, r.m32];
         for (d, s) in jacobian.iter_mut().zip(row) {

@@ -192,40 +192,36 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// A GNSS velocity valid at `t_m`, `dt` before the filter's time: the antenna's,
     /// `v + R(ω × ℓ)`, so `z − R((ω_m − b_g) × ℓ) + a dt` with `a = R(f_m − b_a) + g` (the last
     /// interval's rate and specific force) against `h(x) = v` ([`GnssVelocity`]). After a
-    /// position reset, the velocity is reset to it instead. Returns that body velocity (`None`
-    /// for a frozen receiver's), which the bank of yaw hypotheses takes too.
-    pub(super) fn fuse_gnss_velocity(
-        &mut self,
-        t_m: u64,
-        dt: T,
-        z: Vector3<T>,
-        sigma: T,
-    ) -> Option<Vector3<T>> {
+    /// position reset, the velocity is reset to it instead. The bank of yaw hypotheses takes
+    /// that body velocity too (`nav/ins/heading.rs`), unless the receiver is frozen.
+    pub(super) fn fuse_gnss_velocity(&mut self, t_m: u64, dt: T, z: Vector3<T>, sigma: T) {
         let (rate, specific_force, lever) = (
             self.filter_rate,
             self.filter_accel,
             self.config.gnss_lever_arm,
         );
         let (frozen, reset) = (self.gnss.frozen, self.gnss.reset_velocity);
-        let ins = self.ins_mut()?;
+        let Mode::Running(ins, bank) = &mut self.mode else {
+            return;
+        };
         if frozen {
-            return None;
+            return;
         }
         let s = *ins.state();
         let omega = rate - s.gyro_bias;
         let accel = s.attitude.act(&(specific_force - s.accel_bias)) + ins.config().gravity;
         let body = z - s.attitude.act(&omega.cross(&lever)) + accel * dt;
+        bank.take_velocity(&body, sigma);
         if reset {
             let ok = ins.reset_velocity(body, sigma).is_ok();
             self.gnss.reset_velocity = false;
             if !ok {
                 count(&mut self.counters.numerical_failures);
             }
-            return Some(body);
+            return;
         }
         let r = ins.update(&GnssVelocity::new(body, sigma), &UpdateOptions::default());
         self.record(Aiding::GnssVelocity, t_m, r);
-        Some(body)
     }
 
     /// A magnetometer sample valid at `t_m`, `dt` before the filter's time, carried by the

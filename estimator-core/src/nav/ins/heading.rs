@@ -36,7 +36,7 @@ use super::{InsNavigator, Mode};
 use crate::eskf::{up_direction, Ins, LateralVelocity, UpdateOptions};
 use crate::kernels::block::block;
 use crate::kernels::mat3;
-use crate::lie::{LieGroup, So3};
+use crate::lie::LieGroup;
 use crate::Real;
 use nalgebra::{Vector2, Vector3};
 
@@ -58,10 +58,11 @@ fn heading_variance<T: Real>(ins: &Ins<T>) -> Option<(T, Vector3<T>)> {
 }
 
 impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
-    /// After a measurement was fused (or not) with the INS's attitude `before` it: the bank
-    /// follows the INS's turn, takes a GNSS velocity (`velocity`: the body's, at the filter's
-    /// time, with its 1σ per axis), and resolves or holds the INS's heading (module docs).
-    pub(super) fn track_heading(&mut self, before: &So3<T>, velocity: Option<(Vector3<T>, T)>) {
+    /// After a measurement was fused (or not): the bank follows the INS's turn since the
+    /// attitude it noted before, takes the GNSS velocity the fusion brought, if any, and
+    /// resolves or holds the INS's heading (module docs).
+    #[inline(never)] // its bank step and resets stay out of every IMU call's frame
+    pub(super) fn track_heading(&mut self) {
         let lateral = self.config.lateral_velocity_sigma;
         let valid = self.config.heading_valid_sigma;
         let Mode::Running(ins, bank) = &mut self.mode else {
@@ -70,6 +71,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         if !bank.active() {
             return;
         }
+        let (before, velocity) = bank.fused();
         let Some((_, up)) = heading_variance(ins) else {
             return;
         };
@@ -135,7 +137,7 @@ fn bank_resolved<T: Real>(mode: &Mode<T>) -> bool {
 fn step_noise<T: Real>(ins: &Ins<T>) -> StepNoise<T> {
     let c = ins.config();
     let n = &c.imu_noise;
-    let g2 = c.gravity.norm_squared();
+    let g2 = c.gravity.dot(&c.gravity);
     let p = ins.covariance();
     let largest = |from: usize, count: usize| {
         (from..from + count).fold(T::zero(), |m, k| p.get((k, k)).map_or(m, |d| m.max(*d)))

@@ -88,7 +88,7 @@ use crate::nav::sample::{check_imu, check_vector, within_limits};
 use crate::nav::{FIX_POSITION_SIGMA, FIX_VELOCITY_SIGMA};
 use crate::Real;
 use buffer::{Aid, AidQueue, FixSigma, ImuRing, QueueError, Queued};
-use nalgebra::{Matrix3, Vector2, Vector3};
+use nalgebra::{Matrix3, Vector3};
 use window::{Increment, Interval};
 use yaw::YawBank;
 
@@ -728,15 +728,10 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
                 accel: interval.accel,
                 dt: interval.dt,
             };
-            let before = ins.state().velocity;
             // Every buffered sample passed `check_imu` (finite, within range).
-            if ins.predict_finite(&imu).is_err() {
+            if bank.predict(ins, &imu).is_err() {
                 self.counters.numerical_failures =
                     self.counters.numerical_failures.saturating_add(1);
-            } else if bank.active() {
-                // The horizontal velocity increment, `(R̂ (f − b̂_a) + g) Δt` east and north.
-                let dv = ins.state().velocity - before;
-                bank.accumulate(&Vector2::new(dv.x, dv.y), interval.dt);
             }
         }
         // The fresh window starts where this one ends; when the filter reaches its start, it
@@ -809,26 +804,21 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
                 }
                 _ => self.counters.unused = self.counters.unused.saturating_add(1),
             },
-            Mode::Running(ins, _) => {
-                let before = ins.state().attitude;
-                let velocity = match item.aid {
+            Mode::Running(ins, bank) => {
+                // The bank follows what each fusion does to the INS's heading
+                // (`nav/ins/heading.rs`).
+                bank.note_attitude(&ins.state().attitude);
+                match item.aid {
                     Aid::Gnss(position, sigma) => {
                         self.fuse_gnss(t_f, item.t_ns, dt, position, sigma);
-                        None
                     }
-                    Aid::GnssVelocity(v, sigma) => self
-                        .fuse_gnss_velocity(item.t_ns, dt, v, sigma)
-                        .map(|body| (body, sigma)),
-                    Aid::Magnetometer(field) => {
-                        self.fuse_magnetometer(item.t_ns, dt, field);
-                        None
+                    Aid::GnssVelocity(v, sigma) => {
+                        self.fuse_gnss_velocity(item.t_ns, dt, v, sigma);
                     }
-                    Aid::Barometer(altitude) => {
-                        self.fuse_barometer(item.t_ns, dt, altitude);
-                        None
-                    }
-                };
-                self.track_heading(&before, velocity);
+                    Aid::Magnetometer(field) => self.fuse_magnetometer(item.t_ns, dt, field),
+                    Aid::Barometer(altitude) => self.fuse_barometer(item.t_ns, dt, altitude),
+                }
+                self.track_heading();
             }
         }
     }

@@ -64,7 +64,9 @@
 //! update or a reset turns it about `u` by `δ`, every offset moves by `−δ`, and the increments
 //! accumulated so far turn by `δ` (`R(c) Δ = R(c − δ) R(δ) Δ`: [`YawBank::shift`]).
 
+use crate::eskf::{EskfError, ImuSample, Ins};
 use crate::kernels::mat3;
+use crate::lie::{LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, Vector2, Vector3};
 
@@ -129,6 +131,11 @@ pub(crate) struct YawBank<T: Real> {
     systematic: T,
     /// The lateral constraint was used (the yaw is not from the accelerations alone).
     track: bool,
+    /// The INS's attitude before the fusion under way, and the GNSS velocity it brought
+    /// (the body's, at the filter's time, with its 1σ per axis): what
+    /// [`InsNavigator::track_heading`](super::InsNavigator) takes after it.
+    before: So3<T>,
+    velocity: Option<(Vector3<T>, T)>,
     /// Nothing else measures the heading (no magnetometer): the bank runs.
     active: bool,
     /// The INS's heading has been set from the bank.
@@ -199,7 +206,7 @@ impl<T: Real> Hypothesis<T> {
         let s = h.dot(&ph) + variance;
         let nu = -y;
         let dx = ph * (nu / s);
-        let down = ph * ph.transpose() / s;
+        let down = mat3::sym_outer(&ph, &ph) * (T::lit(0.5) / s);
         self.apply(&dx, &down);
         -T::lit(0.5) * (nu * nu / s + s.ln())
     }
@@ -240,9 +247,32 @@ impl<T: Real> YawBank<T> {
             durations_squared: T::zero(),
             systematic: T::zero(),
             track: false,
+            before: So3::identity(),
+            velocity: None,
             active,
             resolved: false,
         }
+    }
+
+    /// The INS's attitude before a fusion.
+    pub(crate) fn note_attitude(&mut self, attitude: &So3<T>) {
+        if self.active {
+            self.before = *attitude;
+        }
+    }
+
+    /// A GNSS velocity the INS fused (or reset to): the body's, at the filter's time, with
+    /// its 1σ per axis.
+    pub(crate) fn take_velocity(&mut self, velocity: &Vector3<T>, sigma: T) {
+        if self.active {
+            self.velocity = Some((*velocity, sigma));
+        }
+    }
+
+    /// The attitude noted before the fusion, and the velocity it brought (taken: `None`
+    /// until the next one).
+    pub(crate) fn fused(&mut self) -> (So3<T>, Option<(Vector3<T>, T)>) {
+        (self.before, self.velocity.take())
     }
 
     /// The bank runs: nothing else measures the heading.
@@ -264,6 +294,24 @@ impl<T: Real> YawBank<T> {
     pub(crate) fn accumulate(&mut self, increment: &Vector2<T>, dt: T) {
         self.increment += increment;
         self.duration += dt;
+    }
+
+    /// The INS's prediction with `imu` ([`Ins::predict_finite`]), whose horizontal velocity
+    /// increment, `(R̂ (f − b̂_a) + g) Δt` east and north, the bank takes when it runs.
+    /// Out of line: the velocity kept across the prediction stays out of every IMU call's frame.
+    #[inline(never)]
+    pub(crate) fn predict(
+        &mut self,
+        ins: &mut Ins<T>,
+        imu: &ImuSample<T>,
+    ) -> Result<(), EskfError> {
+        let before = ins.state().velocity;
+        ins.predict_finite(imu)?;
+        if self.active {
+            let dv = ins.state().velocity - before;
+            self.accumulate(&Vector2::new(dv.x, dv.y), imu.dt);
+        }
+        Ok(())
     }
 
     /// The INS's attitude turned by `turn` about the up direction: every offset moves by
@@ -313,11 +361,11 @@ impl<T: Real> YawBank<T> {
             // The weights see the error every hypothesis shares as what it is, one that
             // persists: over its persistence `T_c` it adds `σ_a² τ T_c` to each innovation.
             let shared = noise.drift_velocity * tau * T::lit(SHARED_ERROR_PERSISTENCE_S);
-            self.increments_squared += increment.norm_squared();
+            self.increments_squared += increment.dot(&increment);
             self.durations_squared += tau * tau;
             self.systematic = noise.drift_velocity;
             self.track = lateral_variance.is_some();
-            let track = forward.norm();
+            let track = forward.dot(forward).sqrt_rn();
             let d = (track >= T::lit(MIN_FORWARD_HORIZONTAL)).then(|| forward / track);
             for h in &mut self.hypotheses {
                 let sc = h.offset.sincos();
@@ -326,14 +374,15 @@ impl<T: Real> YawBank<T> {
                 // P ← F P Fᵀ + Q with F = I + f e₃ᵀ, f = (J R(c) Δ, 0).
                 let f = Vector3::new(-turned.y, turned.x, T::zero());
                 let p = h.covariance;
-                let pc = p.column(2).into_owned();
-                let fp = p + f * pc.transpose() + pc * f.transpose() + f * f.transpose() * p.m33;
+                let pc = Vector3::new(p.m13, p.m23, p.m33);
+                let fp =
+                    p + mat3::sym_outer(&f, &pc) + mat3::sym_outer(&f, &f) * (p.m33 * T::lit(0.5));
                 h.covariance = fp + Matrix3::from_diagonal(&Vector3::new(q_v, q_v, q_c));
                 let log_likelihood = h.fuse_velocity(z, variance, shared);
                 // The constraint tells the yaw through the velocity's direction: only when the
                 // hypothesis's speed is above 3σ of its velocity (at rest, a velocity of noise
                 // would point the yaw anywhere).
-                let moving = h.velocity.norm_squared()
+                let moving = h.velocity.dot(&h.velocity)
                     >= T::lit(9.0) * h.covariance.m11.max(h.covariance.m22);
                 if let (Some(d), Some(sigma2), true) = (d, lateral_variance, moving) {
                     let dk = rotate(h.offset.sincos(), &d);
@@ -423,7 +472,7 @@ impl<T: Real> YawBank<T> {
     /// `forward`: the hypotheses that see it moving forward (`R(c_k) d · v_k ≥ 0`), as
     /// [`YawBank::estimate`], and whether those that see it moving backwards weigh more.
     pub(crate) fn forward_estimate(&self, forward: &Vector2<T>) -> Option<(T, T, bool)> {
-        let track = forward.norm();
+        let track = forward.dot(forward).sqrt_rn();
         if !(self.started && track >= T::lit(MIN_FORWARD_HORIZONTAL)) {
             return None;
         }

@@ -1019,9 +1019,13 @@ fn montecarlo_writes_runs_bands_and_json() {
     assert_eq!((runs[1][0].as_str(), runs[2][0].as_str()), ("5", "6"));
     for row in &runs[1..] {
         assert_eq!(row.len(), header.len());
+        // The heading's "largest error from 60 s after the first motion" has no sample in a
+        // run shorter than that: its cell may be empty; every other figure is estimated here.
         assert!(
             row.iter()
-                .all(|c| c.parse::<f64>().is_ok_and(f64::is_finite)),
+                .zip(header)
+                .all(|(c, h)| c.parse::<f64>().is_ok_and(f64::is_finite)
+                    || (h == "heading_max_error_from_60s_deg" && c.is_empty())),
             "every figure is estimated here: {row:?}"
         );
     }

@@ -21,7 +21,7 @@ a figure, `write` and commit the new figures with it.
 
 The blocks: `scenarios` (`host-sim run --scenario NAME --seed 1` for each built-in scenario),
 `montecarlo` (`host-sim montecarlo --scenario matched_ins|matched_ahrs --runs 60 --json`),
-`heading` (`host-sim montecarlo --scenario rover|rover_moving|car_no_mag --runs 50 --json`),
+`heading` (`host-sim montecarlo --scenario rover|rover_moving|rover_reversing|car_no_mag --runs 50 --json`),
 `faults` (`host-sim faults --runs 50`), `bench` (`host-sim bench DATASETS`, only where the
 datasets are present: `--datasets`, default ../shared/datasets beside the checkout; without
 them the block is left as it is and the check says so).
@@ -65,7 +65,7 @@ SCENARIOS = [
 ]
 MONTECARLO = [("matched_ins", 60), ("matched_ahrs", 60)]
 # The INS without a magnetometer: the scenarios whose heading the GNSS track must resolve.
-HEADING = [("rover", 50), ("rover_moving", 50), ("car_no_mag", 50)]
+HEADING = [("rover", 50), ("rover_moving", 50), ("rover_reversing", 50), ("car_no_mag", 50)]
 FAULT_RUNS = 50
 
 

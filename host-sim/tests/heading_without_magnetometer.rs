@@ -66,6 +66,13 @@ fn the_rover_recorded_while_driving_finds_its_heading_within_60_s() {
 }
 
 #[test]
+fn the_rover_driving_back_and_forth_keeps_its_heading_through_each_reversal() {
+    // A reversal is not a new heading: the heading neither jumps nor locks on the reversed
+    // track (the checks above: within 5° for good, never valid outside 4σ).
+    check("rover_reversing", "5", 60.0);
+}
+
+#[test]
 fn the_car_without_a_magnetometer_finds_its_heading_within_20_s_of_driving() {
     check("car_no_mag", "2", 20.0);
 }

@@ -371,6 +371,12 @@ pub fn builtin_scenarios() -> Vec<Scenario> {
         },
         rover.clone(),
         Scenario {
+            name: "rover_reversing".into(),
+            description: "the rover driving back and forth: its speed swings between -0.25 and 0.95 m/s every 200 s, reversing for a third of each swing; 360 s, IMU 200 Hz, GNSS 1.5 m at 5 Hz, no magnetometer".into(),
+            shape: "rover_reversing".into(),
+            ..rover.clone()
+        },
+        Scenario {
             name: "rover_moving".into(),
             description: "the rover recorded from 30 s, while it drives (never seen at rest): 330 s; IMU 200 Hz, GNSS 1.5 m at 5 Hz, no magnetometer".into(),
             record_from_s: ROVER_MOVING_FROM_S,

@@ -331,6 +331,23 @@ pub fn builtin(shape: &str, static_s: f64) -> Option<Trajectory> {
                 track: Some(Track { radius, phase }),
             }
         }
+        // The rover driving back and forth: its speed along the track swings by 0.6 m/s every
+        // 200 s about 0.35 m/s, so that it reverses (down to -0.25 m/s) for about a third of
+        // each swing, its body x axis still along the track's forward direction.
+        "rover_reversing" => {
+            let mut t = builtin("rover", static_s)?;
+            let radius = 15.0;
+            let reverse = 0.6 / (radius * std::f64::consts::TAU * 0.005);
+            let phase = Signal {
+                offset: 0.0,
+                rate: 0.35 / radius,
+                sines: vec![],
+            }
+            .with(reverse, 0.005, 0.0);
+            t.euler[2] = phase.clone().with(1.0_f64.to_radians(), 0.1, 0.5);
+            t.track = Some(Track { radius, phase });
+            t
+        }
         // Aggressive coning: roll and pitch in quadrature at 2 Hz, 0.3 rad.
         "coning" => Trajectory {
             static_s,
@@ -397,8 +414,17 @@ pub fn builtin(shape: &str, static_s: f64) -> Option<Trajectory> {
 }
 
 /// Names of the built-in shapes.
-pub const SHAPES: [&str; 9] = [
-    "static", "hover", "figure8", "car", "rover", "coning", "pitch90", "handheld", "rotate",
+pub const SHAPES: [&str; 10] = [
+    "static",
+    "hover",
+    "figure8",
+    "car",
+    "rover",
+    "rover_reversing",
+    "coning",
+    "pitch90",
+    "handheld",
+    "rotate",
 ];
 
 #[cfg(test)]

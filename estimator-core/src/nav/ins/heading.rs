@@ -31,6 +31,7 @@
 //!   reference with it ([`YawBank::shift`]).
 
 use super::report::InsEvent;
+use super::validity::largest;
 use super::yaw::{StepNoise, YawBank};
 use super::{InsNavigator, Mode};
 use crate::eskf::{up_direction, Ins, LateralVelocity, UpdateOptions};
@@ -100,19 +101,13 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             let noise = step_noise(ins);
             let r = ins.state().attitude.rotation_matrix();
             let forward = Vector2::new(r.m11, r.m21);
-            bank.fuse_velocity(
-                &Vector2::new(z.x, z.y),
-                sigma * sigma,
-                &forward,
-                lateral.map(|s| s * s),
-                &noise,
-            );
+            bank.fuse_velocity(&Vector2::new(z.x, z.y), sigma * sigma, &forward, &noise);
             if resolve(ins, bank, valid, &forward) {
                 self.counters.heading_resets = self.counters.heading_resets.saturating_add(1);
                 self.report.event = Some(InsEvent::HeadingFromGnss);
             }
         }
-        if let (false, Mode::Running(ins, _)) = (bank_resolved(&self.mode), &mut self.mode) {
+        if !bank.resolved() {
             hold_unknown(ins);
         }
     }
@@ -126,31 +121,21 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     }
 }
 
-fn bank_resolved<T: Real>(mode: &Mode<T>) -> bool {
-    match mode {
-        Mode::Running(_, bank) => bank.resolved() || !bank.active(),
-        Mode::Aligning(_) => true,
-    }
-}
-
 /// The bank's process noise from the IMU's noise and the INS's covariance (`nav/ins/yaw.rs`).
 fn step_noise<T: Real>(ins: &Ins<T>) -> StepNoise<T> {
     let c = ins.config();
     let n = &c.imu_noise;
     let g2 = c.gravity.dot(&c.gravity);
     let p = ins.covariance();
-    let largest = |from: usize, count: usize| {
-        (from..from + count).fold(T::zero(), |m, k| p.get((k, k)).map_or(m, |d| m.max(*d)))
-    };
     // The tilt's world-frame variances (east and north axes of R̂ P_θθ R̂ᵀ), not the body
     // frame's, which hold the heading's.
     let r = ins.state().attitude.rotation_matrix();
     let world = mat3::mul(&mat3::mul(&r, &block(p, 0, 0)), &r.transpose());
     StepNoise {
         white_velocity: n.accelerometer_noise_density * n.accelerometer_noise_density,
-        drift_velocity: g2 * world.m11.max(world.m22) + largest(12, 3),
+        drift_velocity: g2 * world.m11.max(world.m22) + largest(p, 4),
         white_yaw: n.gyroscope_noise_density * n.gyroscope_noise_density,
-        drift_yaw: largest(9, 3),
+        drift_yaw: largest(p, 3),
     }
 }
 
@@ -176,7 +161,7 @@ fn resolve<T: Real>(
         // vehicle starts its run forward (or from rest, where its first acceleration says so
         // too), and at a steady speed nothing else tells forward from backward (module docs).
         match bank.forward_estimate(forward) {
-            Some((o, s, _)) if s <= half => (o, s),
+            Some((o, s)) if s <= half => (o, s),
             _ => return false,
         }
     } else if sigma <= half {
@@ -210,7 +195,7 @@ fn resolve<T: Real>(
 /// Sets the INS's heading back to unknown (variance [`UNKNOWN_HEADING_VARIANCE`], no
 /// covariance with any other state: [`Ins::reset_heading`] by no turn) when a measurement
 /// narrowed it by a tenth or more.
-pub(super) fn hold_unknown<T: Real>(ins: &mut Ins<T>) {
+fn hold_unknown<T: Real>(ins: &mut Ins<T>) {
     let Some((variance, _)) = heading_variance(ins) else {
         return;
     };

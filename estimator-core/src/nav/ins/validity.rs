@@ -21,7 +21,7 @@ fn within<T: Real>(variance: T, limit: T) -> Validity {
 }
 
 /// The largest variance of block `b` of the 15-state `P` (its diagonal only, read in place).
-fn largest<T: Real>(p: &SMatrix<T, 15, 15>, b: usize) -> T {
+pub(super) fn largest<T: Real>(p: &SMatrix<T, 15, 15>, b: usize) -> T {
     (0..3).fold(T::zero(), |m, k| {
         p.get((3 * b + k, 3 * b + k)).map_or(m, |d| larger(m, *d))
     })

@@ -129,8 +129,9 @@ pub(crate) struct YawBank<T: Real> {
     increments_squared: T,
     durations_squared: T,
     systematic: T,
-    /// The lateral constraint was used (the yaw is not from the accelerations alone).
-    track: bool,
+    /// The lateral velocity's variance of a vehicle that does not move sideways (the yaw is
+    /// then not from the accelerations alone); `None` for one that may.
+    lateral: Option<T>,
     /// The INS's attitude before the fusion under way, and the GNSS velocity it brought
     /// (the body's, at the filter's time, with its 1σ per axis): what
     /// [`InsNavigator::track_heading`](super::InsNavigator) takes after it.
@@ -200,15 +201,14 @@ impl<T: Real> Hypothesis<T> {
     }
 
     /// The scalar update `0 = h x + e`, `e ~ N(0, variance)`, linearized at the estimate with
-    /// the row `h` and the value `y = h(x̂)`; returns the log-likelihood.
-    fn fuse_scalar(&mut self, h: &Vector3<T>, y: T, variance: T) -> T {
+    /// the row `h` and the value `y = h(x̂)`.
+    fn fuse_scalar(&mut self, h: &Vector3<T>, y: T, variance: T) {
         let ph = mat3::mul_vec(&self.covariance, h);
         let s = h.dot(&ph) + variance;
         let nu = -y;
         let dx = ph * (nu / s);
         let down = mat3::sym_outer(&ph, &ph) * (T::lit(0.5) / s);
         self.apply(&dx, &down);
-        -T::lit(0.5) * (nu * nu / s + s.ln())
     }
 
     /// `x += δx`, `P −= D`, `P` made exactly symmetric with a non-negative diagonal.
@@ -229,8 +229,9 @@ impl<T: Real> Hypothesis<T> {
 }
 
 impl<T: Real> YawBank<T> {
-    /// A bank without its first velocity; `active` when nothing else measures the heading.
-    pub(crate) fn new(active: bool) -> Self {
+    /// A bank without its first velocity; `active` when nothing else measures the heading,
+    /// `lateral` the lateral velocity's variance of a vehicle that does not move sideways.
+    pub(crate) fn new(active: bool, lateral: Option<T>) -> Self {
         let h = Hypothesis {
             offset: T::zero(),
             velocity: Vector2::zeros(),
@@ -246,7 +247,7 @@ impl<T: Real> YawBank<T> {
             increments_squared: T::zero(),
             durations_squared: T::zero(),
             systematic: T::zero(),
-            track: false,
+            lateral,
             before: So3::identity(),
             velocity: None,
             active,
@@ -305,9 +306,9 @@ impl<T: Real> YawBank<T> {
         ins: &mut Ins<T>,
         imu: &ImuSample<T>,
     ) -> Result<(), EskfError> {
-        let before = ins.state().velocity;
+        let before = self.active.then(|| ins.state().velocity);
         ins.predict_finite(imu)?;
-        if self.active {
+        if let Some(before) = before {
             let dv = ins.state().velocity - before;
             self.accumulate(&Vector2::new(dv.x, dv.y), imu.dt);
         }
@@ -330,9 +331,8 @@ impl<T: Real> YawBank<T> {
         self.fixes
     }
 
-    /// One GNSS velocity: horizontal `z` with `variance` per axis, the INS's horizontal
-    /// forward direction `forward` (body `x`, not normalized), and the lateral velocity's
-    /// variance of a vehicle that does not move sideways. The first starts the hypotheses at
+    /// One GNSS velocity: horizontal `z` with `variance` per axis, and the INS's horizontal
+    /// forward direction `forward` (body `x`, not normalized). The first starts the hypotheses at
     /// `z`; each later one predicts them over the accumulated increments with `noise` and
     /// updates them and their weights.
     pub(crate) fn fuse_velocity(
@@ -340,7 +340,6 @@ impl<T: Real> YawBank<T> {
         z: &Vector2<T>,
         variance: T,
         forward: &Vector2<T>,
-        lateral_variance: Option<T>,
         noise: &StepNoise<T>,
     ) {
         if !self.started {
@@ -364,7 +363,6 @@ impl<T: Real> YawBank<T> {
             self.increments_squared += increment.dot(&increment);
             self.durations_squared += tau * tau;
             self.systematic = noise.drift_velocity;
-            self.track = lateral_variance.is_some();
             let track = forward.dot(forward).sqrt_rn();
             let d = (track >= T::lit(MIN_FORWARD_HORIZONTAL)).then(|| forward / track);
             for h in &mut self.hypotheses {
@@ -384,7 +382,7 @@ impl<T: Real> YawBank<T> {
                 // would point the yaw anywhere).
                 let moving = h.velocity.dot(&h.velocity)
                     >= T::lit(9.0) * h.covariance.m11.max(h.covariance.m22);
-                if let (Some(d), Some(sigma2), true) = (d, lateral_variance, moving) {
+                if let (Some(d), Some(sigma2), true) = (d, self.lateral, moving) {
                     let dk = rotate(h.offset.sincos(), &d);
                     let lk = Vector2::new(-dk.y, dk.x);
                     let row = Vector3::new(lk.x, lk.y, -dk.dot(&h.velocity));
@@ -458,7 +456,7 @@ impl<T: Real> YawBank<T> {
         // From the accelerations alone, a yaw is no better than the accelerations' shared
         // error over their size: `σ_a² Σ τ² / Σ ‖Δ‖²` (at most a uniform heading's π²/3).
         let uniform = T::pi() * T::pi() / T::lit(3.0);
-        let floor = if self.track {
+        let floor = if self.lateral.is_some() {
             T::zero()
         } else if self.systematic * self.durations_squared < uniform * self.increments_squared {
             self.systematic * self.durations_squared / self.increments_squared
@@ -470,8 +468,8 @@ impl<T: Real> YawBank<T> {
 
     /// For a vehicle that moves along its track, with the INS's horizontal forward direction
     /// `forward`: the hypotheses that see it moving forward (`R(c_k) d · v_k ≥ 0`), as
-    /// [`YawBank::estimate`], and whether those that see it moving backwards weigh more.
-    pub(crate) fn forward_estimate(&self, forward: &Vector2<T>) -> Option<(T, T, bool)> {
+    /// [`YawBank::estimate`].
+    pub(crate) fn forward_estimate(&self, forward: &Vector2<T>) -> Option<(T, T)> {
         let track = forward.dot(forward).sqrt_rn();
         if !(self.started && track >= T::lit(MIN_FORWARD_HORIZONTAL)) {
             return None;
@@ -479,13 +477,12 @@ impl<T: Real> YawBank<T> {
         let d = forward / track;
         let ahead = |h: &Hypothesis<T>| rotate(h.offset.sincos(), &d).dot(&h.velocity) >= T::zero();
         let (mean, variance, w_forward) = self.mixture(ahead);
-        let (_, _, w_backward) = self.mixture(|h| !ahead(h));
-        (w_forward > T::zero()).then(|| (mean, variance.sqrt_rn(), w_backward > w_forward))
+        (w_forward > T::zero()).then(|| (mean, variance.sqrt_rn()))
     }
 
-    /// The lateral constraint was used at the last step.
+    /// The bank holds a vehicle that does not move sideways to its track.
     pub(crate) fn track(&self) -> bool {
-        self.track
+        self.lateral.is_some()
     }
 }
 
@@ -509,7 +506,7 @@ mod tests {
         lateral: Option<f64>,
         accel: impl Fn(f64) -> Vector2<f64>,
     ) -> YawBank<f64> {
-        let mut bank = YawBank::new(true);
+        let mut bank = YawBank::new(true, lateral);
         let (dt, steps_per_fix) = (0.01, 20);
         let mut v = Vector2::zeros();
         let mut heading = 0.0_f64;
@@ -527,7 +524,7 @@ mod tests {
             }
             // The INS's forward direction: the true one turned by the INS's heading error.
             let forward = turn(error, &Vector2::new(heading.cos(), heading.sin()));
-            bank.fuse_velocity(&v, 0.01, &forward, lateral, &NOISE);
+            bank.fuse_velocity(&v, 0.01, &forward, &NOISE);
         }
         bank
     }

@@ -76,3 +76,45 @@ fn the_rover_driving_back_and_forth_keeps_its_heading_through_each_reversal() {
 fn the_car_without_a_magnetometer_finds_its_heading_within_20_s_of_driving() {
     check("car_no_mag", "2", 20.0);
 }
+
+/// The figure-eight flight without its magnetometer, replayed with the defaults: a body that
+/// first flies straight is taken to travel along its axis, and its first turn under its track
+/// takes that back (`nav/ins/track_axis.rs`). What is held here is what the default owes such a
+/// body: the heading within 5° for good by 60 s after the first motion, as the rover's, and
+/// the attitude ANEES inside its band. A transient of the assumption, a heading reported valid
+/// outside 4σ for up to a second before the turn refutes it, is the default's known cost
+/// (`travel = "sideways"` avoids it), so that check is not made here.
+#[test]
+fn a_flight_without_a_magnetometer_is_not_held_to_its_track() {
+    let flight = Scenario::load("default").expect("built-in scenario");
+    let scenario = Scenario {
+        mag: None,
+        ..flight
+    };
+    let report = run_from(&scenario, 1, SEEDS, 0.0, false).expect("runs");
+    let h = report.heading_summary().expect("the body moves");
+    let (latest, never) = h
+        .settled_after_motion_s
+        .iter()
+        .find(|(deg, _, _)| deg == "5")
+        .map(|(_, l, n)| (*l, *n))
+        .expect("a settling threshold");
+    assert_eq!(never, 0, "heading not within 5° at the end");
+    let latest = latest.expect("settled");
+    assert!(
+        latest <= 60.0,
+        "within 5° only {latest:.1} s after the first motion"
+    );
+    let attitude = report
+        .nees
+        .iter()
+        .find(|b| b.name == "attitude")
+        .expect("attitude NEES");
+    assert!(
+        attitude.holds(),
+        "attitude ANEES {:.2} outside [{:.2}, {:.2}]",
+        attitude.value,
+        attitude.lower,
+        attitude.upper
+    );
+}

@@ -62,7 +62,12 @@ fn rover_is_slow_tilted_and_moves_along_its_heading() {
     assert_eq!(sc.imu.rate_hz, 200.0);
     let gnss = sc.gnss.as_ref().expect("GNSS");
     assert_eq!((gnss.rate_hz, gnss.sigma_horizontal), (5.0, 1.5));
-    assert_eq!(sc.replay.lateral_velocity_sigma, 0.05);
+    // The replay's defaults: the navigator learns from the track that it does not move
+    // sideways.
+    assert_eq!(
+        (sc.replay.lateral_velocity_sigma, sc.replay.travel.as_str()),
+        (0.0, "detect")
+    );
     sc.validate().expect("valid");
 
     let dir = tmp("rover");
@@ -177,7 +182,10 @@ fn car_no_mag_is_car_without_its_magnetometer() {
     let car = scenario("car");
     let sc = scenario("car_no_mag");
     assert!(car.mag.is_some() && sc.mag.is_none());
-    assert_eq!(sc.replay.lateral_velocity_sigma, 0.1);
+    assert_eq!(
+        (sc.replay.lateral_velocity_sigma, sc.replay.travel.as_str()),
+        (0.0, "detect")
+    );
     assert!(sc.ceilings.ate_m.is_infinite() && sc.ceilings.attitude_deg.is_infinite());
     assert_eq!(
         Scenario {

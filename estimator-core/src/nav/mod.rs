@@ -51,7 +51,7 @@
 //!
 //! | parameter | what it does | how to choose it |
 //! |---|---|---|
-//! | `lateral_velocity_sigma` (`None`) | a vehicle that does not move sideways: its lateral body velocity's 1σ, m/s; the heading is then resolved along the track at any speed (forward, the one assumption: a run starts driving forward or from rest) and held to it | `None` for a drone or a hand-held device; for a car or a rover, its slip and crab on its ground: 0.05–0.1 m/s on a firm surface, more on loose soil or with a lane-changing wiggle |
+//! | `travel` (`Travel::Detect`) | whether the vehicle travels along its body x axis; then its heading is resolved along the GNSS track at any speed (forward, the one assumption: a run starts driving forward or from rest) and held to it with a lateral-velocity 1σ: learned from the track (`Detect`: the body-frame GNSS velocities' smaller spread, noise removed, plus its 2σ sampling bound; taken back when the body turns under its track or three lateral updates in a row fail their gate), declared (`Forward { lateral_sigma }`), or none (`Sideways`) | `Detect` unless known: `Sideways` for a multirotor or a hand-held device (a straight start would be taken for a track until its first turn, a second or so of a heading valid but wrong); `Forward` with the slip and crab of a car or rover on its ground, 0.05–0.1 m/s on a firm surface |
 //! | `heading_valid_sigma` (10°) | also when the bank of yaw hypotheses is sure enough to resolve the heading (half of it) | what the application can use |
 //!
 //! Fixed by the physics, not tuned: the bank's 6 hypotheses (even, each with one at 180°), the
@@ -100,6 +100,6 @@ pub use attitude::{
 pub use error::NavError;
 pub use ins::{
     AidStatus, Aiding, GnssFix, InsConfig, InsCounters, InsEstimate, InsEvent, InsFusion,
-    InsNavigator, InsReport, InsValidity, AID_STALE_INTERVALS, AID_STALE_NS,
+    InsNavigator, InsReport, InsValidity, Travel, AID_STALE_INTERVALS, AID_STALE_NS,
 };
 pub use mean::VectorMean;

@@ -14,7 +14,7 @@ use crate::faults::epochs;
 use crate::metrics::{Estimate, Outcome, Scorer};
 use estimator_core::nav::{
     AidStatus, Aiding, GnssFix, InsConfig, InsEvent, InsNavigator, InsReport, MagneticFusion,
-    NavError, Validity,
+    NavError, Travel, Validity,
 };
 use estimator_core::Real;
 use nalgebra::Matrix3;
@@ -32,8 +32,15 @@ pub(super) fn ins_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> InsConfig
     }
     let mut c = InsConfig::new(attitude);
     c.horizon_s = T::lit(cfg.horizon_s);
-    c.lateral_velocity_sigma =
-        (cfg.lateral_velocity_sigma > 0.0).then(|| T::lit(cfg.lateral_velocity_sigma));
+    c.travel = if cfg.lateral_velocity_sigma > 0.0 {
+        Travel::Forward {
+            lateral_sigma: T::lit(cfg.lateral_velocity_sigma),
+        }
+    } else if cfg.travel == "sideways" {
+        Travel::Sideways
+    } else {
+        Travel::Detect
+    };
     if let Some(g) = &ds.gnss {
         c.gnss_lever_arm = lit3(&g.lever_arm);
     }

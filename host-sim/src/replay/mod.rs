@@ -109,10 +109,14 @@ pub struct ReplayConfig {
     /// this far behind the newest IMU sample).
     pub horizon_s: f64,
     /// INS navigator: the vehicle does not move sideways (a car, a rover): 1σ of its lateral
-    /// body velocity, m/s, with the body's x axis along its track; 0: it may (a drone, a
-    /// hand-held device). Without a magnetometer, this is what finds the heading of a slow
-    /// ground vehicle from its GNSS track.
+    /// body velocity, m/s, with the body's x axis along its track; 0: not declared (`travel`
+    /// says). Without a magnetometer, this is what finds the heading of a slow ground vehicle
+    /// from its GNSS track.
     pub lateral_velocity_sigma: f64,
+    /// INS navigator, when `lateral_velocity_sigma` is 0: `"detect"` (learn from the GNSS
+    /// track whether the vehicle travels along its body x axis, and its lateral 1σ) or
+    /// `"sideways"` (it may move sideways: a multirotor, a hand-held device).
+    pub travel: String,
     /// Take every GNSS fix as valid when its row is stamped, ignoring `latency_s` (to see
     /// what the latency costs).
     pub ignore_gnss_latency: bool,
@@ -199,6 +203,18 @@ impl ReplayConfig {
                 return Err(format!("{name} = {x}: must be below 4 s"));
             }
         }
+        if self.travel != "detect" && self.travel != "sideways" {
+            return Err(format!(
+                "travel = \"{}\": must be \"detect\" or \"sideways\"",
+                self.travel
+            ));
+        }
+        if self.travel == "sideways" && self.lateral_velocity_sigma > 0.0 {
+            return Err(format!(
+                "travel = \"sideways\" with lateral_velocity_sigma = {}: a vehicle that moves sideways has no lateral sigma",
+                self.lateral_velocity_sigma
+            ));
+        }
         if !(self.lateral_velocity_sigma.is_finite() && self.lateral_velocity_sigma >= 0.0) {
             return Err(format!(
                 "lateral_velocity_sigma = {}: must be a finite value, 0 or more",
@@ -262,6 +278,7 @@ impl Default for ReplayConfig {
             instantaneous_imu: false,
             horizon_s: 0.3,
             lateral_velocity_sigma: 0.0,
+            travel: "detect".into(),
             ignore_gnss_latency: false,
             plots: true,
         }

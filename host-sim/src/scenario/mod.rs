@@ -329,7 +329,7 @@ pub fn builtin_scenarios() -> Vec<Scenario> {
         static_s: 10.0,
         shape: "rover".into(),
         gnss: Some(GnssConfig { sigma_horizontal: 1.5, ..GnssConfig::default() }),
-        replay: ReplayConfig { lateral_velocity_sigma: 0.05, ..ReplayConfig::simulated() },
+        replay: ReplayConfig::simulated(),
         ..base.clone()
     };
     let mut all = vec![
@@ -366,7 +366,7 @@ pub fn builtin_scenarios() -> Vec<Scenario> {
             description: "car without its magnetometer: 60 s planar drive on a 15 m circle at 2.5 m/s; IMU, GNSS with 0.3 m lever arm, no magnetometer".into(),
             mag: None,
             ceilings: Ceilings::default(),
-            replay: ReplayConfig { lateral_velocity_sigma: 0.1, ..ReplayConfig::simulated() },
+            replay: ReplayConfig::simulated(),
             ..car
         },
         rover.clone(),

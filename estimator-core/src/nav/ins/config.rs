@@ -47,12 +47,35 @@ pub struct InsConfig<T: Real> {
     pub gyro_bias_valid_sigma: T,
     /// Accelerometer bias valid below this 1σ, m/s².
     pub accel_bias_valid_sigma: T,
-    /// A vehicle that does not move sideways (a car, a rover), with its body `x` axis along
-    /// its track: the 1σ of its lateral body velocity, m/s (slip, crab on rough ground).
-    /// Without a magnetometer, the heading is then found from the GNSS track at any speed
-    /// above the velocity's noise (`nav/ins/yaw.rs`), not only while accelerating. `None`
-    /// (the default): a vehicle that may move sideways (a drone, a hand-held device).
-    pub lateral_velocity_sigma: Option<T>,
+    /// How the vehicle moves against its body: whether its track lies along its body `x` axis
+    /// (a car, a rover), which without a magnetometer is what finds the heading of a slow
+    /// ground vehicle from its GNSS track (`nav/ins/yaw.rs`). [`Travel::Detect`] by default.
+    pub travel: Travel<T>,
+}
+
+/// How a vehicle moves against its body ([`InsConfig::travel`]).
+///
+/// A vehicle that does not move sideways has, in its body frame, the velocity
+/// `v_b = (v_x, v_y, v_z)` with `v_y ≈ 0` (`|v_y| ≤` a few `σ_l`): its GNSS track then gives its
+/// heading to `σ_l/‖v‖` at any speed above the velocity's noise, not only while it accelerates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Travel<T: Real> {
+    /// Learned from the GNSS track (`nav/ins/track_axis.rs`): the vehicle is taken to travel
+    /// along its body `x` axis while its GNSS velocities, seen in the INS's heading frame, lie
+    /// on one axis (the lateral RMS at most half the speed), with the lateral 1σ they show;
+    /// a turn of the body under its track takes it back. The default: a vehicle without a
+    /// magnetometer is most often a ground vehicle, and a body whose track turns under it is
+    /// told apart as soon as it does.
+    Detect,
+    /// A vehicle that may move sideways (a multirotor, a hand-held device): the heading from
+    /// the accelerations alone.
+    Sideways,
+    /// A vehicle that does not move sideways, with the 1σ of its lateral body velocity, m/s
+    /// (slip, crab on rough ground), `> 0`.
+    Forward {
+        /// 1σ of the lateral body velocity, m/s.
+        lateral_sigma: T,
+    },
 }
 
 impl<T: Real> InsConfig<T> {
@@ -78,7 +101,7 @@ impl<T: Real> InsConfig<T> {
             heading_valid_sigma: T::lit(10.0_f64.to_radians()),
             gyro_bias_valid_sigma: T::lit(0.05_f64.to_radians()),
             accel_bias_valid_sigma: T::lit(0.05),
-            lateral_velocity_sigma: None,
+            travel: Travel::Detect,
         }
     }
 
@@ -95,9 +118,12 @@ impl<T: Real> InsConfig<T> {
         let baro = self
             .barometer_sigma
             .is_none_or(|s| crate::nav::sample::within_limits(s, 1e-3, 1e3));
-        let lateral = self
-            .lateral_velocity_sigma
-            .is_none_or(|s| crate::nav::sample::within_limits(s, 1e-3, 1e2));
+        let lateral = match self.travel {
+            Travel::Forward { lateral_sigma } => {
+                crate::nav::sample::within_limits(lateral_sigma, 1e-3, 1e2)
+            }
+            Travel::Detect | Travel::Sideways => true,
+        };
         let non_negative = [
             self.accelerometer_range,
             self.gyro_range,

@@ -22,7 +22,8 @@
 //!   difference (an INS locked on a wrong heading); a ground vehicle's INS, which the lateral
 //!   constraint holds better than the bank, only once its own heading is no longer valid, and
 //!   never turned around (by more than 90°): a reversal of travel is not a new heading.
-//! * **A ground vehicle** ([`InsConfig::lateral_velocity_sigma`](super::InsConfig::lateral_velocity_sigma))
+//! * **A ground vehicle** ([`InsConfig::travel`](super::InsConfig::travel), its lateral
+//!   velocity's 1σ declared or learned from the track: `nav/ins/track_axis.rs`)
 //!   with its heading resolved is also held to a zero lateral velocity at each GNSS velocity
 //!   while its horizontal speed is above 3σ of its velocity ([`LateralVelocity`]): at a slow,
 //!   steady speed the accelerations say little, the track says it to `σ_l/‖v‖`; at rest the
@@ -64,7 +65,6 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// resolves or holds the INS's heading (module docs).
     #[inline(never)] // its bank step and resets stay out of every IMU call's frame
     pub(super) fn track_heading(&mut self) {
-        let lateral = self.config.lateral_velocity_sigma;
         let valid = self.config.heading_valid_sigma;
         let Mode::Running(ins, bank) = &mut self.mode else {
             return;
@@ -82,7 +82,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             v.x * v.x + v.y * v.y >= T::lit(9.0) * var(3).max(var(4))
         };
         if let (Some(sigma), Some(_), true, true) =
-            (lateral, velocity, bank.resolved(), moving(ins))
+            (bank.lateral_sigma(), velocity, bank.resolved(), moving(ins))
         {
             // A ground vehicle with a known heading: its lateral velocity is zero, at each GNSS
             // velocity (`LateralVelocity`); the heading's second source beside the
@@ -90,8 +90,14 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             let r = ins.update(&LateralVelocity::new(sigma), &UpdateOptions::default());
             let c = &mut self.counters;
             match r {
-                Ok(o) if o.is_accepted() => c.lateral_fused = c.lateral_fused.saturating_add(1),
-                Ok(_) => c.lateral_rejected = c.lateral_rejected.saturating_add(1),
+                Ok(o) if o.is_accepted() => {
+                    c.lateral_fused = c.lateral_fused.saturating_add(1);
+                    bank.lateral_outcome(true);
+                }
+                Ok(_) => {
+                    c.lateral_rejected = c.lateral_rejected.saturating_add(1);
+                    bank.lateral_outcome(false);
+                }
                 Err(_) => c.numerical_failures = c.numerical_failures.saturating_add(1),
             }
         }

@@ -67,12 +67,13 @@ mod faults;
 mod heading;
 mod report;
 mod start;
+mod track_axis;
 mod validity;
 mod vibration;
 mod window;
 mod yaw;
 
-pub use config::InsConfig;
+pub use config::{InsConfig, Travel};
 pub use report::{
     AidStatus, Aiding, InsCounters, InsEstimate, InsEvent, InsFusion, InsReport, InsValidity,
 };

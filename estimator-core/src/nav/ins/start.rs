@@ -109,8 +109,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
             && positive_finite(square(sigma_v))
             && position_sigma.iter().all(|s| positive_finite(square(*s)));
         let started = if ok {
-            let lateral = self.config.lateral_velocity_sigma.map(|s| s * s);
-            let bank = YawBank::new(!has_magnetometer, lateral);
+            let bank = YawBank::new(!has_magnetometer, self.config.travel);
             self.mode = Mode::Running(Ins::unstarted(*aligned.config()), bank);
             match &mut self.mode {
                 Mode::Running(ins, _) => ins

@@ -37,7 +37,10 @@
 //! themselves are updated with `S`.
 //!
 //!
-//! **A vehicle that does not move sideways** (a car, a rover: [`InsConfig::lateral_velocity_sigma`](super::InsConfig::lateral_velocity_sigma)),
+//! **A vehicle that does not move sideways** (a car, a rover: [`InsConfig::travel`](super::InsConfig::travel),
+//! declared or learned from the GNSS velocities seen in the body frame, `nav/ins/track_axis.rs`,
+//! and taken back when the body turns under its track or the INS's lateral updates fail
+//! their gate three times in a row),
 //! adds at each velocity, once the hypothesis's speed is above 3σ of its velocity, the
 //! pseudo-measurement "no lateral body velocity": with `d` the
 //! horizontal forward direction (body `x`) of the INS's attitude, `d_k = R(c_k) d` and
@@ -64,6 +67,8 @@
 //! update or a reset turns it about `u` by `δ`, every offset moves by `−δ`, and the increments
 //! accumulated so far turn by `δ` (`R(c) Δ = R(c − δ) R(δ) Δ`: [`YawBank::shift`]).
 
+use super::config::Travel;
+use super::track_axis::TrackAxis;
 use crate::eskf::{EskfError, ImuSample, Ins};
 use crate::kernels::mat3;
 use crate::lie::{LieGroup, So3};
@@ -82,6 +87,11 @@ pub(crate) const LOG_WEIGHT_FLOOR: f64 = 20.0;
 /// the INS's tilt and accelerometer-bias errors, which its GNSS aiding corrects over tens of
 /// seconds, not from one fix to the next.
 const SHARED_ERROR_PERSISTENCE_S: f64 = 10.0;
+
+/// The INS's lateral-velocity updates rejected in a row that take a learned track axis back
+/// ([`YawBank::lateral_outcome`]): each passes a consistent filter's 99.9 % gate but once in a
+/// thousand, three in a row once in 10⁹.
+pub(crate) const LATERAL_REJECTIONS_TO_REFUTE: u8 = 3;
 
 /// A forward direction whose horizontal part is shorter than this (body `x` within 30° of
 /// the vertical) gives no track direction.
@@ -132,6 +142,10 @@ pub(crate) struct YawBank<T: Real> {
     /// The lateral velocity's variance of a vehicle that does not move sideways (the yaw is
     /// then not from the accelerations alone); `None` for one that may.
     lateral: Option<T>,
+    /// How the vehicle moves against its body, as configured.
+    travel: Travel<T>,
+    /// Its GNSS velocities in the INS's heading frame, for [`Travel::Detect`].
+    axis: TrackAxis<T>,
     /// The INS's attitude before the fusion under way, and the GNSS velocity it brought
     /// (the body's, at the filter's time, with its 1σ per axis): what
     /// [`InsNavigator::track_heading`](super::InsNavigator) takes after it.
@@ -141,6 +155,10 @@ pub(crate) struct YawBank<T: Real> {
     active: bool,
     /// The INS's heading has been set from the bank.
     resolved: bool,
+    /// … while the bank held a vehicle along its track.
+    resolved_by_track: bool,
+    /// The INS's lateral-velocity updates rejected in a row.
+    lateral_rejections: u8,
 }
 
 /// `x` wrapped into `(−π, π]`.
@@ -230,8 +248,12 @@ impl<T: Real> Hypothesis<T> {
 
 impl<T: Real> YawBank<T> {
     /// A bank without its first velocity; `active` when nothing else measures the heading,
-    /// `lateral` the lateral velocity's variance of a vehicle that does not move sideways.
-    pub(crate) fn new(active: bool, lateral: Option<T>) -> Self {
+    /// `travel` how the vehicle moves against its body.
+    pub(crate) fn new(active: bool, travel: Travel<T>) -> Self {
+        let lateral = match travel {
+            Travel::Forward { lateral_sigma } => Some(lateral_sigma * lateral_sigma),
+            Travel::Detect | Travel::Sideways => None,
+        };
         let h = Hypothesis {
             offset: T::zero(),
             velocity: Vector2::zeros(),
@@ -248,10 +270,14 @@ impl<T: Real> YawBank<T> {
             durations_squared: T::zero(),
             systematic: T::zero(),
             lateral,
+            travel,
+            axis: TrackAxis::default(),
             before: So3::identity(),
             velocity: None,
             active,
             resolved: false,
+            resolved_by_track: false,
+            lateral_rejections: 0,
         }
     }
 
@@ -289,6 +315,7 @@ impl<T: Real> YawBank<T> {
     /// Marks the INS's heading as set from the bank.
     pub(crate) fn set_resolved(&mut self) {
         self.resolved = true;
+        self.resolved_by_track = self.lateral.is_some();
     }
 
     /// Adds one INS prediction's horizontal velocity increment `(R̂ (f − b̂_a) Δt)_h` over `dt`.
@@ -324,6 +351,7 @@ impl<T: Real> YawBank<T> {
         // The increments so far were measured in the INS's frame before the turn: in the new
         // one, `R(c) Δ = R(c − turn) R(turn) Δ`.
         self.increment = rotate(turn.sincos(), &self.increment);
+        self.axis.turn(turn);
     }
 
     /// GNSS velocities fused since the first.
@@ -342,6 +370,18 @@ impl<T: Real> YawBank<T> {
         forward: &Vector2<T>,
         noise: &StepNoise<T>,
     ) {
+        if self.travel == Travel::Detect {
+            let track = forward.dot(forward).sqrt_rn();
+            if track >= T::lit(MIN_FORWARD_HORIZONTAL) {
+                self.axis.add(z, variance, &(forward / track));
+            }
+            let was = self.lateral.is_some();
+            self.lateral = self.axis.lateral_variance();
+            if was && self.lateral.is_none() {
+                // The body turned under its track: it moves sideways.
+                self.refute();
+            }
+        }
         if !self.started {
             let count = T::from_count(HYPOTHESES as u32);
             let spread = T::pi() / count;
@@ -413,8 +453,7 @@ impl<T: Real> YawBank<T> {
                 && h.covariance.iter().all(|x| x.is_finite())
         });
         if !(finite && best.is_finite()) {
-            self.started = false;
-            self.fixes = 0;
+            self.restart();
             return;
         }
         let floor = -T::lit(LOG_WEIGHT_FLOOR);
@@ -484,6 +523,49 @@ impl<T: Real> YawBank<T> {
     pub(crate) fn track(&self) -> bool {
         self.lateral.is_some()
     }
+
+    /// The outcome of the INS's lateral-velocity update. A learned axis
+    /// ([`Travel::Detect`]) is taken back, for the rest of the run, after
+    /// [`LATERAL_REJECTIONS_TO_REFUTE`] rejections in a row: the body moved sideways, so its
+    /// track is not its heading, and a heading resolved from the track is not known after all.
+    pub(crate) fn lateral_outcome(&mut self, accepted: bool) {
+        if accepted {
+            self.lateral_rejections = 0;
+            return;
+        }
+        self.lateral_rejections = self.lateral_rejections.saturating_add(1);
+        if self.travel == Travel::Detect && self.lateral_rejections >= LATERAL_REJECTIONS_TO_REFUTE
+        {
+            self.refute();
+        }
+    }
+
+    /// A learned track axis taken back for the rest of the run: the vehicle moves sideways.
+    /// A heading resolved from the track is not known after all, and the hypotheses, pulled
+    /// onto the track, start again at the next velocity.
+    fn refute(&mut self) {
+        self.travel = Travel::Sideways;
+        self.lateral = None;
+        if self.resolved_by_track {
+            self.resolved = false;
+            self.resolved_by_track = false;
+        }
+        self.restart();
+    }
+
+    /// Starts the hypotheses again at the next velocity, from nothing learned.
+    fn restart(&mut self) {
+        self.started = false;
+        self.fixes = 0;
+        self.increments_squared = T::zero();
+        self.durations_squared = T::zero();
+    }
+
+    /// The lateral velocity's 1σ of a vehicle that does not move sideways, m/s, configured or
+    /// learned ([`Travel`]); `None` for one that may.
+    pub(crate) fn lateral_sigma(&self) -> Option<T> {
+        self.lateral.map(|v| v.sqrt_rn())
+    }
 }
 
 #[cfg(test)]
@@ -506,7 +588,20 @@ mod tests {
         lateral: Option<f64>,
         accel: impl Fn(f64) -> Vector2<f64>,
     ) -> YawBank<f64> {
-        let mut bank = YawBank::new(true, lateral);
+        let travel = lateral.map_or(Travel::Sideways, |v: f64| Travel::Forward {
+            lateral_sigma: v.sqrt(),
+        });
+        drive_with(travel, error, seconds, accel)
+    }
+
+    /// [`drive`] with the vehicle's travel as configured.
+    fn drive_with(
+        travel: Travel<f64>,
+        error: f64,
+        seconds: f64,
+        accel: impl Fn(f64) -> Vector2<f64>,
+    ) -> YawBank<f64> {
+        let mut bank = YawBank::new(true, travel);
         let (dt, steps_per_fix) = (0.01, 20);
         let mut v = Vector2::zeros();
         let mut heading = 0.0_f64;
@@ -620,5 +715,62 @@ mod tests {
         let (after, _) = bank.estimate().expect("started");
         assert!((wrap(after - before) + 0.2).abs() < 1e-12);
         assert!((bank.increment - rotate(0.2f64.sincos(), &Vector2::new(0.1, 0.0))).norm() < 1e-15);
+    }
+
+    #[test]
+    fn a_vehicle_along_its_track_is_learned_and_found_forward() {
+        let error = -120f64.to_radians();
+        let bank = drive_with(Travel::Detect, error, 40.0, |t| {
+            let along = if t < 2.0 {
+                0.175
+            } else {
+                0.05 * (0.5 * t).cos()
+            };
+            Vector2::new(0.0, along)
+        });
+        // No lateral motion: the learned σ_l is the sampling bound of the fixes' noise,
+        // σ_v √2 (2/n)^¼ with σ_v = 0.1 m/s and n ≈ 200: 0.045 m/s.
+        let sigma_l = bank.lateral_sigma().expect("an axis");
+        assert!(sigma_l < 0.05, "{sigma_l}");
+        let d = rotate(error.sincos(), &Vector2::new(0.0, 1.0));
+        let (offset, sigma) = bank.forward_estimate(&d).expect("started");
+        assert!(sigma < 5f64.to_radians(), "σ {}", sigma.to_degrees());
+        assert!(
+            wrap(offset + error).abs() < 3.0 * sigma,
+            "{}",
+            offset.to_degrees()
+        );
+    }
+
+    #[test]
+    fn three_rejected_lateral_updates_in_a_row_take_a_learned_axis_back() {
+        let mut bank = drive_with(Travel::Detect, 0.5, 20.0, |t| {
+            Vector2::new(0.0, if t < 2.0 { 0.2 } else { 0.0 })
+        });
+        assert!(bank.track());
+        bank.set_resolved();
+        bank.lateral_outcome(false);
+        bank.lateral_outcome(false);
+        bank.lateral_outcome(true);
+        bank.lateral_outcome(false);
+        bank.lateral_outcome(false);
+        assert!(bank.track() && bank.resolved(), "not three in a row");
+        bank.lateral_outcome(false);
+        assert!(!bank.track() && !bank.resolved());
+        assert_eq!(
+            (bank.travel, bank.started, bank.fixes),
+            (Travel::Sideways, false, 0)
+        );
+    }
+
+    #[test]
+    fn a_declared_axis_is_never_taken_back() {
+        let mut bank = drive(0.5, 20.0, Some(0.01), |t| {
+            Vector2::new(0.0, if t < 2.0 { 0.2 } else { 0.0 })
+        });
+        for _ in 0..10 {
+            bank.lateral_outcome(false);
+        }
+        assert!(bank.track());
     }
 }

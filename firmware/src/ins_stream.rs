@@ -6,6 +6,13 @@
 //! with constant biases. The magnetometer samples and the fixes are stamped with the time they
 //! were valid and delivered `DELAY_NS` (0.2 s) later, after the IMU sample of their arrival, as
 //! a receiver's fixes reach a main loop. The truth is known in closed form ([`truth_position`]).
+//!
+//! The same stream without its magnetometer samples is the navigator's without a magnetometer
+//! ([`config_without_magnetometer`]): its heading found by the bank of yaw hypotheses from the
+//! GNSS track (estimator-core's `nav/ins/yaw.rs`; at constant velocity the accelerations say
+//! nothing of it, the track along the body's `x` axis does). The stream's track,
+//! `atan2(0.6, 1.2)` = 0.464 rad, is 0.036 rad off its yaw (a crab of 0.049 m/s sideways): a
+//! heading found from the track is that far from the truth.
 
 use crate::scenario::{attitude_config, Scalar};
 use estimator_core::lie::{LieGroup, So3};
@@ -47,6 +54,15 @@ pub enum InsSample<T: Real> {
 /// noise, the magnetometer's σ and reference field), the INS defaults around it (0.3 s horizon).
 pub fn config<T: Scalar>() -> InsConfig<T> {
     InsConfig::new(attitude_config::<T>())
+}
+
+/// The configuration without a magnetometer: [`config`] with none configured, the rest
+/// `InsConfig::new`'s defaults. The navigator's heading is then unknown until the bank of yaw
+/// hypotheses resolves it from the GNSS velocities (estimator-core's `nav/ins/heading.rs`).
+pub fn config_without_magnetometer<T: Scalar>() -> InsConfig<T> {
+    let mut c = config::<T>();
+    c.attitude.magnetometer = None;
+    c
 }
 
 #[inline(always)]

@@ -72,6 +72,19 @@ CALLS = {
         ("ins_nav_gnss_call", "ins_nav_magnetometer_call")),
     "`InsNavigator::estimate`": ("ins_nav_estimate",),
     "`InsNavigator`, mean per IMU sample": (("ins_nav_per_imu_sample",), ("ins_nav",)),
+    # The INS navigator's run without a magnetometer (the bank of yaw hypotheses).
+    "`InsNavigator::imu` without a magnetometer (heading from the GNSS track": (
+        ("ins_nav_no_mag_step_max",), ("ins_nav_no_mag_step",)),
+    "`InsNavigator::imu` without a magnetometer, with a delayed GNSS position": (
+        ("ins_nav_no_mag_gnss_position_max", "ins_nav_no_mag_gnss_velocity_max"),
+        ("ins_nav_no_mag_gnss_position", "ins_nav_no_mag_gnss_velocity")),
+    "`InsNavigator::imu` without a magnetometer, the call that starts": (
+        ("ins_nav_no_mag_start_max", "ins_nav_no_mag_aligning_max"),
+        ("ins_nav_no_mag_start", "ins_nav_no_mag_aligning")),
+    "`InsNavigator::gnss` without a magnetometer": (
+        ("ins_nav_no_mag_gnss_call_max",), ("ins_nav_no_mag_gnss_call",)),
+    "`InsNavigator` without a magnetometer, mean per IMU sample": (
+        ("ins_nav_no_mag_per_imu_sample",), ("ins_nav_no_mag",)),
     "`solve_pnp`, 20 points": ("pnp_solve_20",),
     "`scalar::sincos_f32`": ("sincos_f32",),
     "`scalar::sqrt_f32`": ("sqrt_f32",),

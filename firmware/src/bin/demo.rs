@@ -13,6 +13,9 @@
 //!    (`ins_stream.rs`: magnetometer and fixes delivered 0.2 s late), every call in its own
 //!    window, each window classed by what the call did (its report's `fused` and `event`), and
 //!    checks that the INS started, fused every fix and ends within a few metres of the truth;
+//!    then once more over the same stream without its magnetometer (none configured: the bank
+//!    of yaw hypotheses finds the heading from the GNSS track), and checks that the heading was
+//!    set from the track and is valid at the end;
 //! 4. prints `size_of` of the filter, navigator and solver types;
 //! 5. exits through semihosting: status 0 when every check passed, 1 otherwise.
 #![no_std]
@@ -481,23 +484,47 @@ const INS_CLASSES: [(u8, &str); 10] = [
 /// At most this many windows in the INS navigator's run (its stream has 2,031 calls).
 const INS_WINDOWS: usize = 2_100;
 
+/// The INS navigator's two runs over `ins_stream`: with its magnetometer (`ins_stream::config`,
+/// every sample) and without (`ins_stream::config_without_magnetometer`, the magnetometer
+/// samples left out: the bank of yaw hypotheses finds the heading from the GNSS track).
+#[derive(Clone, Copy, PartialEq)]
+enum InsRun {
+    WithMagnetometer,
+    WithoutMagnetometer,
+}
+
+impl InsRun {
+    /// The run's name in the figures (`icount.<name>_<class>_max`, `stack.<name>_<class>`).
+    fn name(self) -> &'static str {
+        match self {
+            InsRun::WithMagnetometer => "ins_nav",
+            InsRun::WithoutMagnetometer => "ins_nav_no_mag",
+        }
+    }
+}
+
 /// What the INS navigator's measured run found.
 struct InsNavRun {
     /// The report and estimate after the last call.
     report: InsReport<f32>,
     estimate: Option<InsEstimate<f32>>,
     counters: InsCounters,
-    /// IMU calls that started the INS; that raised any other event (realigned, reset, IMU
-    /// fault); whose update the gate rejected.
+    /// IMU calls that started the INS; that set the heading from the GNSS track
+    /// (`HeadingFromGnss`); that raised any other event (realigned, reset, IMU fault); whose
+    /// update the gate rejected.
     started: u32,
+    heading_from_gnss: u32,
     other_events: u32,
     rejected: u32,
     /// Windows beyond the tag buffer (0 when every call was classed).
     unclassed: u32,
-    /// When the INS started, ms after switch-on.
+    /// When the INS started, and when its heading was first set from the GNSS track, ms after
+    /// switch-on.
     start_ms: u32,
-    /// The call after an IMU gap went back to aligning.
-    realigned: bool,
+    heading_ms: u32,
+    /// The call after an IMU gap went back to aligning (measured in the run with the
+    /// magnetometer only: `None` in the other).
+    realigned: Option<bool>,
 }
 
 /// The class of an INS navigator's `imu` call that was not refused, from its report.
@@ -519,21 +546,33 @@ fn ins_imu_class(nav: &InsNavigator<f32>) -> u8 {
 }
 
 /// Runs a new `InsNavigator<f32>` (its default ring of IMU intervals and queue, 0.3 s horizon)
-/// from switch-on over `ins_stream`, each call in its own measured window, and prints
-/// `bench_group <first> <windows> ins_nav imu_samples=<n> stack=<peak>`, the class of every
-/// window (`bench_tags ins_nav <first window> <codes>`, legend in `bench_classes`) and each
-/// class's peak stack; then measures `estimate()` once, and an `imu` call after an IMU gap on
-/// a copy.
-fn bench_ins_nav(index: &mut u32) -> Option<InsNavRun> {
-    let mut nav: InsNavigator<f32> = InsNavigator::new(ins_stream::config::<f32>()).ok()?;
+/// from switch-on over `ins_stream` (`run`: with its magnetometer, or without), each call in its
+/// own measured window, and prints `bench_group <first> <windows> <name> imu_samples=<n>
+/// stack=<peak>`, the class of every window (`bench_tags <name> <first window> <codes>`, legend
+/// in `bench_classes`) and each class's peak stack (`<name>`: [`InsRun::name`]); then, with the
+/// magnetometer, measures `estimate()` once, and an `imu` call after an IMU gap on a copy.
+fn bench_ins_nav(index: &mut u32, run: InsRun) -> Option<InsNavRun> {
+    let magnetometer = run == InsRun::WithMagnetometer;
+    let name = run.name();
+    let config = if magnetometer {
+        ins_stream::config::<f32>()
+    } else {
+        ins_stream::config_without_magnetometer::<f32>()
+    };
+    let mut nav: InsNavigator<f32> = InsNavigator::new(config).ok()?;
     let first = *index;
     let mut tags = [0u8; INS_WINDOWS];
     let mut class_stack = [0usize; INS_CLASSES.len()];
     let (mut windows, mut imu, mut peak) = (0usize, 0u32, 0usize);
-    let (mut started, mut other_events, mut rejected) = (0u32, 0u32, 0u32);
-    let mut start_ms = 0u32;
+    let (mut started, mut heading_from_gnss) = (0u32, 0u32);
+    let (mut other_events, mut rejected) = (0u32, 0u32);
+    let (mut start_ms, mut heading_ms) = (0u32, 0u32);
     let mut last_imu = None;
     ins_stream::samples::<f32>(|sample| {
+        if !magnetometer && matches!(sample, ins_stream::InsSample::Mag { .. }) {
+            // Without a magnetometer: its samples are not there.
+            return;
+        }
         let refused_before = nav.counters().refused;
         let (stack, tag) = match sample {
             ins_stream::InsSample::Imu { t_ns, gyro, accel } => {
@@ -548,11 +587,18 @@ fn bench_ins_nav(index: &mut u32) -> Option<InsNavRun> {
                 let tag = ins_imu_class(&nav);
                 last_imu = Some((t_ns, gyro, accel));
                 let r = nav.report();
+                let ms = (t_ns - ins_stream::T0_NS) / 1_000_000;
+                let ms = u32::try_from(ms).unwrap_or(u32::MAX);
                 match r.event {
                     Some(InsEvent::Started) => {
                         started += 1;
-                        let ms = (t_ns - ins_stream::T0_NS) / 1_000_000;
-                        start_ms = u32::try_from(ms).unwrap_or(u32::MAX);
+                        start_ms = ms;
+                    }
+                    Some(InsEvent::HeadingFromGnss) => {
+                        if heading_from_gnss == 0 {
+                            heading_ms = ms;
+                        }
+                        heading_from_gnss += 1;
                     }
                     Some(_) => other_events += 1,
                     None => {}
@@ -596,16 +642,17 @@ fn bench_ins_nav(index: &mut u32) -> Option<InsNavRun> {
     });
     *index += windows as u32;
     hprintln!(
-        "bench_group {} {} ins_nav imu_samples={} stack={}",
+        "bench_group {} {} {} imu_samples={} stack={}",
         first,
         windows,
+        name,
         imu,
         peak
     );
     let mut legend = [0u8; 160];
     let mut n = 0;
-    for (code, name) in INS_CLASSES {
-        for b in [code, b':'].iter().chain(name.as_bytes()).chain(b" ") {
+    for (code, class) in INS_CLASSES {
+        for b in [code, b':'].iter().chain(class.as_bytes()).chain(b" ") {
             if let Some(slot) = legend.get_mut(n) {
                 *slot = *b;
                 n += 1;
@@ -613,7 +660,8 @@ fn bench_ins_nav(index: &mut u32) -> Option<InsNavRun> {
         }
     }
     hprintln!(
-        "bench_classes ins_nav {}",
+        "bench_classes {} {}",
+        name,
         core::str::from_utf8(legend.get(..n).unwrap_or(&[])).unwrap_or("")
     );
     let classed = windows.min(INS_WINDOWS);
@@ -622,16 +670,32 @@ fn bench_ins_nav(index: &mut u32) -> Option<InsNavRun> {
         let end = (at + 100).min(classed);
         let line = tags.get(at..end).unwrap_or(&[]);
         hprintln!(
-            "bench_tags ins_nav {} {}",
+            "bench_tags {} {} {}",
+            name,
             first as usize + at,
             core::str::from_utf8(line).unwrap_or("")
         );
         at = end;
     }
-    for ((code, name), stack) in INS_CLASSES.iter().zip(class_stack) {
+    for ((code, class), stack) in INS_CLASSES.iter().zip(class_stack) {
         if tags.get(..classed).is_some_and(|t| t.contains(code)) {
-            hprintln!("bench_stack ins_nav_{} {}", name, stack);
+            hprintln!("bench_stack {}_{} {}", name, class, stack);
         }
+    }
+    if !magnetometer {
+        return Some(InsNavRun {
+            report: *nav.report(),
+            estimate: nav.estimate(),
+            counters: *nav.counters(),
+            started,
+            heading_from_gnss,
+            other_events,
+            rejected,
+            unclassed: u32::try_from(windows - classed).unwrap_or(u32::MAX),
+            start_ms,
+            heading_ms,
+            realigned: None,
+        });
     }
     bench(index, "ins_nav_estimate", || {
         black_box(black_box(&nav).estimate());
@@ -660,11 +724,13 @@ fn bench_ins_nav(index: &mut u32) -> Option<InsNavRun> {
         estimate: nav.estimate(),
         counters: *nav.counters(),
         started,
+        heading_from_gnss,
         other_events,
         rejected,
         unclassed: u32::try_from(windows - classed).unwrap_or(u32::MAX),
         start_ms,
-        realigned,
+        heading_ms,
+        realigned: Some(realigned),
     })
 }
 
@@ -680,7 +746,12 @@ fn check_ins_nav(c: &mut Checker, run: &Option<InsNavRun>) {
     c.equal("ins nav samples refused", n.refused, 0);
     c.equal("ins nav started", r.started, 1);
     hprintln!("info ins_nav started {} ms after switch-on", r.start_ms);
-    c.equal("ins nav gap call realigned", u32::from(r.realigned), 1);
+    c.equal(
+        "ins nav gap call realigned",
+        u32::from(r.realigned == Some(true)),
+        1,
+    );
+    c.equal("ins nav heading from gnss", r.heading_from_gnss, 0);
     c.equal("ins nav other events", r.other_events, 0);
     c.equal("ins nav updates rejected", r.rejected, 0);
     c.equal("ins nav numerical failures", n.numerical_failures, 0);
@@ -718,6 +789,68 @@ fn check_ins_nav(c: &mut Checker, run: &Option<InsNavRun>) {
     c.below("ins nav attitude error (rad)", err, 0.03);
 }
 
+/// Checks the INS navigator's run without a magnetometer: every sample taken, the INS started
+/// once, every fix fused, the bank of yaw hypotheses fed every GNSS velocity and the heading
+/// set from it (resolved: valid at the end), the lateral velocity fused at the fixes after
+/// that, and the end estimate near the truth (the heading to the stream's track: 0.036 rad off
+/// its yaw, `ins_stream.rs`).
+fn check_ins_nav_without_magnetometer(c: &mut Checker, run: &Option<InsNavRun>) {
+    let Some(r) = run else {
+        c.equal("ins nav no-mag constructed", 0, 1);
+        return;
+    };
+    let n = &r.counters;
+    c.equal("ins nav no-mag windows classed", r.unclassed, 0);
+    c.equal("ins nav no-mag refused", n.refused, 0);
+    c.equal("ins nav no-mag started", r.started, 1);
+    hprintln!(
+        "info ins_nav_no_mag started {} ms after switch-on, heading from gnss at {} ms",
+        r.start_ms,
+        r.heading_ms
+    );
+    c.equal("ins nav no-mag other events", r.other_events, 0);
+    c.equal("ins nav no-mag updates rejected", r.rejected, 0);
+    c.equal("ins nav no-mag num. failures", n.numerical_failures, 0);
+    c.at_least("ins nav no-mag gnss pos fused", n.gnss_position_fused, 25);
+    c.at_least("ins nav no-mag gnss vel fused", n.gnss_velocity_fused, 25);
+    c.equal("ins nav no-mag mag fused", n.magnetometer_fused, 0);
+    // The heading resolved by the bank: set from it (once: the INS keeps it after, held by the
+    // lateral velocity), and the lateral velocity fused at every GNSS velocity after that.
+    c.equal("ins nav no-mag heading resets", n.heading_resets, 1);
+    c.equal(
+        "ins nav no-mag HeadingFromGnss",
+        r.heading_from_gnss,
+        n.heading_resets,
+    );
+    c.at_least("ins nav no-mag lateral fused", n.lateral_fused, 20);
+    c.equal("ins nav no-mag lateral rejected", n.lateral_rejected, 0);
+    let v = &r.report.validity;
+    let valid = [v.tilt, v.heading, v.velocity, v.position]
+        .iter()
+        .filter(|x| x.is_valid())
+        .count();
+    c.equal("ins nav no-mag tilt/hdg/v/p valid", valid as u32, 4);
+    let Some(e) = &r.estimate else {
+        c.equal("ins nav no-mag estimate", 0, 1);
+        return;
+    };
+    let p = ins_stream::truth_position::<f32>(e.t_ns);
+    c.below(
+        "ins nav no-mag position error (m)",
+        (e.state.position - p).norm(),
+        1.5,
+    );
+    let v = ins_stream::truth_velocity::<f32>();
+    c.below(
+        "ins nav no-mag velocity err (m/s)",
+        (e.state.velocity - v).norm(),
+        0.15,
+    );
+    let a = ins_stream::truth_attitude::<f32>();
+    let err = e.state.attitude.between(&a).log().norm();
+    c.below("ins nav no-mag attitude err (rad)", err, 0.06);
+}
+
 /// What the benchmarks found besides the figures.
 struct Benchmarks {
     updates: Updates,
@@ -725,8 +858,9 @@ struct Benchmarks {
     nav_step: bool,
     /// The navigator's measured run over the stream: final estimate, samples refused.
     nav_stream: Option<(AttitudeEstimate<f32>, u32)>,
-    /// The INS navigator's measured run over its stream.
+    /// The INS navigator's measured runs over its stream, with its magnetometer and without.
     ins_nav: Option<InsNavRun>,
+    ins_nav_no_mag: Option<InsNavRun>,
 }
 
 fn run_benchmarks(w: &scenario::Workload<f32>) -> Benchmarks {
@@ -859,12 +993,15 @@ fn run_benchmarks(w: &scenario::Workload<f32>) -> Benchmarks {
         updates.bench(&mut i, "nav_filter_update_heading", f, &p.heading, opts);
     }
     let nav_stream = bench_nav_stream(&mut i);
-    let ins_nav = bench_ins_nav(&mut i);
+    let ins_nav = bench_ins_nav(&mut i, InsRun::WithMagnetometer);
+    // After every other window, so that theirs keep their indices.
+    let ins_nav_no_mag = bench_ins_nav(&mut i, InsRun::WithoutMagnetometer);
     Benchmarks {
         updates,
         nav_step,
         nav_stream,
         ins_nav,
+        ins_nav_no_mag,
     }
 }
 
@@ -899,6 +1036,7 @@ fn main() -> ! {
                 None => c.equal("nav stream run", 0, 1),
             }
             check_ins_nav(&mut c, &b.ins_nav);
+            check_ins_nav_without_magnetometer(&mut c, &b.ins_nav_no_mag);
         }
         None => c.equal("benchmark workload built", 0, 1),
     }

@@ -3,6 +3,7 @@
 //! GNSS faults it must detect (a frozen receiver, a persistent disagreement).
 
 use estimator_core::eskf::FilterConfig;
+use estimator_core::lie::LieGroup;
 use estimator_core::nav::{
     AidStatus, Aiding, AttitudeConfig, GnssFix, InsConfig, InsEvent, InsNavigator, MagneticConfig,
     NavError, Reason, Validity,
@@ -686,4 +687,71 @@ fn ins_navigator_does_not_start_from_an_outlier() {
     assert!(started > 1.2 && started < 2.0, "started at {started} s");
     assert!(nav.estimate().unwrap().state.position.norm() < 1.0);
     assert!(nav.counters().unused >= 2, "{:?}", nav.counters());
+}
+
+/// Without a magnetometer, the stream's fixes with their velocities turned by `turn` about
+/// the vertical (a receiver whose velocities disagree with its positions); returns the last
+/// report, the counters and the estimate's yaw (the truth faces east: yaw 0).
+fn without_magnetometer(
+    turn: f64,
+) -> (
+    estimator_core::nav::InsReport<f64>,
+    estimator_core::nav::InsCounters,
+    f64,
+) {
+    let mut c = config();
+    c.attitude.magnetometer = None;
+    let mut nav = InsNavigator::<f64>::new(c).unwrap();
+    let (s, co) = turn.sin_cos();
+    let fixes: Vec<(u64, Aid)> = aids(40.0, 5.0)
+        .into_iter()
+        .filter_map(|(t, a)| match a {
+            Aid::Gnss(f) => {
+                let v = f.velocity.unwrap();
+                let turned = Vector3::new(co * v.x - s * v.y, s * v.x + co * v.y, v.z);
+                Some((
+                    t,
+                    Aid::Gnss(GnssFix::new(f.position, Some(turned), 0.5, 0.05)),
+                ))
+            }
+            Aid::Mag(_) => None,
+        })
+        .collect();
+    let mut next = 0;
+    for k in 0..(40.0 * 200.0) as u64 {
+        let (t, g, a) = imu(k);
+        while let Some((valid, aid)) = fixes.get(next) {
+            if *valid > t {
+                break;
+            }
+            give(&mut nav, *valid, aid).unwrap();
+            next += 1;
+        }
+        nav.imu(t, &g, &a).unwrap();
+    }
+    let q = nav.estimate().unwrap().state.attitude;
+    let fwd = q.act(&Vector3::x());
+    (*nav.report(), *nav.counters(), fwd.y.atan2(fwd.x))
+}
+
+#[test]
+fn ins_navigator_without_a_magnetometer_takes_its_heading_only_from_velocities_the_positions_confirm(
+) {
+    // The vehicle accelerates east, facing east. With its true velocities the GNSS track
+    // resolves the heading; with velocities turned by 90° (north, while the positions move
+    // east) the comparison of velocities and positions finds them wrong, the bank takes none
+    // of them, and the heading is reported unresolved to the end rather than locked 90° off.
+    let (report, counters, yaw) = without_magnetometer(0.0);
+    assert!(report.validity.heading.is_valid(), "{report:?}");
+    assert!(counters.heading_resets >= 1);
+    assert_eq!(counters.gnss_velocity_inconsistent, 0, "{counters:?}");
+    assert!(yaw.abs() < 2f64.to_radians(), "yaw {}", yaw.to_degrees());
+
+    let (report, counters, _) = without_magnetometer(core::f64::consts::FRAC_PI_2);
+    assert_eq!(
+        report.validity.heading,
+        Validity::Invalid(Reason::HeadingUnresolved),
+        "{counters:?}"
+    );
+    assert!(counters.gnss_velocity_inconsistent > 0, "{counters:?}");
 }

@@ -116,6 +116,11 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         let lever = self.config.gnss_lever_arm;
         let repeated = self.gnss.last_position == Some(z);
         self.gnss.last_position = Some(z);
+        if let Mode::Running(_, bank) = &mut self.mode {
+            if !repeated && bank.check_position(t_m, &z, sigma.horizontal) {
+                count(&mut self.counters.gnss_velocity_inconsistent);
+            }
+        }
         let Some(ins) = self.ins_mut() else {
             return;
         };
@@ -193,7 +198,8 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
     /// `v + R(ω × ℓ)`, so `z − R((ω_m − b_g) × ℓ) + a dt` with `a = R(f_m − b_a) + g` (the last
     /// interval's rate and specific force) against `h(x) = v` ([`GnssVelocity`]). After a
     /// position reset, the velocity is reset to it instead. The bank of yaw hypotheses takes
-    /// that body velocity too (`nav/ins/heading.rs`), unless the receiver is frozen.
+    /// that body velocity too (`nav/ins/heading.rs`), unless the receiver is frozen or its
+    /// velocities disagree with its positions (`nav/ins/velocity_check.rs`).
     pub(super) fn fuse_gnss_velocity(&mut self, t_m: u64, dt: T, z: Vector3<T>, sigma: T) {
         let (rate, specific_force, lever) = (
             self.filter_rate,
@@ -207,6 +213,7 @@ impl<T: Real, const H: usize, const Q: usize> InsNavigator<T, H, Q> {
         if frozen {
             return;
         }
+        bank.check_velocity(t_m, &z, sigma);
         let s = *ins.state();
         let omega = rate - s.gyro_bias;
         let accel = s.attitude.act(&(specific_force - s.accel_bias)) + ins.config().gravity;

@@ -30,6 +30,10 @@
 //!   velocity's direction is noise, and so would be the heading it gives.
 //! * **Each update** that turns the INS's attitude about the vertical turns the bank's
 //!   reference with it ([`YawBank::shift`]).
+//! * **Velocities the positions refute** (`nav/ins/velocity_check.rs`: the displacement the
+//!   velocities describe against the positions', window by window) are not given to the bank
+//!   until a window agrees again (`InsCounters::gnss_velocity_inconsistent`), nor are a frozen
+//!   receiver's: the bank would take a heading from them as confidently as from true ones.
 
 use super::report::InsEvent;
 use super::validity::largest;

@@ -69,6 +69,7 @@ mod report;
 mod start;
 mod track_axis;
 mod validity;
+mod velocity_check;
 mod vibration;
 mod window;
 mod yaw;

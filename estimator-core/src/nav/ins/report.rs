@@ -163,6 +163,10 @@ pub struct InsCounters {
     pub lateral_fused: u32,
     /// … and rejected by the gate (the vehicle slid, or the heading is wrong).
     pub lateral_rejected: u32,
+    /// Without a magnetometer: windows over which the GNSS velocities disagreed with the
+    /// positions (`nav/ins/velocity_check.rs`); the bank of yaw hypotheses takes no velocity
+    /// until a window agrees again.
+    pub gnss_velocity_inconsistent: u32,
     /// Updates or predictions the filter refused (a numerical failure: skipped, the filter
     /// left as it was).
     pub numerical_failures: u32,

@@ -69,6 +69,7 @@
 
 use super::config::Travel;
 use super::track_axis::TrackAxis;
+use super::velocity_check::VelocityCheck;
 use crate::eskf::{EskfError, ImuSample, Ins};
 use crate::kernels::mat3;
 use crate::lie::{LieGroup, So3};
@@ -146,6 +147,9 @@ pub(crate) struct YawBank<T: Real> {
     travel: Travel<T>,
     /// Its GNSS velocities in the INS's heading frame, for [`Travel::Detect`].
     axis: TrackAxis<T>,
+    /// Whether the GNSS velocities agree with the positions (`nav/ins/velocity_check.rs`):
+    /// the bank takes none while they do not.
+    check: VelocityCheck<T>,
     /// The INS's attitude before the fusion under way, and the GNSS velocity it brought
     /// (the body's, at the filter's time, with its 1σ per axis): what
     /// [`InsNavigator::track_heading`](super::InsNavigator) takes after it.
@@ -272,6 +276,7 @@ impl<T: Real> YawBank<T> {
             lateral,
             travel,
             axis: TrackAxis::default(),
+            check: VelocityCheck::default(),
             before: So3::identity(),
             velocity: None,
             active,
@@ -291,7 +296,7 @@ impl<T: Real> YawBank<T> {
     /// A GNSS velocity the INS fused (or reset to): the body's, at the filter's time, with
     /// its 1σ per axis.
     pub(crate) fn take_velocity(&mut self, velocity: &Vector3<T>, sigma: T) {
-        if self.active {
+        if self.active && self.check.agree() {
             self.velocity = Some((*velocity, sigma));
         }
     }
@@ -551,6 +556,26 @@ impl<T: Real> YawBank<T> {
             self.resolved_by_track = false;
         }
         self.restart();
+    }
+
+    /// A GNSS velocity as the receiver gave it (horizontal, world), valid at `t_ns`, with its
+    /// 1σ per axis: for the comparison with the positions.
+    pub(crate) fn check_velocity(&mut self, t_ns: u64, velocity: &Vector3<T>, sigma: T) {
+        if self.active {
+            let v = Vector2::new(velocity.x, velocity.y);
+            self.check.velocity(t_ns, &v, sigma * sigma);
+        }
+    }
+
+    /// A GNSS position (world), valid at `t_ns`, with its horizontal 1σ; `true` when it
+    /// closes a window over which the velocities disagreed with the positions (the bank then
+    /// takes no velocity until a window agrees again).
+    pub(crate) fn check_position(&mut self, t_ns: u64, position: &Vector3<T>, sigma: T) -> bool {
+        if !self.active {
+            return false;
+        }
+        let p = Vector2::new(position.x, position.y);
+        self.check.position(t_ns, &p, sigma * sigma) == Some(false)
     }
 
     /// Starts the hypotheses again at the next velocity, from nothing learned.

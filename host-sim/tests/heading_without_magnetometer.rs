@@ -7,7 +7,7 @@
 //! The 50-seed figures are `host-sim montecarlo --scenario rover --runs 50` (and
 //! `rover_moving`, `car_no_mag`), in docs/FIGURES.md; here a few seeds, in the test profile.
 
-use host_sim::montecarlo::run_from;
+use host_sim::montecarlo::{run_from, HeadingSummary, Report};
 use host_sim::scenario::Scenario;
 
 /// Seeds per scenario here (each a full 360 s or 60 s run).
@@ -16,8 +16,23 @@ const SEEDS: u64 = 10;
 fn check(name: &str, within_deg: &str, by_s: f64) {
     let scenario = Scenario::load(name).expect("built-in scenario");
     let report = run_from(&scenario, 1, SEEDS, 0.0, false).expect("runs");
-    let h = report.heading_summary().expect("the body moves");
+    let h = settled(name, &report, within_deg, by_s);
     assert_eq!(h.runs as u64, SEEDS);
+    assert!(
+        h.valid_samples > 0,
+        "{name}: the heading was never reported valid"
+    );
+    assert_eq!(
+        h.valid_outside_4sigma, 0,
+        "{name}: reported valid with the heading outside 4σ"
+    );
+    anees_in_band(name, &report);
+}
+
+/// The heading summary, checked within `within_deg` for good by `by_s` after the first motion
+/// in every run.
+fn settled(name: &str, report: &Report, within_deg: &str, by_s: f64) -> HeadingSummary {
+    let h = report.heading_summary().expect("the body moves");
     let (latest, never) = h
         .settled_after_motion_s
         .iter()
@@ -33,14 +48,11 @@ fn check(name: &str, within_deg: &str, by_s: f64) {
         latest <= by_s,
         "{name}: within {within_deg}° only {latest:.1} s after the first motion (target {by_s} s)"
     );
-    assert!(
-        h.valid_samples > 0,
-        "{name}: the heading was never reported valid"
-    );
-    assert_eq!(
-        h.valid_outside_4sigma, 0,
-        "{name}: reported valid with the heading outside 4σ"
-    );
+    h
+}
+
+/// The attitude ANEES over the runs inside its chi-square band.
+fn anees_in_band(name: &str, report: &Report) {
     let attitude = report
         .nees
         .iter()
@@ -92,29 +104,6 @@ fn a_flight_without_a_magnetometer_is_not_held_to_its_track() {
         ..flight
     };
     let report = run_from(&scenario, 1, SEEDS, 0.0, false).expect("runs");
-    let h = report.heading_summary().expect("the body moves");
-    let (latest, never) = h
-        .settled_after_motion_s
-        .iter()
-        .find(|(deg, _, _)| deg == "5")
-        .map(|(_, l, n)| (*l, *n))
-        .expect("a settling threshold");
-    assert_eq!(never, 0, "heading not within 5° at the end");
-    let latest = latest.expect("settled");
-    assert!(
-        latest <= 60.0,
-        "within 5° only {latest:.1} s after the first motion"
-    );
-    let attitude = report
-        .nees
-        .iter()
-        .find(|b| b.name == "attitude")
-        .expect("attitude NEES");
-    assert!(
-        attitude.holds(),
-        "attitude ANEES {:.2} outside [{:.2}, {:.2}]",
-        attitude.value,
-        attitude.lower,
-        attitude.upper
-    );
+    settled("flight without a magnetometer", &report, "5", 60.0);
+    anees_in_band("flight without a magnetometer", &report);
 }

@@ -710,19 +710,28 @@ mod tests {
     #[test]
     fn a_speed_change_on_the_track_tells_forward_from_backward() {
         let error = -120f64.to_radians();
-        // 0.35 m/s north reached in 2 s, then slower and faster again (a rover's speed).
-        let bank = drive(error, 40.0, Some(0.05), |t| {
-            let along = if t < 2.0 {
-                0.175
-            } else {
-                0.05 * (0.5 * t).cos()
-            };
-            Vector2::new(0.0, along)
-        });
-        let (offset, sigma) = bank.estimate().expect("started");
+        let bank = drive(error, 40.0, Some(0.05), rover_speed);
         // The yaw is known to the velocity's steady-state error over the speed: with the
         // random walk q_v = 2.4e-5 (m/s)² per fix against the fixes' 0.01, (q_v r)^¼ ≈ 0.022
         // m/s, over 0.35 m/s: 3.6°.
+        assert_found(bank.estimate(), error);
+    }
+
+    /// 0.35 m/s north reached in 2 s, then slower and faster again (a rover's speed): the
+    /// acceleration at `t`.
+    fn rover_speed(t: f64) -> Vector2<f64> {
+        let along = if t < 2.0 {
+            0.175
+        } else {
+            0.05 * (0.5 * t).cos()
+        };
+        Vector2::new(0.0, along)
+    }
+
+    /// The bank's `(offset, σ)` takes an INS off by `error` to the truth: σ below 5°, the
+    /// offset within 3σ of `−error`.
+    fn assert_found(estimate: Option<(f64, f64)>, error: f64) {
+        let (offset, sigma) = estimate.expect("started");
         assert!(sigma < 5f64.to_radians(), "σ {}", sigma.to_degrees());
         assert!(
             wrap(offset + error).abs() < 3.0 * sigma,
@@ -745,26 +754,13 @@ mod tests {
     #[test]
     fn a_vehicle_along_its_track_is_learned_and_found_forward() {
         let error = -120f64.to_radians();
-        let bank = drive_with(Travel::Detect, error, 40.0, |t| {
-            let along = if t < 2.0 {
-                0.175
-            } else {
-                0.05 * (0.5 * t).cos()
-            };
-            Vector2::new(0.0, along)
-        });
+        let bank = drive_with(Travel::Detect, error, 40.0, rover_speed);
         // No lateral motion: the learned σ_l is the sampling bound of the fixes' noise,
         // σ_v √2 (2/n)^¼ with σ_v = 0.1 m/s and n ≈ 200: 0.045 m/s.
         let sigma_l = bank.lateral_sigma().expect("an axis");
         assert!(sigma_l < 0.05, "{sigma_l}");
         let d = rotate(error.sincos(), &Vector2::new(0.0, 1.0));
-        let (offset, sigma) = bank.forward_estimate(&d).expect("started");
-        assert!(sigma < 5f64.to_radians(), "σ {}", sigma.to_degrees());
-        assert!(
-            wrap(offset + error).abs() < 3.0 * sigma,
-            "{}",
-            offset.to_degrees()
-        );
+        assert_found(bank.forward_estimate(&d), error);
     }
 
     #[test]

@@ -762,31 +762,42 @@ fn check_ins_nav(c: &mut Checker, run: &Option<InsNavRun>) {
     c.at_least("ins nav gnss position fused", n.gnss_position_fused, 25);
     c.at_least("ins nav gnss velocity fused", n.gnss_velocity_fused, 25);
     c.at_least("ins nav magnetometer fused", n.magnetometer_fused, 250);
+    check_ins_nav_end(
+        c,
+        r,
+        [
+            "ins nav tilt/heading/v/p valid",
+            "ins nav estimate",
+            "ins nav position error (m)",
+            "ins nav velocity error (m/s)",
+            "ins nav attitude error (rad)",
+        ],
+        0.03,
+    );
+}
+
+/// The INS navigator's end: tilt, heading, velocity and position valid, and the estimate
+/// within 1.5 m, 0.15 m/s and `attitude_bound` rad of the truth; `labels` name the checks
+/// (validity, estimate present, position, velocity, attitude).
+fn check_ins_nav_end(c: &mut Checker, r: &InsNavRun, labels: [&str; 5], attitude_bound: f32) {
+    let [valid_label, estimate_label, position_label, velocity_label, attitude_label] = labels;
     let v = &r.report.validity;
     let valid = [v.tilt, v.heading, v.velocity, v.position]
         .iter()
         .filter(|x| x.is_valid())
         .count();
-    c.equal("ins nav tilt/heading/v/p valid", valid as u32, 4);
+    c.equal(valid_label, valid as u32, 4);
     let Some(e) = &r.estimate else {
-        c.equal("ins nav estimate", 0, 1);
+        c.equal(estimate_label, 0, 1);
         return;
     };
     let p = ins_stream::truth_position::<f32>(e.t_ns);
-    c.below(
-        "ins nav position error (m)",
-        (e.state.position - p).norm(),
-        1.5,
-    );
+    c.below(position_label, (e.state.position - p).norm(), 1.5);
     let v = ins_stream::truth_velocity::<f32>();
-    c.below(
-        "ins nav velocity error (m/s)",
-        (e.state.velocity - v).norm(),
-        0.15,
-    );
+    c.below(velocity_label, (e.state.velocity - v).norm(), 0.15);
     let a = ins_stream::truth_attitude::<f32>();
     let err = e.state.attitude.between(&a).log().norm();
-    c.below("ins nav attitude error (rad)", err, 0.03);
+    c.below(attitude_label, err, attitude_bound);
 }
 
 /// Checks the INS navigator's run without a magnetometer: every sample taken, the INS started
@@ -824,31 +835,18 @@ fn check_ins_nav_without_magnetometer(c: &mut Checker, run: &Option<InsNavRun>) 
     );
     c.at_least("ins nav no-mag lateral fused", n.lateral_fused, 20);
     c.equal("ins nav no-mag lateral rejected", n.lateral_rejected, 0);
-    let v = &r.report.validity;
-    let valid = [v.tilt, v.heading, v.velocity, v.position]
-        .iter()
-        .filter(|x| x.is_valid())
-        .count();
-    c.equal("ins nav no-mag tilt/hdg/v/p valid", valid as u32, 4);
-    let Some(e) = &r.estimate else {
-        c.equal("ins nav no-mag estimate", 0, 1);
-        return;
-    };
-    let p = ins_stream::truth_position::<f32>(e.t_ns);
-    c.below(
-        "ins nav no-mag position error (m)",
-        (e.state.position - p).norm(),
-        1.5,
+    check_ins_nav_end(
+        c,
+        r,
+        [
+            "ins nav no-mag tilt/hdg/v/p valid",
+            "ins nav no-mag estimate",
+            "ins nav no-mag position error (m)",
+            "ins nav no-mag velocity err (m/s)",
+            "ins nav no-mag attitude err (rad)",
+        ],
+        0.06,
     );
-    let v = ins_stream::truth_velocity::<f32>();
-    c.below(
-        "ins nav no-mag velocity err (m/s)",
-        (e.state.velocity - v).norm(),
-        0.15,
-    );
-    let a = ins_stream::truth_attitude::<f32>();
-    let err = e.state.attitude.between(&a).log().norm();
-    c.below("ins nav no-mag attitude err (rad)", err, 0.06);
 }
 
 /// What the benchmarks found besides the figures.

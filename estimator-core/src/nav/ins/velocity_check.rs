@@ -21,16 +21,12 @@
 //! positions move are not judged, and say nothing of a heading either. The verdict holds until
 //! the next window closes.
 
+use super::seconds;
 use crate::Real;
 use nalgebra::Vector2;
 
 /// The 99.9 % point of a χ² with 2 degrees of freedom.
 const CHI2_2_999: f64 = 13.8155;
-
-/// Seconds between two stamps, ns (0 when `b` is not after `a`).
-fn seconds<T: Real>(a: u64, b: u64) -> T {
-    T::from_count(u32::try_from(b.saturating_sub(a) / 1_000).unwrap_or(u32::MAX)) * T::lit(1e-6)
-}
 
 /// The running comparison of velocities and positions (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,7 +58,7 @@ impl<T: Real> VelocityCheck<T> {
     /// A horizontal velocity valid at `t_ns`, with `variance` per axis.
     pub(crate) fn velocity(&mut self, t_ns: u64, v: &Vector2<T>, variance: T) {
         if let Some((t0, v0)) = self.last {
-            let dt: T = seconds(t0, t_ns);
+            let dt: T = seconds(t_ns.saturating_sub(t0));
             self.displacement += (v0 + v) * (dt * T::lit(0.5));
             self.displacement_variance += variance * dt * dt * T::lit(0.5);
         }
@@ -81,9 +77,9 @@ impl<T: Real> VelocityCheck<T> {
         let moved = p - p0;
         let positions = var0 + variance;
         // The last velocity carried to the fix's time.
-        let carried = self
-            .last
-            .map_or(Vector2::zeros(), |(t, v)| v * seconds::<T>(t, t_ns));
+        let carried = self.last.map_or(Vector2::zeros(), |(t, v)| {
+            v * seconds::<T>(t_ns.saturating_sub(t))
+        });
         let described = self.displacement + carried;
         // Closed by the velocities' displacement alone: closed by the positions', a window
         // would end when their noise happens to carry them out, and judge that noise.
@@ -117,12 +113,24 @@ mod tests {
 
     /// Fixes at 5 Hz of a body moving at `v` m/s east, with velocities reported as `reported`.
     fn run(v: f64, reported: Vector2<f64>, seconds: u64) -> Vec<bool> {
+        run_noisy(v, reported, seconds, 1.0, |_| Vector2::zeros())
+    }
+
+    /// [`run`] with the positions' variance per axis `variance` and their error `noise(k)`
+    /// at fix `k`.
+    fn run_noisy(
+        v: f64,
+        reported: Vector2<f64>,
+        seconds: u64,
+        variance: f64,
+        noise: impl Fn(u64) -> Vector2<f64>,
+    ) -> Vec<bool> {
         let mut check = VelocityCheck::default();
         let mut verdicts = Vec::new();
         for k in 0..seconds * 5 {
             let t = k * 200_000_000;
-            let p = Vector2::new(v * k as f64 * 0.2, 0.0);
-            if let Some(v) = check.position(t, &p, 1.0) {
+            let p = Vector2::new(v * k as f64 * 0.2, 0.0) + noise(k);
+            if let Some(v) = check.position(t, &p, variance) {
                 verdicts.push(v);
             }
             check.velocity(t, &reported, 0.01);
@@ -148,18 +156,10 @@ mod tests {
     fn white_position_noise_seldom_fails_the_check() {
         // 1.5 m white noise on the positions (a deterministic spread of ±√3 σ), 0.35 m/s:
         // every window agrees.
-        let mut check = VelocityCheck::default();
-        let mut verdicts = Vec::new();
-        for k in 0..2_000u64 {
-            let t = k * 200_000_000;
-            let u = |j: u64| ((j.wrapping_mul(2_654_435_761) % 1_000) as f64 / 999.0 - 0.5) * 2.0;
-            let noise = Vector2::new(u(k), u(k + 7_919)) * (1.5 * 3f64.sqrt());
-            let p = Vector2::new(0.35 * k as f64 * 0.2, 0.0) + noise;
-            if let Some(v) = check.position(t, &p, 2.25) {
-                verdicts.push(v);
-            }
-            check.velocity(t, &Vector2::new(0.35, 0.0), 0.01);
-        }
+        let u = |j: u64| ((j.wrapping_mul(2_654_435_761) % 1_000) as f64 / 999.0 - 0.5) * 2.0;
+        let verdicts = run_noisy(0.35, Vector2::new(0.35, 0.0), 400, 2.25, |k| {
+            Vector2::new(u(k), u(k + 7_919)) * (1.5 * 3f64.sqrt())
+        });
         assert!(verdicts.len() >= 10, "{verdicts:?}");
         assert!(verdicts.iter().all(|a| *a), "{verdicts:?}");
     }

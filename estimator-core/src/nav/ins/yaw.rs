@@ -375,10 +375,11 @@ impl<T: Real> YawBank<T> {
         forward: &Vector2<T>,
         noise: &StepNoise<T>,
     ) {
+        let track = forward.dot(forward).sqrt_rn();
+        let d = (track >= T::lit(MIN_FORWARD_HORIZONTAL)).then(|| forward / track);
         if self.travel == Travel::Detect {
-            let track = forward.dot(forward).sqrt_rn();
-            if track >= T::lit(MIN_FORWARD_HORIZONTAL) {
-                self.axis.add(z, variance, &(forward / track));
+            if let Some(d) = &d {
+                self.axis.add(z, variance, d);
             }
             let was = self.lateral.is_some();
             self.lateral = self.axis.lateral_variance();
@@ -408,8 +409,6 @@ impl<T: Real> YawBank<T> {
             self.increments_squared += increment.dot(&increment);
             self.durations_squared += tau * tau;
             self.systematic = noise.drift_velocity;
-            let track = forward.dot(forward).sqrt_rn();
-            let d = (track >= T::lit(MIN_FORWARD_HORIZONTAL)).then(|| forward / track);
             for h in &mut self.hypotheses {
                 let sc = h.offset.sincos();
                 let turned = rotate(sc, &increment);

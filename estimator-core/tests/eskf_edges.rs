@@ -746,6 +746,31 @@ fn widening_the_attitude_stops_at_no_information() {
     }
 }
 
+/// The attitude prior of a tilt of σ = π and a yaw of σ = 1e-6 rad about an up direction
+/// 64 ε too long in `f32` (a rounded gravity and rotation gave one): the eigenvalue along the
+/// up direction is `σ_ψ² − δ (σ_t² − σ_ψ²)` for `|u|² = 1 + δ`, −7.5·10⁻⁵ rad² here unless the
+/// direction is made a unit vector; normalized, what is left is the rounding of entries of
+/// size π², a few `ε π²`. A fuzzing finding: `Ins<f32>::widen_attitude` at its cap left `P`
+/// indefinite.
+#[test]
+fn f32_attitude_prior_with_a_long_up_direction_is_positive_semi_definite() {
+    let long = 1.0 + 64.0 * f32::EPSILON;
+    let up = Vector3::new(1.0f32, 1.0, 1.0) / 3.0f32.sqrt() * long.sqrt();
+    let sigmas = InitialSigmas {
+        tilt: core::f32::consts::PI,
+        yaw: 1e-6,
+        ..InitialSigmas::default()
+    };
+    let sigma = sigmas.attitude_covariance(&So3::identity(), &up);
+    let sigma64: Matrix3<f64> = sigma.cast();
+    let smallest = sigma64.symmetric_eigenvalues().min();
+    let rounding = 8.0 * f64::from(f32::EPSILON) * core::f64::consts::PI.powi(2);
+    assert!(
+        smallest >= -rounding,
+        "smallest eigenvalue {smallest:e}, rounding bound {rounding:e}"
+    );
+}
+
 /// A GNSS fix of σ = 1e-6 m against a position prior of 0.1 m, in `f32`: accepted, and `P`
 /// stays positive definite because each row's noise is raised to the floor
 /// `256 N ε Σ_i H_i² P_ii` for the posterior (here `256·15·ε·0.01`). Without the floor the

@@ -53,6 +53,12 @@ pub trait Real: RealField + Copy + sealed::Sealed {
     /// `P_ii P_jj`, a gain's `P H² P`) stays finite.
     const VARIANCE_CEILING_F64: f64;
 
+    /// The smallest variance a filter holds, `√MIN_POSITIVE` rounded up (`1.1e-19` for `f32`,
+    /// `1.5e-154` for `f64`), as an `f64`: the product of any two such variances stays a
+    /// normal number, with its full relative precision (a subnormal variance has lost it: at
+    /// `5e-324` there is one bit left).
+    const VARIANCE_FLOOR_F64: f64;
+
     /// Converts a literal: `T::lit(1.0 / 6.0)` folds to a constant of type `T`.
     fn lit(x: f64) -> Self;
 
@@ -80,6 +86,7 @@ pub trait Real: RealField + Copy + sealed::Sealed {
 impl Real for f64 {
     const EPSILON_F64: f64 = f64::EPSILON;
     const VARIANCE_CEILING_F64: f64 = 1.3e154;
+    const VARIANCE_FLOOR_F64: f64 = 1.5e-154;
 
     fn lit(x: f64) -> Self {
         x
@@ -109,6 +116,7 @@ impl Real for f64 {
 impl Real for f32 {
     const EPSILON_F64: f64 = f32::EPSILON as f64;
     const VARIANCE_CEILING_F64: f64 = 1.8e19;
+    const VARIANCE_FLOOR_F64: f64 = 1.1e-19;
 
     fn lit(x: f64) -> Self {
         x as f32

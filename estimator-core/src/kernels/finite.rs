@@ -24,11 +24,11 @@ pub(crate) fn positive_finite<T: Real>(x: T) -> bool {
     x > T::zero() && x * T::zero() == T::zero()
 }
 
-/// `x` is a variance a filter may hold: positive and at most [`Real::VARIANCE_CEILING_F64`]
-/// (so finite; NaN fails).
+/// `x` is a variance a filter may hold: at least [`Real::VARIANCE_FLOOR_F64`] and at most
+/// [`Real::VARIANCE_CEILING_F64`] (so finite and normal; NaN fails).
 #[inline(always)]
 pub(crate) fn usable_variance<T: Real>(x: T) -> bool {
-    x > T::zero() && x <= T::lit(T::VARIANCE_CEILING_F64)
+    x >= T::lit(T::VARIANCE_FLOOR_F64) && x <= T::lit(T::VARIANCE_CEILING_F64)
 }
 
 /// The larger of `a` and `b`, `a` when `b` is NaN: a comparison and a select. `f32::max` is

@@ -16,9 +16,10 @@ pub enum EskfError {
     /// an `R` singular to the scalar's resolution (a row whose variance the others explain
     /// to all but `256 N ε` of it, the update's noise floor).
     NoiseNotPositiveDefinite,
-    /// A covariance given to a constructor that is not symmetric positive definite, or is
-    /// singular to the resolution the filter keeps (a variable whose variance the others
-    /// explain to all but `256 N ε` of it).
+    /// A covariance given to a constructor that is not symmetric positive definite, has a
+    /// variance outside the floor and ceiling ([`crate::Real::VARIANCE_FLOOR_F64`],
+    /// [`crate::Real::VARIANCE_CEILING_F64`]), or is singular to the resolution the filter
+    /// keeps (a variable whose variance the others explain to all but `256 N ε` of it).
     CovarianceNotPositiveDefinite,
     /// A vector that must have a direction (magnetometer, accelerometer, reference field) has
     /// zero norm, or no horizontal component where a heading is needed.
@@ -29,8 +30,9 @@ pub enum EskfError {
     SingularGeometry,
     /// The innovation covariance `S = H P Hᵀ + R` could not be factored.
     SingularInnovation,
-    /// The updated covariance came out non-finite, with a non-positive diagonal or with a
-    /// variance above the variance ceiling ([`crate::Real::VARIANCE_CEILING_F64`]), or the
+    /// The updated covariance came out non-finite, with a variance below the variance floor
+    /// ([`crate::Real::VARIANCE_FLOOR_F64`]) or above the variance ceiling
+    /// ([`crate::Real::VARIANCE_CEILING_F64`]), or the
     /// attitude correction `|δθ|` reached π (outside the chart where `⊕` is one-to-one); the
     /// update was not applied. Or a prediction whose bias-corrected rotation in one step,
     /// `|(ω_m − b_g) dt|`, reached π (the sample cannot say how the body turned).

@@ -126,7 +126,8 @@ impl<T: Real, S: ErrorState<T, N>, const N: usize> Filter<T, S, N> {
     /// [`covariance`](Self::covariance).
     ///
     /// # Errors
-    /// A non-finite state, `P` not symmetric positive definite or singular to the scalar's
+    /// A non-finite state, `P` not symmetric positive definite, with a variance outside the
+    /// variance floor and ceiling, or singular to the scalar's
     /// resolution (a state other than the attitude known, given the attitude and the states
     /// before it, to less than `256 N ε` of its variance), or an invalid configuration
     /// ([`FilterConfig::validate`]).
@@ -484,8 +485,9 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
     /// sensor has disagreed with the estimate for so long that the estimate is the suspect.
     ///
     /// # Errors
-    /// [`EskfError::NonFinite`] for a non-finite position, or a sigma whose square is not
-    /// positive or is above the variance ceiling ([`crate::Real::VARIANCE_CEILING_F64`]); the
+    /// [`EskfError::NonFinite`] for a non-finite position, or a sigma whose square is below the
+    /// variance floor or above the variance ceiling ([`crate::Real::VARIANCE_FLOOR_F64`],
+    /// [`crate::Real::VARIANCE_CEILING_F64`]); the
     /// filter is then unchanged.
     pub fn reset_position(&mut self, position: Vector3<T>, sigma: T) -> Result<(), EskfError> {
         self.reset_block(2, position, &Vector3::repeat(sigma))
@@ -574,8 +576,8 @@ impl<T: Real> Filter<T, InsState<T>, 15> {
     /// ```
     ///
     /// # Errors
-    /// [`EskfError::NonFinite`] for a non-finite turn, or a sigma whose square is not positive
-    /// or is above the variance ceiling; [`EskfError::ZeroNorm`] for a zero gravity;
+    /// [`EskfError::NonFinite`] for a non-finite turn, or a sigma whose square is below the
+    /// variance floor or above the variance ceiling; [`EskfError::ZeroNorm`] for a zero gravity;
     /// [`EskfError::NumericalFailure`] when the result is not finite. The filter is then
     /// unchanged.
     #[inline(never)] // rare: its matrices stay out of the caller's frame

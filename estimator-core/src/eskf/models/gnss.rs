@@ -73,8 +73,9 @@ impl<T: Real> GnssPosition<T> {
     /// # Errors
     /// [`EskfError::NonFinite`] for a non-finite position or lever arm;
     /// [`EskfError::NoiseNotPositiveDefinite`] for a sigma that is not finite and positive, or
-    /// whose square is zero or above the variance ceiling
-    /// ([`crate::Real::VARIANCE_CEILING_F64`]). Nothing is built.
+    /// whose square is below the variance floor or above the variance ceiling
+    /// ([`crate::Real::VARIANCE_FLOOR_F64`], [`crate::Real::VARIANCE_CEILING_F64`]). Nothing is
+    /// built.
     pub fn with_sigmas(
         position: Vector3<T>,
         lever_arm: Vector3<T>,

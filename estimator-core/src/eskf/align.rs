@@ -186,14 +186,18 @@ impl<T: Real> InitialSigmas<T> {
         let t2 = tilt * tilt;
         let y2 = yaw * yaw;
         // Σ_w = σ_t² I + (σ_ψ² − σ_t²) u uᵀ, so Rᵀ Σ_w R = σ_t² I + (σ_ψ² − σ_t²) u_b u_bᵀ with
-        // u_b = Rᵀ u: exactly symmetric (u_i u_j = u_j u_i), at every magnitude. u_b is made a
-        // unit vector here: one of length² 1 + δ gives the eigenvalue σ_ψ² − δ (σ_t² − σ_ψ²)
-        // along it, below zero for a yaw far below the tilt (a rounded gravity and rotation gave
-        // δ = 64 ε in f32, −7.5·10⁻⁵ rad² against σ_t² = π²); normalized, δ is a few ε.
+        // u_b = Rᵀ u: exactly symmetric (u_i u_j = u_j u_i), at every magnitude. A u_b of
+        // length² 1 + δ gives the eigenvalue σ_ψ² − δ (σ_t² − σ_ψ²) along it, below zero for a
+        // yaw far below the tilt (an up rounded 64 ε long in f32 gave −7.5·10⁻⁵ rad² against
+        // σ_t² = π²): beyond |δ| = 16 ε (an eigenvalue error of 16 ε σ_t², under the attitude
+        // floor's margin) it is made a unit vector; a unit `up` and rotation never take the
+        // branch (their rounding is a few ε).
         let u_b = mat3::mul_vec(&attitude.rotation_matrix().transpose(), up);
-        let length = mat3::norm(&u_b);
-        let u_b = if crate::kernels::positive_finite(length) {
-            u_b / length
+        let length_sq = u_b.dot(&u_b);
+        let off = length_sq - T::one();
+        let limit = T::lit(16.0 * T::EPSILON_F64);
+        let u_b = if (off > limit || off < -limit) && crate::kernels::positive_finite(length_sq) {
+            u_b / length_sq.sqrt_rn()
         } else {
             u_b
         };

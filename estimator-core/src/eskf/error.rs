@@ -30,9 +30,8 @@ pub enum EskfError {
     SingularGeometry,
     /// The innovation covariance `S = H P Hᵀ + R` could not be factored.
     SingularInnovation,
-    /// The updated covariance came out non-finite, with a variance below the variance floor
-    /// ([`crate::Real::VARIANCE_FLOOR_F64`]) or above the variance ceiling
-    /// ([`crate::Real::VARIANCE_CEILING_F64`]), or the
+    /// The updated covariance came out non-finite, with a non-positive diagonal or with a
+    /// variance above the variance ceiling ([`crate::Real::VARIANCE_CEILING_F64`]), or the
     /// attitude correction `|δθ|` reached π (outside the chart where `⊕` is one-to-one); the
     /// update was not applied. Or a prediction whose bias-corrected rotation in one step,
     /// `|(ω_m − b_g) dt|`, reached π (the sample cannot say how the body turned).

@@ -8,7 +8,7 @@ use super::covariance::{
 use super::error::EskfError;
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
 use crate::kernels::block::{add_scaled_identity, block, block_in, set_block};
-use crate::kernels::{all_finite, mat3, usable_variance};
+use crate::kernels::{all_finite, mat3, positive_variance};
 use crate::lie::{skew, LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -139,7 +139,7 @@ pub(crate) fn predict_ins_finite<T: Real>(
     // an extreme step (a huge `dt` times a huge rate) can leave it zero or negative, and such
     // a P is refused, not stored; so is one above the variance ceiling (`√MAX`), beyond which
     // the products of an update overflow or lose the state's resolution.
-    let diagonal_finite = (0..9).all(|k| l.get((k, k)).is_some_and(|d| usable_variance(*d)));
+    let diagonal_finite = (0..9).all(|k| l.get((k, k)).is_some_and(|d| positive_variance(*d)));
     let n = &cfg.imu_noise;
     let rw = |s: T| s * s * dt;
     let (q_bg, q_ba) = (rw(n.gyroscope_random_walk), rw(n.accelerometer_random_walk));
@@ -185,14 +185,14 @@ pub(crate) fn predict_ins_finite<T: Real>(
 
 /// The variances of block `block` of `P` (a bias: its row of `F` is the identity) after
 /// their random walk `q = σ² dt` stay usable: their sum `tr P_bb + 3 q` at most the variance
-/// ceiling ([`usable_variance`]; the variances are positive, so each is then at most it too).
+/// ceiling ([`positive_variance`]; the variances are positive, so each is then at most it too).
 /// Checked before anything is written, as `F P Fᵀ`'s diagonal is, so that a bias left
 /// without a measurement is refused at the ceiling instead of growing to overflow.
 #[inline(always)]
 fn walk_usable<T: Real, const N: usize>(p: &SMatrix<T, N, N>, block: usize, q: T) -> bool {
     let at = |k: usize| p.get((k, k)).copied().unwrap_or_else(T::zero);
     let k = 3 * block;
-    usable_variance(at(k) + at(k + 1) + at(k + 2) + q * T::lit(3.0))
+    positive_variance(at(k) + at(k + 1) + at(k + 2) + q * T::lit(3.0))
 }
 
 /// `|ω dt| < π` (false for NaN): the step's rotation is one the exponential map gives
@@ -251,7 +251,7 @@ fn predict_attitude<T: Real, const N: usize>(
     // As in the 15-state prediction: an overflow shows on the diagonal of N00, which bounds
     // M01 and M02 through the positive semi-definite P⁺; a diagonal that rounding left at zero
     // or below is refused too.
-    let diagonal_finite = (0..3).all(|k| n00.get((k, k)).is_some_and(|d| usable_variance(*d)));
+    let diagonal_finite = (0..3).all(|k| n00.get((k, k)).is_some_and(|d| positive_variance(*d)));
     let n = &cfg.imu_noise;
     let q_bg = n.gyroscope_random_walk * n.gyroscope_random_walk * dt;
     let q_ba = n.accelerometer_random_walk * n.accelerometer_random_walk * dt;

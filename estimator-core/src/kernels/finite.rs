@@ -24,11 +24,23 @@ pub(crate) fn positive_finite<T: Real>(x: T) -> bool {
     x > T::zero() && x * T::zero() == T::zero()
 }
 
-/// `x` is a variance a filter may hold: at least [`Real::VARIANCE_FLOOR_F64`] and at most
-/// [`Real::VARIANCE_CEILING_F64`] (so finite and normal; NaN fails).
+/// `x` is a variance a filter may take in: at least [`Real::VARIANCE_FLOOR_F64`] and at most
+/// [`Real::VARIANCE_CEILING_F64`] (so finite and normal; NaN fails). Checked where a
+/// covariance enters a filter (its constructors, resets and widenings).
 #[inline(always)]
 pub(crate) fn usable_variance<T: Real>(x: T) -> bool {
     x >= T::lit(T::VARIANCE_FLOOR_F64) && x <= T::lit(T::VARIANCE_CEILING_F64)
+}
+
+/// `x` is positive and at most [`Real::VARIANCE_CEILING_F64`] (NaN fails): the check on the
+/// variances a prediction or an update computes from ones [`usable_variance`] let in. A
+/// prediction only adds to them, and an update leaves each measured combination at least the
+/// noise floor's fraction of its prior (`update/gain.rs`), so a comparison with zero (one
+/// instruction on a Cortex-M4F, where the floor needs its constant loaded, on every variance
+/// of the hot path) is what is left to check.
+#[inline(always)]
+pub(crate) fn positive_variance<T: Real>(x: T) -> bool {
+    x > T::zero() && x <= T::lit(T::VARIANCE_CEILING_F64)
 }
 
 /// The larger of `a` and `b`, `a` when `b` is NaN: a comparison and a select. `f32::max` is

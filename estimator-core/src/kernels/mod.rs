@@ -32,5 +32,5 @@ pub(crate) mod mat3;
 pub(crate) mod slice;
 
 pub(crate) use finite::{
-    all_finite, larger, non_negative_finite, positive_finite, usable_variance,
+    all_finite, larger, non_negative_finite, positive_finite, positive_variance, usable_variance,
 };

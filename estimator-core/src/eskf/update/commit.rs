@@ -6,7 +6,7 @@ use crate::eskf::covariance::attitude_floor;
 use crate::eskf::error::EskfError;
 use crate::eskf::state::ErrorState;
 use crate::kernels::block::{block, copy};
-use crate::kernels::{mat3, usable_variance};
+use crate::kernels::{mat3, positive_variance};
 use crate::lie::{LieGroup, So3};
 use crate::Real;
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -55,17 +55,17 @@ where
             .iter()
             .fold(T::zero(), |acc, wc| acc + at(wc, j) * at(wc, j));
         let v = at(pc, j) - d;
-        usable_variance(v + v * other_reset)
+        positive_variance(v + v * other_reset)
     });
     let gr: Matrix3<T> = So3::right_jacobian(&dtheta);
     let c00 = mat3::mul(&mat3::mul(&gr, &m00), &gr.transpose());
     let c00 = (c00 + c00.transpose()) * half;
     let c00 = c00 + Matrix3::from_diagonal_element(attitude_floor(&c00) + attitude_reset);
-    let diagonal_ok = diagonal_ok && usable_variance(c00.m11) && usable_variance(c00.m22);
+    let diagonal_ok = diagonal_ok && positive_variance(c00.m11) && positive_variance(c00.m22);
     // The correction stays inside the chart: below π the exponential map is one-to-one and
     // J_r(δθ) regular; at 2π it is singular, and the reset G P Gᵀ with it is not definite.
     let in_chart = turn_squared < T::pi() * T::pi();
-    if !(in_chart && new_x.is_finite() && diagonal_ok && usable_variance(c00.m33)) {
+    if !(in_chart && new_x.is_finite() && diagonal_ok && positive_variance(c00.m33)) {
         return Err(EskfError::NumericalFailure);
     }
     // The upper triangle (column j holds rows 0..=j): P_ij −= Σ_c w_ci w_cj; then the attitude

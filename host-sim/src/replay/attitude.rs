@@ -5,11 +5,10 @@
 //! navigator is configured without one and fuses the gyroscope and accelerometer only.
 
 use super::output::{EstimateFiles, Partials};
-use super::{lit3, up3, ReplayConfig, ReplayError};
+use super::{filter_config, lit3, up3, ReplayConfig, ReplayError, SensorParameters};
 use crate::baseline::{Madgwick, Mahony};
 use crate::dataset::read::{Dataset, Event, EventStream};
 use crate::metrics::{Estimate, Outcome, Scorer};
-use estimator_core::eskf::{FilterConfig, ImuNoise};
 use estimator_core::nav::{
     AttitudeConfig, AttitudeNavigator, AttitudeReport, Fusion, MagneticConfig, MagneticFusion,
     NavError,
@@ -19,19 +18,19 @@ use nalgebra::{Matrix3, Vector3};
 use std::path::Path;
 use std::time::Instant;
 
-/// The navigator's configuration from the dataset's sensor files and the replay options.
-pub(super) fn navigator_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> AttitudeConfig<T> {
-    let filter = FilterConfig::<T> {
-        imu_noise: ImuNoise {
-            gyroscope_noise_density: T::lit(ds.imu.gyroscope_noise_density),
-            gyroscope_random_walk: T::lit(ds.imu.gyroscope_random_walk),
-            accelerometer_noise_density: T::lit(ds.imu.accelerometer_noise_density),
-            accelerometer_random_walk: T::lit(ds.imu.accelerometer_random_walk),
-        },
-        gravity: lit3(&Vector3::from(cfg.gravity)),
-        max_dt: T::lit(cfg.max_dt),
-    };
-    let mut c = AttitudeConfig::new(filter);
+/// The attitude navigator's configuration, as `host-sim replay` builds it: the IMU's noise
+/// and the magnetometer's from `sensors`, everything else from `cfg`.
+///
+/// The navigator has a magnetometer when `with_magnetometer` (the data has one) and
+/// `cfg.use_magnetometer`; it fuses its heading, or its whole field with
+/// `cfg.magnetometer_vector`.
+#[must_use]
+pub fn navigator_config<T: Real>(
+    sensors: &SensorParameters,
+    cfg: &ReplayConfig,
+    with_magnetometer: bool,
+) -> AttitudeConfig<T> {
+    let mut c = AttitudeConfig::new(filter_config(sensors, cfg));
     c.instantaneous_imu = cfg.instantaneous_imu;
     c.startup_s = T::lit(cfg.align_window_s);
     c.block_s = T::lit(cfg.block_s);
@@ -41,8 +40,9 @@ pub(super) fn navigator_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> Att
     c.accelerometer_bias_sigma = T::lit(cfg.accelerometer_bias_sigma);
     c.gyro_bias_sigma = T::lit(cfg.gyro_bias_sigma_dps.to_radians());
     c.gyro_scale_sigma = T::lit(cfg.gyro_scale_sigma);
-    c.magnetometer = ds.mag.as_ref().map(|m| {
-        let mut mc = MagneticConfig::new(T::lit(m.sigma), Some(lit3(&m.reference_field)));
+    c.magnetometer = (with_magnetometer && cfg.use_magnetometer).then(|| {
+        let reference = sensors.mag_reference.map(|r| lit3(&Vector3::from(r)));
+        let mut mc = MagneticConfig::new(T::lit(sensors.mag_sigma), reference);
         mc.heading_noise = T::lit(cfg.heading_noise_deg.to_radians());
         mc.heading_floor = T::lit(cfg.heading_floor_deg.to_radians());
         mc.hard_iron = cfg.magnetometer_hard_iron;
@@ -126,7 +126,8 @@ pub(super) fn replay_attitude<T: Real>(
     title: &str,
     mut scorer: Scorer,
 ) -> Result<Scorer, ReplayError> {
-    let mut nav = AttitudeNavigator::<T>::new(navigator_config(ds, cfg))
+    let sensors = SensorParameters::from_dataset(ds);
+    let mut nav = AttitudeNavigator::<T>::new(navigator_config(&sensors, cfg, ds.mag.is_some()))
         .map_err(|e| ReplayError::Config(format!("navigator: {e}")))?;
     let mut partials = Partials::new(out);
     partials.clear_previous();

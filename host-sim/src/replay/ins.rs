@@ -7,7 +7,7 @@
 
 use super::attitude::navigator_config;
 use super::output::{open_partial, EstimateFiles, Partials};
-use super::{lit3, out_err, up3, ReplayConfig, ReplayError};
+use super::{lit3, out_err, up3, ReplayConfig, ReplayError, SensorParameters};
 use crate::baseline::{Madgwick, Mahony};
 use crate::dataset::read::{Dataset, Event, EventStream};
 use crate::faults::epochs;
@@ -17,14 +17,34 @@ use estimator_core::nav::{
     NavError, Travel, Validity,
 };
 use estimator_core::Real;
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-/// The navigator's configuration from the dataset's sensor files and the replay options.
-pub(super) fn ins_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> InsConfig<T> {
-    let mut attitude = navigator_config::<T>(ds, cfg);
+/// The INS navigator of `host-sim replay`: its ring holds [`HORIZON_SAMPLES`] IMU intervals
+/// (with room) and 64 queued measurements.
+pub type ReplayInsNavigator<T> = InsNavigator<T, 256, 64>;
+
+/// The most IMU samples `cfg.horizon_s` may span in [`ReplayInsNavigator`]'s ring (0.3 s at
+/// 200 Hz is 60).
+pub const HORIZON_SAMPLES: f64 = 250.0;
+
+/// The INS navigator's configuration, as `host-sim replay` builds it on a GNSS dataset: the
+/// attitude navigator's ([`navigator_config`], with the magnetometer's whole field fused),
+/// the GNSS lever arm and the barometer's 1σ from `sensors`, the horizon and how the vehicle
+/// travels from `cfg`.
+///
+/// The navigator has a magnetometer when `with_magnetometer` and `cfg.use_magnetometer`, a
+/// barometer when `with_barometer`.
+#[must_use]
+pub fn ins_config<T: Real>(
+    sensors: &SensorParameters,
+    cfg: &ReplayConfig,
+    with_magnetometer: bool,
+    with_barometer: bool,
+) -> InsConfig<T> {
+    let mut attitude = navigator_config::<T>(sensors, cfg, with_magnetometer);
     // The INS fuses the magnetometer's whole field: the GNSS velocity, not the magnetometer,
     // holds the tilt, and the gate guards the heading.
     if let Some(m) = attitude.magnetometer.as_mut() {
@@ -41,10 +61,8 @@ pub(super) fn ins_config<T: Real>(ds: &Dataset, cfg: &ReplayConfig) -> InsConfig
     } else {
         Travel::Detect
     };
-    if let Some(g) = &ds.gnss {
-        c.gnss_lever_arm = lit3(&g.lever_arm);
-    }
-    c.barometer_sigma = ds.baro.as_ref().map(|b| T::lit(b.sigma));
+    c.gnss_lever_arm = lit3(&Vector3::from(sensors.gnss_lever_arm));
+    c.barometer_sigma = with_barometer.then(|| T::lit(sensors.baro_sigma));
     c
 }
 
@@ -157,26 +175,20 @@ pub(super) fn replay_ins<T: Real>(
     title: &str,
     mut scorer: Scorer,
 ) -> Result<Scorer, ReplayError> {
+    let sensors = SensorParameters::from_dataset(ds);
+    let config = ins_config(&sensors, cfg, ds.mag.is_some(), ds.baro.is_some());
     // A ring for the horizon at the IMU's rate, with room: 0.3 s at 200 Hz is 60 intervals.
-    let mut nav = InsNavigator::<T, 256, 64>::new(ins_config(ds, cfg))
+    let mut nav = ReplayInsNavigator::<T>::new(config)
         .map_err(|e| ReplayError::Config(format!("navigator: {e}")))?;
-    if cfg.horizon_s * ds.imu.rate_hz > 250.0 {
+    if cfg.horizon_s * ds.imu.rate_hz > HORIZON_SAMPLES {
         return Err(ReplayError::Config(format!(
-            "horizon_s = {} holds {:.0} IMU samples at {} Hz; at most 250",
+            "horizon_s = {} holds {:.0} IMU samples at {} Hz; at most {HORIZON_SAMPLES}",
             cfg.horizon_s,
             cfg.horizon_s * ds.imu.rate_hz,
             ds.imu.rate_hz
         )));
     }
-    let latency_ns = ds
-        .gnss
-        .as_ref()
-        .map_or(0, |g| (g.latency_s * 1e9).round() as u64);
-    let latency_ns = if cfg.ignore_gnss_latency {
-        0
-    } else {
-        latency_ns
-    };
+    let latency_ns = sensors.gnss_latency_ns(cfg);
     let mut partials = Partials::new(out);
     partials.clear_previous();
     let mut files = EstimateFiles::open(out, dir, ds.has_groundtruth)?;

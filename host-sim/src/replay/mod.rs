@@ -44,7 +44,111 @@ mod attitude;
 mod ins;
 mod output;
 
+pub use attitude::navigator_config;
+pub use ins::{ins_config, ReplayInsNavigator, HORIZON_SAMPLES};
+pub use output::TruthCursor;
 use output::{EstimateFiles, Partials};
+
+/// The sensor parameters a navigator is configured from besides the [`ReplayConfig`]: what
+/// `host-sim replay` reads from a dataset's `sensor.yaml` files ([`Self::from_dataset`]), or
+/// what a caller without a dataset gives (the Python package's keyword arguments of the same
+/// names).
+///
+/// A sensor's values are used only where the navigator has that sensor (the flags of
+/// [`navigator_config`] and [`ins_config`]). The [`Default`]: a consumer MEMS IMU
+/// ([`ImuNoise::mems`]), a magnetometer of 0.4 µT per axis (host-sim's simulated one) without
+/// a known reference field, the GNSS antenna at the IMU and its fixes stamped without latency,
+/// a barometer of 0.5 m.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SensorParameters {
+    /// The IMU's white noise densities and bias random walks (`imu0/sensor.yaml`): gyroscope
+    /// rad/s/√Hz and rad/s²/√Hz, accelerometer m/s²/√Hz and m/s³/√Hz.
+    pub imu_noise: ImuNoise<f64>,
+    /// The magnetometer's white noise per sample and axis, µT (`mag0/sensor.yaml`'s `sigma`).
+    pub mag_sigma: f64,
+    /// The magnetic field in the world frame (ENU), µT (`mag0/sensor.yaml`'s reference
+    /// field); `None`: not known, the navigator learns it from its first samples, which then
+    /// define north.
+    pub mag_reference: Option<[f64; 3]>,
+    /// The GNSS antenna in the body frame, m (`gnss0/sensor.yaml`'s lever arm).
+    pub gnss_lever_arm: [f64; 3],
+    /// How long before its row's time each GNSS fix was valid, s (`gnss0/sensor.yaml`'s
+    /// `latency_s`).
+    pub gnss_latency_s: f64,
+    /// The barometric altitude's white noise per sample, 1σ, m (`baro0/sensor.yaml`'s
+    /// `sigma`).
+    pub baro_sigma: f64,
+}
+
+impl Default for SensorParameters {
+    fn default() -> Self {
+        Self {
+            imu_noise: ImuNoise::mems(),
+            mag_sigma: 0.4,
+            mag_reference: None,
+            gnss_lever_arm: [0.0; 3],
+            gnss_latency_s: 0.0,
+            baro_sigma: 0.5,
+        }
+    }
+}
+
+impl SensorParameters {
+    /// The parameters of the dataset's sensors, as `host-sim replay` configures its navigator
+    /// from them; those of a sensor the dataset lacks (or was opened without) keep their
+    /// [`Default`].
+    #[must_use]
+    pub fn from_dataset(ds: &Dataset) -> Self {
+        let mut s = Self {
+            imu_noise: ImuNoise {
+                gyroscope_noise_density: ds.imu.gyroscope_noise_density,
+                gyroscope_random_walk: ds.imu.gyroscope_random_walk,
+                accelerometer_noise_density: ds.imu.accelerometer_noise_density,
+                accelerometer_random_walk: ds.imu.accelerometer_random_walk,
+            },
+            ..Self::default()
+        };
+        if let Some(m) = &ds.mag {
+            s.mag_sigma = m.sigma;
+            s.mag_reference = Some(m.reference_field.into());
+        }
+        if let Some(g) = &ds.gnss {
+            s.gnss_lever_arm = g.lever_arm.into();
+            s.gnss_latency_s = g.latency_s;
+        }
+        if let Some(b) = &ds.baro {
+            s.baro_sigma = b.sigma;
+        }
+        s
+    }
+
+    /// How far back each GNSS fix is stamped from its row's time, ns: `gnss_latency_s`
+    /// rounded to the nanosecond, 0 with `cfg.ignore_gnss_latency`.
+    #[must_use]
+    pub fn gnss_latency_ns(&self, cfg: &ReplayConfig) -> u64 {
+        if cfg.ignore_gnss_latency {
+            0
+        } else {
+            (self.gnss_latency_s * 1e9).round() as u64
+        }
+    }
+}
+
+/// The 15-state filter's configuration: the IMU's noise from `sensors`, gravity and the
+/// longest IMU interval from `cfg`.
+fn filter_config<T: Real>(sensors: &SensorParameters, cfg: &ReplayConfig) -> FilterConfig<T> {
+    let n = &sensors.imu_noise;
+    FilterConfig {
+        imu_noise: ImuNoise {
+            gyroscope_noise_density: T::lit(n.gyroscope_noise_density),
+            gyroscope_random_walk: T::lit(n.gyroscope_random_walk),
+            accelerometer_noise_density: T::lit(n.accelerometer_noise_density),
+            accelerometer_random_walk: T::lit(n.accelerometer_random_walk),
+        },
+        gravity: lit3(&Vector3::from(cfg.gravity)),
+        max_dt: T::lit(cfg.max_dt),
+    }
+}
 
 /// Replay options (a TOML file given with `--config`; every field optional).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -444,16 +548,7 @@ fn replay_in<T: Real>(
         return ins::replay_ins::<T>(&ds, dir, out, cfg, title, scorer);
     }
     let gravity = Vector3::from(cfg.gravity);
-    let config = FilterConfig::<T> {
-        imu_noise: ImuNoise {
-            gyroscope_noise_density: T::lit(ds.imu.gyroscope_noise_density),
-            gyroscope_random_walk: T::lit(ds.imu.gyroscope_random_walk),
-            accelerometer_noise_density: T::lit(ds.imu.accelerometer_noise_density),
-            accelerometer_random_walk: T::lit(ds.imu.accelerometer_random_walk),
-        },
-        gravity: lit3(&gravity),
-        max_dt: T::lit(cfg.max_dt),
-    };
+    let config = filter_config::<T>(&SensorParameters::from_dataset(&ds), cfg);
     let mut events = ds.events()?.with_max_dt(cfg.max_dt);
 
     // --- Start-up: a window at rest, then the first camera frame, solved for the pose. ---

@@ -12,36 +12,53 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-/// The truth at arbitrary times, streamed: keeps the two rows around the requested time.
-pub(super) struct TruthCursor {
-    pub(super) stream: TruthStream,
-    pub(super) prev: Option<Truth>,
-    pub(super) next: Option<Truth>,
-    pub(super) tum: BufWriter<File>,
-    pub(super) tum_path: PathBuf,
+/// The truth at increasing times, from its rows read one by one in time order: each time is
+/// given the row stamped with it, or the two rows around it interpolated
+/// ([`TruthSpacing::between`]); nothing before the first row, after the last, or where rows
+/// are lost around it. This is how `host-sim replay` scores each estimate.
+///
+/// `I` yields the rows (`Err`: a row that could not be read, passed on by [`Self::at`]); only
+/// the two around the last time asked for are held.
+pub struct TruthCursor<I> {
+    rows: I,
+    prev: Option<Truth>,
+    next: Option<Truth>,
     /// The truth's sampling, to leave its lost rows unscored.
-    pub(super) spacing: TruthSpacing,
+    spacing: TruthSpacing,
 }
 
-impl TruthCursor {
-    /// Reads one more row into `next`, copying it to `groundtruth.tum`.
-    fn advance(&mut self) -> Result<(), ReplayError> {
+impl<I, E> TruthCursor<I>
+where
+    I: Iterator<Item = Result<Truth, E>>,
+{
+    /// A cursor before the first of `rows` (none read yet).
+    pub fn new(rows: I) -> Self {
+        Self {
+            rows,
+            prev: None,
+            next: None,
+            spacing: TruthSpacing::default(),
+        }
+    }
+
+    /// Reads one more row into `next`.
+    fn advance(&mut self) -> Result<(), E> {
         self.prev = self.next.take();
-        self.next = self.stream.next_truth()?;
+        self.next = self.rows.next().transpose()?;
         // Every row interval, also where the samples fall on the rows themselves.
         if let (Some(a), Some(b)) = (&self.prev, &self.next) {
             self.spacing.observe(a.t_ns, b.t_ns);
         }
-        if let Some(n) = &self.next {
-            write_tum(&mut self.tum, n.t_ns, &n.position, &n.attitude)
-                .map_err(out_err(&self.tum_path))?;
-        }
         Ok(())
     }
 
-    /// The truth at `t_ns`, interpolated between the rows around it; `None` outside the truth
-    /// and where rows are lost around `t_ns` ([`TruthSpacing::between`]).
-    pub(super) fn at(&mut self, t_ns: u64) -> Result<Option<Truth>, ReplayError> {
+    /// The truth at `t_ns` (ns, not before the time of the previous call): the row stamped
+    /// `t_ns`, else the rows around it interpolated; `None` outside the truth and where rows
+    /// are lost around `t_ns` ([`TruthSpacing::between`]).
+    ///
+    /// # Errors
+    /// A row that could not be read.
+    pub fn at(&mut self, t_ns: u64) -> Result<Option<Truth>, E> {
         if self.prev.is_none() && self.next.is_none() {
             self.advance()?;
             self.prev = None;
@@ -56,15 +73,44 @@ impl TruthCursor {
         })
     }
 
-    /// Copies the remaining rows to `groundtruth.tum`.
-    pub(super) fn finish(&mut self) -> Result<(), ReplayError> {
-        while self.next.is_some() || self.prev.is_none() {
-            self.advance()?;
-            if self.next.is_none() {
-                break;
-            }
+    /// The rows not read yet.
+    pub fn into_rows(self) -> I {
+        self.rows
+    }
+}
+
+/// The truth file's rows, each copied to `groundtruth.tum` as it is read.
+pub(super) struct TruthFile {
+    stream: TruthStream,
+    tum: BufWriter<File>,
+    tum_path: PathBuf,
+}
+
+impl Iterator for TruthFile {
+    type Item = Result<Truth, ReplayError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let row = match self.stream.next_truth() {
+            Ok(row) => row?,
+            Err(e) => return Some(Err(e.into())),
+        };
+        Some(
+            write_tum(&mut self.tum, row.t_ns, &row.position, &row.attitude)
+                .map(|()| row)
+                .map_err(out_err(&self.tum_path)),
+        )
+    }
+}
+
+impl TruthFile {
+    /// Copies the remaining rows to `groundtruth.tum`; returns the truth file's warnings (a
+    /// cut last line).
+    fn finish(mut self) -> Result<Vec<DataWarning>, ReplayError> {
+        for row in self.by_ref() {
+            row?;
         }
-        self.tum.flush().map_err(out_err(&self.tum_path))
+        self.tum.flush().map_err(out_err(&self.tum_path))?;
+        Ok(self.stream.warnings().to_vec())
     }
 }
 
@@ -186,7 +232,7 @@ pub(super) struct EstimateFiles {
     tum_path: PathBuf,
     csv: BufWriter<File>,
     csv_path: PathBuf,
-    truth: Option<TruthCursor>,
+    truth: Option<TruthCursor<TruthFile>>,
 }
 
 impl EstimateFiles {
@@ -196,15 +242,12 @@ impl EstimateFiles {
         let (mut csv, csv_path) = open_partial(out, "estimate.csv")?;
         super::write_csv_header(&mut csv).map_err(out_err(&csv_path))?;
         let truth = if has_truth {
-            let (gt_tum, gt_path) = open_partial(out, "groundtruth.tum")?;
-            Some(TruthCursor {
+            let (tum, tum_path) = open_partial(out, "groundtruth.tum")?;
+            Some(TruthCursor::new(TruthFile {
                 stream: TruthStream::open(dir)?,
-                prev: None,
-                next: None,
-                tum: gt_tum,
-                tum_path: gt_path,
-                spacing: TruthSpacing::default(),
-            })
+                tum,
+                tum_path,
+            }))
         } else {
             None
         };
@@ -245,10 +288,9 @@ impl EstimateFiles {
     pub(super) fn finish(mut self) -> Result<Vec<DataWarning>, ReplayError> {
         self.tum.flush().map_err(out_err(&self.tum_path))?;
         self.csv.flush().map_err(out_err(&self.csv_path))?;
-        if let Some(tr) = self.truth.as_mut() {
-            tr.finish()?;
-            return Ok(tr.stream.warnings().to_vec());
+        match self.truth {
+            Some(tr) => tr.into_rows().finish(),
+            None => Ok(Vec::new()),
         }
-        Ok(Vec::new())
     }
 }

@@ -1,0 +1,344 @@
+//! The INS navigator batched over arrays (`run_ins`), fed and read as `host-sim replay` feeds
+//! and reads it on a GNSS dataset.
+
+use crate::arrays;
+use crate::config::{self, Settings};
+use estimator_core::nav::{GnssFix, Validity};
+use estimator_core::Real;
+use host_sim::replay::{ins_config, ReplayInsNavigator as Nav, HORIZON_SAMPLES};
+use nalgebra::Vector3;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+fn lit3<T: Real>(v: &[f64; 3]) -> Vector3<T> {
+    Vector3::new(T::lit(v[0]), T::lit(v[1]), T::lit(v[2]))
+}
+
+struct Fix {
+    t: u64,
+    p: [f64; 3],
+    v: Option<[f64; 3]>,
+    sigma_p: f64,
+    sigma_p_up: f64,
+    sigma_v: f64,
+}
+
+struct Inputs {
+    t: Vec<u64>,
+    gyr: Vec<[f64; 3]>,
+    acc: Vec<[f64; 3]>,
+    fixes: Vec<Fix>,
+    mag_t: Vec<u64>,
+    mag: Vec<[f64; 3]>,
+    baro_t: Vec<u64>,
+    baro: Vec<f64>,
+    latency_ns: u64,
+}
+
+#[derive(Default)]
+struct Outputs {
+    q: Vec<f64>,
+    p: Vec<f64>,
+    v: Vec<f64>,
+    sigma: Vec<f64>,
+    gyro_bias: Vec<f64>,
+    accel_bias: Vec<f64>,
+    estimated: Vec<bool>,
+    valid: [Vec<bool>; 6],
+    imu_accepted: Vec<bool>,
+    gnss_accepted: Vec<bool>,
+}
+
+fn valid(v: Validity) -> bool {
+    v.is_valid()
+}
+
+/// Feeds every sample in host-sim's event order (by time; at equal times IMU, magnetometer,
+/// GNSS, barometer), each fix stamped with its time minus the latency; goes on past refused
+/// samples as host-sim's replay does.
+fn run<T: Real>(nav: &mut Nav<T>, inp: &Inputs) -> Outputs {
+    let n = inp.t.len();
+    let nan = |k: usize| vec![f64::NAN; k * n];
+    let mut o = Outputs {
+        q: nan(4),
+        p: nan(3),
+        v: nan(3),
+        sigma: nan(15),
+        gyro_bias: nan(3),
+        accel_bias: nan(3),
+        estimated: vec![false; n],
+        valid: std::array::from_fn(|_| vec![false; n]),
+        imu_accepted: vec![false; n],
+        gnss_accepted: vec![false; inp.fixes.len()],
+    };
+    let (mut i, mut m, mut g, mut b) = (0, 0, 0, 0);
+    loop {
+        // The source with the earliest time; the first in this order at equal times.
+        let heads = [
+            inp.t.get(i).copied(),
+            inp.mag_t.get(m).copied(),
+            inp.fixes.get(g).map(|f| f.t),
+            inp.baro_t.get(b).copied(),
+        ];
+        let mut best: Option<(u64, usize)> = None;
+        for (k, h) in heads.iter().enumerate() {
+            if let Some(t) = h {
+                if best.is_none_or(|(bt, _)| *t < bt) {
+                    best = Some((*t, k));
+                }
+            }
+        }
+        let Some((_, which)) = best else { break };
+        match which {
+            0 => {
+                o.imu_accepted[i] = nav
+                    .imu(inp.t[i], &lit3(&inp.gyr[i]), &lit3(&inp.acc[i]))
+                    .is_ok();
+                let v = nav.report().validity;
+                let flags = [
+                    v.tilt,
+                    v.heading,
+                    v.velocity,
+                    v.position,
+                    v.gyro_bias,
+                    v.accel_bias,
+                ];
+                for (k, f) in flags.into_iter().enumerate() {
+                    o.valid[k][i] = valid(f);
+                }
+                if let Some(e) = nav.estimate() {
+                    o.estimated[i] = true;
+                    let q = e.state.attitude.cast::<f64>().quaternion();
+                    o.q[4 * i..4 * i + 4].copy_from_slice(&[q.w, q.i, q.j, q.k]);
+                    let s = &e.state;
+                    for k in 0..3 {
+                        o.p[3 * i + k] = s.position[k].to_f64();
+                        o.v[3 * i + k] = s.velocity[k].to_f64();
+                        o.gyro_bias[3 * i + k] = s.gyro_bias[k].to_f64();
+                        o.accel_bias[3 * i + k] = s.accel_bias[k].to_f64();
+                    }
+                    for (blk, c) in e.covariance.iter().enumerate() {
+                        for k in 0..3 {
+                            o.sigma[15 * i + 3 * blk + k] = c[(k, k)].to_f64().max(0.0).sqrt();
+                        }
+                    }
+                }
+                i += 1;
+            }
+            1 => {
+                let _ = nav.magnetometer(inp.mag_t[m], &lit3(&inp.mag[m]));
+                m += 1;
+            }
+            2 => {
+                let f = &inp.fixes[g];
+                let fix = GnssFix::new(
+                    lit3(&f.p),
+                    f.v.as_ref().map(lit3),
+                    T::lit(f.sigma_p),
+                    T::lit(f.sigma_v),
+                )
+                .with_vertical_sigma(T::lit(f.sigma_p_up));
+                o.gnss_accepted[g] = nav.gnss(f.t.saturating_sub(inp.latency_ns), &fix).is_ok();
+                g += 1;
+            }
+            _ => {
+                let _ = nav.barometer(inp.baro_t[b], T::lit(inp.baro[b]));
+                b += 1;
+            }
+        }
+    }
+    o
+}
+
+fn matrix<'py>(py: Python<'py>, v: Vec<f64>, cols: usize) -> PyResult<Bound<'py, PyAny>> {
+    let rows = v.len() / cols;
+    let a = Array2::from_shape_vec((rows, cols), v)
+        .map_err(|e| PyValueError::new_err(format!("output shape: {e}")))?;
+    Ok(a.into_pyarray(py).into_any())
+}
+
+fn pair<'py>(
+    a: Option<&Bound<'py, PyAny>>,
+    b: Option<&Bound<'py, PyAny>>,
+    names: (&str, &str),
+) -> PyResult<Option<(Bound<'py, PyAny>, Bound<'py, PyAny>)>> {
+    match (a, b) {
+        (Some(a), Some(b)) => Ok(Some((a.clone(), b.clone()))),
+        (None, None) => Ok(None),
+        _ => Err(PyValueError::new_err(format!(
+            "{} and {} go together (both or neither)",
+            names.0, names.1
+        ))),
+    }
+}
+
+/// `run_ins(...)`: see the Python docstring.
+#[pyfunction]
+#[pyo3(signature = (t, gyr, acc, gnss_t, gnss_p, gnss_sigma_p, gnss_v=None, gnss_sigma_v=None, gnss_sigma_p_up=None, mag=None, mag_t=None, baro=None, baro_t=None, **config))]
+#[allow(clippy::too_many_arguments)]
+pub fn run_ins<'py>(
+    py: Python<'py>,
+    t: &Bound<'py, PyAny>,
+    gyr: &Bound<'py, PyAny>,
+    acc: &Bound<'py, PyAny>,
+    gnss_t: &Bound<'py, PyAny>,
+    gnss_p: &Bound<'py, PyAny>,
+    gnss_sigma_p: &Bound<'py, PyAny>,
+    gnss_v: Option<&Bound<'py, PyAny>>,
+    gnss_sigma_v: Option<&Bound<'py, PyAny>>,
+    gnss_sigma_p_up: Option<&Bound<'py, PyAny>>,
+    mag: Option<&Bound<'py, PyAny>>,
+    mag_t: Option<&Bound<'py, PyAny>>,
+    baro: Option<&Bound<'py, PyAny>>,
+    baro_t: Option<&Bound<'py, PyAny>>,
+    config: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    // Everything is checked before the navigator sees a sample.
+    let s: Settings = config::settings(config)?;
+    let t = arrays::times("t", t)?;
+    let n = t.len();
+    let gyr = arrays::vec3s("gyr", gyr, Some(n))?;
+    let acc = arrays::vec3s("acc", acc, Some(n))?;
+    let gnss_t = arrays::times("gnss_t", gnss_t)?;
+    let k = gnss_t.len();
+    let gnss_p = arrays::vec3s("gnss_p", gnss_p, Some(k))?;
+    let sigma_p = arrays::floats("gnss_sigma_p", gnss_sigma_p, k)?;
+    let velocity = match pair(gnss_v, gnss_sigma_v, ("gnss_v", "gnss_sigma_v"))? {
+        Some((v, sv)) => {
+            let v = arrays::nan_rows("gnss_v", &v, 3, k)?;
+            // NaN where the fix has no velocity (a NaN row of gnss_v).
+            let sv = arrays::floats_or_nan("gnss_sigma_v", &sv, k, true)?;
+            if let Some(i) = (0..k).find(|&i| v[i].is_some() && (sv[i].is_nan() || sv[i] <= 0.0)) {
+                return Err(PyValueError::new_err(format!(
+                    "gnss_sigma_v[{i}] is {}: a fix with a velocity needs a 1σ > 0",
+                    sv[i]
+                )));
+            }
+            Some((v, sv))
+        }
+        None => None,
+    };
+    let sigma_up = gnss_sigma_p_up
+        .map(|u| arrays::floats("gnss_sigma_p_up", u, k))
+        .transpose()?;
+    for (name, values) in [
+        ("gnss_sigma_p", Some(&sigma_p)),
+        ("gnss_sigma_p_up", sigma_up.as_ref()),
+    ] {
+        if let Some(i) = values.and_then(|v| v.iter().position(|x| *x <= 0.0)) {
+            return Err(PyValueError::new_err(format!("{name}[{i}] must be > 0")));
+        }
+    }
+    let (mag_t, mag) = match pair(mag_t, mag, ("mag_t", "mag"))? {
+        Some((mt, m)) => {
+            let mt = arrays::times("mag_t", &mt)?;
+            let m = arrays::vec3s("mag", &m, Some(mt.len()))?;
+            (mt, m)
+        }
+        None => (Vec::new(), Vec::new()),
+    };
+    let (baro_t, baro) = match pair(baro_t, baro, ("baro_t", "baro"))? {
+        Some((bt, b)) => {
+            let bt = arrays::times("baro_t", &bt)?;
+            let b = arrays::floats("baro", &b, bt.len())?;
+            (bt, b)
+        }
+        None => (Vec::new(), Vec::new()),
+    };
+    // The horizon must fit host-sim's ring of IMU intervals (its check, at the data's rate).
+    if n >= 2 {
+        let rate_hz = (n - 1) as f64 / ((t[n - 1] - t[0]) as f64 * 1e-9);
+        if s.replay.horizon_s * rate_hz > HORIZON_SAMPLES {
+            return Err(PyValueError::new_err(format!(
+                "horizon_s = {} holds {:.0} IMU samples at {rate_hz:.0} Hz; at most {HORIZON_SAMPLES}",
+                s.replay.horizon_s,
+                s.replay.horizon_s * rate_hz
+            )));
+        }
+    }
+    let fixes = (0..k)
+        .map(|i| {
+            let v = velocity
+                .as_ref()
+                .and_then(|(v, sv)| v[i].map(|r| ([r[0], r[1], r[2]], sv[i])));
+            Fix {
+                t: gnss_t[i],
+                p: gnss_p[i],
+                v: v.map(|(r, _)| r),
+                sigma_p: sigma_p[i],
+                sigma_p_up: sigma_up.as_ref().map_or(sigma_p[i], |u| u[i]),
+                // host-sim's fix without a velocity has a velocity 1σ of 0.
+                sigma_v: v.map_or(0.0, |(_, sv)| sv),
+            }
+        })
+        .collect();
+    let latency_ns = s.sensors.gnss_latency_ns(&s.replay);
+    let with_mag = !mag_t.is_empty() && s.replay.use_magnetometer;
+    let mag_len = mag_t.len();
+    let with_baro = !baro_t.is_empty();
+    let inp = Inputs {
+        t,
+        gyr,
+        acc,
+        fixes,
+        mag_t: if with_mag { mag_t } else { Vec::new() },
+        mag: if with_mag { mag } else { Vec::new() },
+        baro_t,
+        baro,
+        latency_ns,
+    };
+    let err = |e| PyValueError::new_err(format!("configuration: {e}"));
+    let o = match s.replay.precision.as_str() {
+        "f32" => {
+            let nav = Box::new(
+                Nav::<f32>::new(ins_config(&s.sensors, &s.replay, with_mag, with_baro))
+                    .map_err(err)?,
+            );
+            py.detach(move || {
+                let mut nav = nav;
+                run(&mut nav, &inp)
+            })
+        }
+        "f64" => {
+            let nav = Box::new(
+                Nav::<f64>::new(ins_config(&s.sensors, &s.replay, with_mag, with_baro))
+                    .map_err(err)?,
+            );
+            py.detach(move || {
+                let mut nav = nav;
+                run(&mut nav, &inp)
+            })
+        }
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "precision '{other}' (use 'f32' or 'f64')"
+            )))
+        }
+    };
+    let d = PyDict::new(py);
+    d.set_item("quaternion", matrix(py, o.q, 4)?)?;
+    d.set_item("position", matrix(py, o.p, 3)?)?;
+    d.set_item("velocity", matrix(py, o.v, 3)?)?;
+    d.set_item("sigma", matrix(py, o.sigma, 15)?)?;
+    d.set_item("gyro_bias", matrix(py, o.gyro_bias, 3)?)?;
+    d.set_item("accel_bias", matrix(py, o.accel_bias, 3)?)?;
+    d.set_item("estimated", PyArray1::from_vec(py, o.estimated))?;
+    let names = [
+        "tilt_valid",
+        "heading_valid",
+        "velocity_valid",
+        "position_valid",
+        "gyro_bias_valid",
+        "accel_bias_valid",
+    ];
+    for (name, v) in names.into_iter().zip(o.valid) {
+        d.set_item(name, PyArray1::from_vec(py, v))?;
+    }
+    d.set_item("imu_accepted", PyArray1::from_vec(py, o.imu_accepted))?;
+    d.set_item("gnss_accepted", PyArray1::from_vec(py, o.gnss_accepted))?;
+    d.set_item("magnetometer_used", with_mag && mag_len > 0)?;
+    Ok(d)
+}

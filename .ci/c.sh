@@ -20,11 +20,7 @@
 #     opt-level 3, LTO (`cargo rustc --crate-type staticlib`: a plain `cargo build` of the
 #     staticlib+rlib crate gets no LTO), tuned for the Cortex-M4 (`-C target-cpu=cortex-m4`, as
 #     firmware's `cargo build-m4`); the C at -O2. Fails if a C figure is more than
-#     C_ICOUNT_MAX_RATIO times the Rust one: the target is 1.03, met by the costliest calls
-#     (0.966, 0.962 at rest) and not by the means (1.032 the IMU call, 1.033 the magnetometer
-#     call: the wrapper's pointer, alignment and handle checks take about 35 instructions
-#     against the Rust demo's 23, and the two builds inline differently), so the ceiling is
-#     1.04 until it is (a regression still fails). The same counts for the library as step 2
+#     C_ICOUNT_MAX_RATIO (1.03) times the Rust one. The same counts for the library as step 2
 #     builds it (no LTO, plain target CPU) are printed too, not checked: a different build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -164,7 +160,7 @@ for v in c-bench c-bench-default; do
 done
 echo "-- the library built as the Rust figures are (LTO, opt-level 3, -C target-cpu=cortex-m4; C -O2):"
 python3 $FW/tools/c_icount.py "$OUT/c-bench.txt" "$OUT/c-bench-icount.txt" "$RUST_OUT" "$RUST_IC" \
-  "$EXPECTED" --max-ratio "${C_ICOUNT_MAX_RATIO:-1.04}" || status=1
+  "$EXPECTED" --max-ratio "${C_ICOUNT_MAX_RATIO:-1.03}" || status=1
 echo "-- for information, the library as step 2 builds it (cargo build: no LTO, plain target CPU):"
 python3 $FW/tools/c_icount.py "$OUT/c-bench-default.txt" "$OUT/c-bench-default-icount.txt" "$RUST_OUT" \
   "$RUST_IC" "$EXPECTED" --no-gate || status=1

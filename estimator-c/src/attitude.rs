@@ -3,8 +3,8 @@
 use crate::error::{code, est_error};
 use crate::report::{est_attitude_event, est_magnetic_status, est_validity};
 use crate::storage::{
-    check_out, init_slot, nav_mut, nav_ref, read_in, read_vec3, slot_align, slot_size, vec3,
-    write_out, MAGIC_ATTITUDE,
+    check_out, init_slot, nav_mut, nav_ref, read_in, read_vec3, read_vec3_pair, slot_align,
+    slot_size, vec3, write_out, MAGIC_ATTITUDE,
 };
 use core::ffi::c_void;
 use estimator_core::eskf::{FilterConfig, ImuNoise};
@@ -357,13 +357,12 @@ pub unsafe extern "C" fn est_attitude_imu(
     let inputs = unsafe {
         (
             nav_mut::<Nav, _>(nav, MAGIC_ATTITUDE),
-            read_vec3(gyro),
-            read_vec3(accel),
+            read_vec3_pair(gyro, accel),
         )
     };
     code(match inputs {
-        (Ok(n), Ok(g), Ok(a)) => n.imu(t_ns, &g, &a).map(drop).map_err(est_error::from),
-        (Err(e), _, _) | (_, Err(e), _) | (_, _, Err(e)) => Err(e),
+        (Ok(n), Ok((g, a))) => n.imu(t_ns, &g, &a).map(drop).map_err(est_error::from),
+        (Err(e), _) | (_, Err(e)) => Err(e),
     })
 }
 

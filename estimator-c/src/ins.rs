@@ -5,8 +5,8 @@ use crate::attitude::est_attitude_config;
 use crate::error::{code, est_error};
 use crate::report::{est_aid_status, est_ins_event, est_validity};
 use crate::storage::{
-    check_out, init_slot, nav_mut, nav_ref, read_in, read_vec3, slot_align, slot_size, vec3,
-    write_out, MAGIC_INS,
+    check_out, init_slot, nav_mut, nav_ref, read_in, read_vec3, read_vec3_pair, slot_align,
+    slot_size, vec3, write_out, MAGIC_INS,
 };
 use core::ffi::c_void;
 use estimator_core::eskf::FilterConfig;
@@ -369,13 +369,12 @@ pub unsafe extern "C" fn est_ins_imu(
     let inputs = unsafe {
         (
             nav_mut::<Nav, _>(nav, MAGIC_INS),
-            read_vec3(gyro),
-            read_vec3(accel),
+            read_vec3_pair(gyro, accel),
         )
     };
     code(match inputs {
-        (Ok(n), Ok(g), Ok(a)) => n.imu(t_ns, &g, &a).map(drop).map_err(est_error::from),
-        (Err(e), _, _) | (_, Err(e), _) | (_, _, Err(e)) => Err(e),
+        (Ok(n), Ok((g, a))) => n.imu(t_ns, &g, &a).map(drop).map_err(est_error::from),
+        (Err(e), _) | (_, Err(e)) => Err(e),
     })
 }
 

@@ -17,10 +17,12 @@ pub extern "C" fn est_api_version() -> u32 {
     EST_API_VERSION
 }
 
-/// Marks storage holding an attitude navigator ("ESTA"); written last by its init.
-pub(crate) const MAGIC_ATTITUDE: u32 = 0x4553_5441;
-/// Marks storage holding an INS navigator ("ESTI").
-pub(crate) const MAGIC_INS: u32 = 0x4553_5449;
+/// Marks storage holding an attitude navigator; written last by its init. A word of one
+/// repeated byte, so that the check of every call is one compare with an immediate on a
+/// Cortex-M (Thumb-2 encodes `0xXYXYXYXY`), not a constant loaded first.
+pub(crate) const MAGIC_ATTITUDE: u32 = 0x6161_6161;
+/// Marks storage holding an INS navigator (as [`MAGIC_ATTITUDE`]).
+pub(crate) const MAGIC_INS: u32 = 0x6969_6969;
 
 /// What a navigator's storage holds: the magic word at its start, then the navigator.
 #[repr(C)]
@@ -142,6 +144,28 @@ pub(crate) unsafe fn read_vec3(p: *const f32) -> Result<Vector3<f32>, est_error>
     // SAFETY: as required above: 3 floats, which is one `[f32; 3]` (alignment checked).
     let [x, y, z] = unsafe { read_in(p.cast::<[f32; 3]>()) }?;
     Ok(Vector3::new(x, y, z))
+}
+
+/// Reads two `float[3]` (an IMU sample's gyro and accelerometer): the null and alignment
+/// checks of both in one branch each.
+///
+/// # Safety
+/// `a` and `b` are null or point to 3 initialized floats each.
+pub(crate) unsafe fn read_vec3_pair(
+    a: *const f32,
+    b: *const f32,
+) -> Result<(Vector3<f32>, Vector3<f32>), est_error> {
+    if a.is_null() || b.is_null() {
+        return Err(est_error::EST_ERR_NULL_POINTER);
+    }
+    if !(a.addr() | b.addr()).is_multiple_of(align_of::<f32>()) {
+        return Err(est_error::EST_ERR_MISALIGNED);
+    }
+    // SAFETY: non-null and aligned (checked); the caller gives 3 initialized floats at each
+    // (as documented), which is one `[f32; 3]`.
+    let ([ax, ay, az], [bx, by, bz]) =
+        unsafe { (a.cast::<[f32; 3]>().read(), b.cast::<[f32; 3]>().read()) };
+    Ok((Vector3::new(ax, ay, az), Vector3::new(bx, by, bz)))
 }
 
 /// Writes an output struct.

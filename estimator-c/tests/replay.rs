@@ -122,9 +122,72 @@ fn c_replay_is_bit_for_bit_the_rust_navigator() {
         nav.report().heading
     );
 
-    let Some(cc) = c_compiler() else { return };
+    let Some(got) = c_program_output(&samples) else {
+        return;
+    };
+    assert_same_lines(&got, &expected, samples.len());
+}
+
+/// A dataset host-sim writes (its hand-held scenario: IMU at 200 Hz, magnetometer at 50 Hz,
+/// from a simulator independent of these tests' stream) through tests/c/replay.c: bit for bit
+/// what `AttitudeNavigator<f32>` gives on the same samples.
+#[test]
+fn c_replay_of_a_host_sim_dataset_is_bit_for_bit_the_rust_navigator() {
+    let samples = host_sim_stream("handheld_ahrs", 1);
+    let (expected, nav) = rust_replay(&samples);
+    assert!(
+        nav.estimate().is_some() && nav.counters().heading_fused > 0,
+        "the dataset starts the navigator and its magnetometer is fused"
+    );
+    let Some(got) = c_program_output(&samples) else {
+        return;
+    };
+    assert_same_lines(&got, &expected, samples.len());
+}
+
+/// The IMU and magnetometer samples of a dataset host-sim simulates (`scenario`, `seed`), in
+/// `f32`, as its replay reads them; written into this test's own folder under
+/// `CARGO_TARGET_TMPDIR` and removed after.
+fn host_sim_stream(scenario: &str, seed: u64) -> Vec<Sample> {
+    use host_sim::dataset::read::{Dataset, Event};
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "estimator-c-{scenario}-{seed}-{}",
+        std::process::id()
+    ));
+    std::fs::create_dir_all(&dir).expect("the dataset's folder");
+    let sc = host_sim::scenario::Scenario::load(scenario).expect("a built-in scenario");
+    host_sim::dataset::write::simulate(&sc, seed, &dir).expect("simulate");
+    let ds = Dataset::open_with_magnetometer(&dir, true).expect("open the dataset");
+    let f3 = |v: &Vector3<f64>| [v.x as f32, v.y as f32, v.z as f32];
+    let mut samples = Vec::new();
+    for event in ds.events().expect("the dataset's events") {
+        match event.expect("an event") {
+            Event::Imu { t_ns, gyro, accel } => samples.push(Sample::Imu {
+                t_ns,
+                gyro: f3(&gyro),
+                accel: f3(&accel),
+            }),
+            Event::Mag { t_ns, field } => samples.push(Sample::Mag {
+                t_ns,
+                field: f3(&field),
+            }),
+            _ => {}
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    samples
+}
+
+/// What tests/c/replay.c prints for `samples`, built with `cc` against the static library;
+/// `None` (with a message) where there is no C compiler.
+fn c_program_output(samples: &[Sample]) -> Option<String> {
+    let cc = c_compiler()?;
     let crate_dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let dir = std::env::temp_dir().join(format!("estimator-c-replay-{}", std::process::id()));
+    // One folder per call: the tests run in parallel threads of one process.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir =
+        std::env::temp_dir().join(format!("estimator-c-replay-{}-{call}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let exe = dir.join("replay");
     let build = Command::new(&cc)
@@ -167,7 +230,7 @@ fn c_replay_is_bit_for_bit_the_rust_navigator() {
         .stderr(Stdio::piped())
         .spawn()
         .expect("run the replay");
-    let input = stream_text(&samples);
+    let input = stream_text(samples);
     let mut stdin = child.stdin.take().expect("stdin");
     let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
     let output = child.wait_with_output().expect("replay output");
@@ -179,6 +242,13 @@ fn c_replay_is_bit_for_bit_the_rust_navigator() {
         String::from_utf8_lossy(&output.stderr)
     );
     let got = String::from_utf8(output.stdout).expect("ASCII output");
+    let _ = std::fs::remove_dir_all(&dir);
+    Some(got)
+}
+
+/// `got` (the C program's lines) equals `expected` (the Rust navigator's) line by line: one
+/// line per sample and the counters.
+fn assert_same_lines(got: &str, expected: &str, samples: usize) {
     let (mut got_lines, mut expected_lines) = (got.lines(), expected.lines());
     let mut line = 0;
     loop {
@@ -188,8 +258,7 @@ fn c_replay_is_bit_for_bit_the_rust_navigator() {
             (g, e) => assert_eq!(g, e, "line {line}: C interface (left) against Rust (right)"),
         }
     }
-    assert!(line > samples.len(), "one line per sample and the counters");
-    let _ = std::fs::remove_dir_all(&dir);
+    assert!(line > samples, "one line per sample and the counters");
 }
 
 /// The INS through the C interface (with a barometer and a declared travel, so that the

@@ -42,7 +42,7 @@ fn reason_code(v: Validity) -> u8 {
     }
 }
 
-fn nav_error(e: &NavError) -> PyErr {
+pub(crate) fn nav_error(e: &NavError) -> PyErr {
     PyValueError::new_err(format!("refused by the navigator: {e}"))
 }
 
@@ -138,7 +138,7 @@ pub struct PyAttitudeNavigator {
     nav: Nav,
 }
 
-fn vector(name: &str, v: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
+pub(crate) fn vector(name: &str, v: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
     let xs: Vec<f64> = v
         .extract()
         .map_err(|_| PyTypeError::new_err(format!("{name}: expected 3 numbers")))?;
@@ -159,6 +159,23 @@ fn vector(name: &str, v: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
     }
 }
 
+/// The settings of a navigator's constructor: `config` updated by the keywords.
+pub(crate) fn merged_settings(
+    config: Option<&Bound<'_, PyDict>>,
+    kwargs: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Settings> {
+    let merged = match (config, kwargs) {
+        (Some(c), Some(k)) => {
+            let m = c.copy()?;
+            m.update(k.as_mapping())?;
+            Some(m)
+        }
+        (Some(c), None) => Some(c.clone()),
+        (None, k) => k.cloned(),
+    };
+    config::settings(merged.as_ref())
+}
+
 #[pymethods]
 impl PyAttitudeNavigator {
     #[new]
@@ -167,16 +184,7 @@ impl PyAttitudeNavigator {
         config: Option<&Bound<'_, PyDict>>,
         kwargs: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let merged = match (config, kwargs) {
-            (Some(c), Some(k)) => {
-                let m = c.copy()?;
-                m.update(k.as_mapping())?;
-                Some(m)
-            }
-            (Some(c), None) => Some(c.clone()),
-            (None, k) => k.cloned(),
-        };
-        let s = config::settings(merged.as_ref())?;
+        let s = merged_settings(config, kwargs)?;
         Ok(Self {
             nav: build(&s, true)?,
         })

@@ -2,8 +2,9 @@
 //! and reads it on a GNSS dataset.
 
 use crate::arrays;
+use crate::attitude::{merged_settings, nav_error, vector};
 use crate::config::{self, Settings};
-use estimator_core::nav::{GnssFix, Validity};
+use estimator_core::nav::{GnssFix, InsEstimate, InsReport, NavError, Validity};
 use estimator_core::Real;
 use host_sim::replay::{ins_config, ReplayInsNavigator as Nav, HORIZON_SAMPLES};
 use nalgebra::Vector3;
@@ -341,4 +342,192 @@ pub fn run_ins<'py>(
     d.set_item("gnss_accepted", PyArray1::from_vec(py, o.gnss_accepted))?;
     d.set_item("magnetometer_used", with_mag && mag_len > 0)?;
     Ok(d)
+}
+
+/// One INS navigator in either precision.
+enum InsNav {
+    F32(Box<Nav<f32>>),
+    F64(Box<Nav<f64>>),
+}
+
+/// The report after a call: each quantity's validity.
+fn ins_report_dict<'py, T: Real>(
+    py: Python<'py>,
+    r: &InsReport<T>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let v = r.validity;
+    let d = PyDict::new(py);
+    d.set_item("t_ns", r.t_ns)?;
+    for (name, f) in [
+        ("tilt_valid", v.tilt),
+        ("heading_valid", v.heading),
+        ("velocity_valid", v.velocity),
+        ("position_valid", v.position),
+        ("gyro_bias_valid", v.gyro_bias),
+        ("accel_bias_valid", v.accel_bias),
+    ] {
+        d.set_item(name, valid(f))?;
+    }
+    d.set_item("event", r.event.map(|e| format!("{e:?}")))?;
+    Ok(d)
+}
+
+/// The estimate: attitude (w, x, y, z; world ENU from body), position m and velocity m/s
+/// (ENU), biases, and the 15 sigmas (attitude rad, velocity, position, gyro bias, accelerometer
+/// bias), as `run_ins` gives them per sample.
+fn ins_estimate_dict<'py, T: Real>(
+    py: Python<'py>,
+    e: &InsEstimate<T>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let s = &e.state;
+    let q = s.attitude.cast::<f64>().quaternion();
+    let f = |v: &Vector3<T>| [v.x.to_f64(), v.y.to_f64(), v.z.to_f64()];
+    let mut sigma = [0.0; 15];
+    for (blk, c) in e.covariance.iter().enumerate() {
+        for k in 0..3 {
+            sigma[3 * blk + k] = c[(k, k)].to_f64().max(0.0).sqrt();
+        }
+    }
+    let d = PyDict::new(py);
+    d.set_item("quaternion", [q.w, q.i, q.j, q.k].to_vec())?;
+    d.set_item("position", f(&s.position).to_vec())?;
+    d.set_item("velocity", f(&s.velocity).to_vec())?;
+    d.set_item("gyro_bias", f(&s.gyro_bias).to_vec())?;
+    d.set_item("accel_bias", f(&s.accel_bias).to_vec())?;
+    d.set_item("sigma", sigma.to_vec())?;
+    Ok(d)
+}
+
+/// `InsNavigator(config=None, magnetometer=False, barometer=False, **kwargs)`: the INS
+/// navigator, one sample at a time, configured as `run_ins` configures it.
+#[pyclass(name = "InsNavigator", module = "estimator._estimator")]
+pub struct PyInsNavigator {
+    nav: InsNav,
+    latency_ns: u64,
+}
+
+/// Runs `$body` with `$n` the navigator of either precision and `$T` its scalar.
+macro_rules! with_nav {
+    ($self:expr, $n:ident, $T:ident, $body:expr) => {
+        match &mut $self.nav {
+            InsNav::F32($n) => {
+                type $T = f32;
+                $body
+            }
+            InsNav::F64($n) => {
+                type $T = f64;
+                $body
+            }
+        }
+    };
+}
+
+#[pymethods]
+impl PyInsNavigator {
+    #[new]
+    #[pyo3(signature = (config=None, magnetometer=false, barometer=false, **kwargs))]
+    fn new(
+        config: Option<&Bound<'_, PyDict>>,
+        magnetometer: bool,
+        barometer: bool,
+        kwargs: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let s = merged_settings(config, kwargs)?;
+        let with_mag = magnetometer && s.replay.use_magnetometer;
+        let err = |e: NavError| PyValueError::new_err(format!("configuration: {e}"));
+        let nav = match s.replay.precision.as_str() {
+            "f32" => InsNav::F32(Box::new(
+                Nav::new(ins_config(&s.sensors, &s.replay, with_mag, barometer)).map_err(err)?,
+            )),
+            "f64" => InsNav::F64(Box::new(
+                Nav::new(ins_config(&s.sensors, &s.replay, with_mag, barometer)).map_err(err)?,
+            )),
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "precision '{other}' (use 'f32' or 'f64')"
+                )))
+            }
+        };
+        Ok(Self {
+            nav,
+            latency_ns: s.sensors.gnss_latency_ns(&s.replay),
+        })
+    }
+
+    /// Takes one IMU sample; returns the report (validity per quantity) after it.
+    fn imu<'py>(
+        &mut self,
+        py: Python<'py>,
+        t_ns: u64,
+        gyr: &Bound<'py, PyAny>,
+        acc: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (g, a) = (vector("gyr", gyr)?, vector("acc", acc)?);
+        with_nav!(self, n, T, {
+            let r = n
+                .imu(t_ns, &lit3::<T>(&g), &lit3::<T>(&a))
+                .map_err(|e| nav_error(&e))?;
+            ins_report_dict(py, &r)
+        })
+    }
+
+    /// Takes one GNSS fix stamped `t_ns` (minus the configured `gnss_latency_s`, as `run_ins`
+    /// and host-sim stamp it).
+    #[pyo3(signature = (t_ns, position, sigma_p, velocity=None, sigma_v=None, sigma_p_up=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn gnss(
+        &mut self,
+        t_ns: u64,
+        position: &Bound<'_, PyAny>,
+        sigma_p: f64,
+        velocity: Option<&Bound<'_, PyAny>>,
+        sigma_v: Option<f64>,
+        sigma_p_up: Option<f64>,
+    ) -> PyResult<()> {
+        let p = vector("position", position)?;
+        let v = velocity.map(|v| vector("velocity", v)).transpose()?;
+        if v.is_some() != sigma_v.is_some() {
+            return Err(PyValueError::new_err(
+                "velocity and sigma_v go together (both or neither)",
+            ));
+        }
+        let t = t_ns.saturating_sub(self.latency_ns);
+        with_nav!(self, n, T, {
+            let fix = GnssFix::new(
+                lit3::<T>(&p),
+                v.as_ref().map(lit3::<T>),
+                T::lit(sigma_p),
+                T::lit(sigma_v.unwrap_or(0.0)),
+            )
+            .with_vertical_sigma(T::lit(sigma_p_up.unwrap_or(sigma_p)));
+            n.gnss(t, &fix).map(drop).map_err(|e| nav_error(&e))
+        })
+    }
+
+    /// Takes one magnetometer sample (µT, body frame).
+    fn magnetometer(&mut self, t_ns: u64, mag: &Bound<'_, PyAny>) -> PyResult<()> {
+        let m = vector("mag", mag)?;
+        with_nav!(self, n, T, {
+            n.magnetometer(t_ns, &lit3::<T>(&m))
+                .map(drop)
+                .map_err(|e| nav_error(&e))
+        })
+    }
+
+    /// Takes one barometric altitude (m, up).
+    fn barometer(&mut self, t_ns: u64, altitude: f64) -> PyResult<()> {
+        with_nav!(self, n, T, {
+            n.barometer(t_ns, T::lit(altitude))
+                .map(drop)
+                .map_err(|e| nav_error(&e))
+        })
+    }
+
+    /// The estimate after the last sample, `None` before the INS started.
+    fn estimate<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        match &self.nav {
+            InsNav::F32(n) => n.estimate().map(|e| ins_estimate_dict(py, &e)).transpose(),
+            InsNav::F64(n) => n.estimate().map(|e| ins_estimate_dict(py, &e)).transpose(),
+        }
+    }
 }

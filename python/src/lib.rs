@@ -17,6 +17,7 @@ mod score;
 #[pymodule]
 fn _estimator(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<attitude::PyAttitudeNavigator>()?;
+    m.add_class::<ins::PyInsNavigator>()?;
     m.add_function(wrap_pyfunction!(attitude::run_attitude, m)?)?;
     m.add_function(wrap_pyfunction!(ins::run_ins, m)?)?;
     m.add_function(wrap_pyfunction!(dataset::read_dataset, m)?)?;

@@ -28,6 +28,7 @@ from ._estimator import REASONS, default_config
 __all__ = [
     "AttitudeEstimate",
     "AttitudeNavigator",
+    "InsNavigator",
     "AttitudeRun",
     "Dataset",
     "InsRun",
@@ -237,6 +238,58 @@ class InsRun(NamedTuple):
     gnss_accepted: np.ndarray
     """(G,) bool per fix: false where the navigator refused it."""
     magnetometer_used: bool
+
+
+class InsNavigator:
+    """The INS navigator, one timestamped sample at a time, configured as :func:`run_ins`.
+
+    ``InsNavigator(config=None, magnetometer=False, barometer=False, **kwargs)``: the
+    configuration keys of :func:`default_config`; ``magnetometer`` and ``barometer`` say which
+    of those sensors will be given. A sample the navigator refuses raises ValueError and leaves
+    it unchanged.
+    """
+
+    def __init__(
+        self,
+        config: Optional[Dict[str, Any]] = None,
+        magnetometer: bool = False,
+        barometer: bool = False,
+        **kwargs: Any,
+    ) -> None:
+        self._nav = _estimator.InsNavigator(config, magnetometer, barometer, **kwargs)
+
+    def imu(self, t_ns: int, gyr: Any, acc: Any) -> Dict[str, Any]:
+        """One IMU sample: ``gyr`` (3,) rad/s, ``acc`` (3,) m/s², body frame. Returns the
+        validity of each quantity after it."""
+        return self._nav.imu(_t_ns(t_ns), gyr, acc)
+
+    def gnss(
+        self,
+        t_ns: int,
+        position: Any,
+        sigma_p: float,
+        velocity: Any = None,
+        sigma_v: Optional[float] = None,
+        sigma_p_up: Optional[float] = None,
+    ) -> None:
+        """One fix: ``position`` (3,) m ENU with horizontal 1σ ``sigma_p`` (m) and vertical
+        ``sigma_p_up`` (default ``sigma_p``), ``velocity`` (3,) m/s with ``sigma_v``, or
+        neither. ``t_ns`` is the row's time; the configured ``gnss_latency_s`` is taken off."""
+        self._nav.gnss(_t_ns(t_ns), position, float(sigma_p), velocity, sigma_v, sigma_p_up)
+
+    def magnetometer(self, t_ns: int, mag: Any) -> None:
+        """One magnetometer sample ``mag`` (3,) µT, body frame."""
+        self._nav.magnetometer(_t_ns(t_ns), mag)
+
+    def barometer(self, t_ns: int, altitude: float) -> None:
+        """One barometric altitude, m (up)."""
+        self._nav.barometer(_t_ns(t_ns), float(altitude))
+
+    def estimate(self) -> Optional[Dict[str, Any]]:
+        """The estimate after the last sample (``quaternion`` w, x, y, z world ENU from body;
+        ``position`` m, ``velocity`` m/s, ``gyro_bias``, ``accel_bias``, ``sigma`` the 15
+        sigmas as in :func:`run_ins`); ``None`` before the INS started."""
+        return self._nav.estimate()
 
 
 def run_ins(

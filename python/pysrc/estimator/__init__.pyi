@@ -56,6 +56,28 @@ class AttitudeNavigator:
     def magnetometer(self, t_ns: int, mag: _Floats) -> Dict[str, Any]: ...
     def estimate(self) -> Optional[AttitudeEstimate]: ...
 
+class InsNavigator:
+    def __init__(
+        self,
+        config: Optional[Dict[str, Any]] = ...,
+        magnetometer: bool = ...,
+        barometer: bool = ...,
+        **kwargs: Any,
+    ) -> None: ...
+    def imu(self, t_ns: int, gyr: _Floats, acc: _Floats) -> Dict[str, Any]: ...
+    def gnss(
+        self,
+        t_ns: int,
+        position: _Floats,
+        sigma_p: float,
+        velocity: Optional[_Floats] = ...,
+        sigma_v: Optional[float] = ...,
+        sigma_p_up: Optional[float] = ...,
+    ) -> None: ...
+    def magnetometer(self, t_ns: int, mag: _Floats) -> None: ...
+    def barometer(self, t_ns: int, altitude: float) -> None: ...
+    def estimate(self) -> Optional[Dict[str, Any]]: ...
+
 def run_attitude(
     t: _Times,
     gyr: _Floats,

@@ -15,6 +15,28 @@ class AttitudeNavigator:
     def magnetometer(self, t_ns: int, mag: Any) -> Dict[str, Any]: ...
     def estimate(self) -> Optional[Dict[str, Any]]: ...
 
+class InsNavigator:
+    def __init__(
+        self,
+        config: Optional[Dict[str, Any]] = ...,
+        magnetometer: bool = ...,
+        barometer: bool = ...,
+        **kwargs: Any,
+    ) -> None: ...
+    def imu(self, t_ns: int, gyr: Any, acc: Any) -> Dict[str, Any]: ...
+    def gnss(
+        self,
+        t_ns: int,
+        position: Any,
+        sigma_p: float,
+        velocity: Any = ...,
+        sigma_v: Optional[float] = ...,
+        sigma_p_up: Optional[float] = ...,
+    ) -> None: ...
+    def magnetometer(self, t_ns: int, mag: Any) -> None: ...
+    def barometer(self, t_ns: int, altitude: float) -> None: ...
+    def estimate(self) -> Optional[Dict[str, Any]]: ...
+
 def run_attitude(
     t: npt.NDArray[np.int64],
     gyr: npt.NDArray[np.float64],

@@ -3,8 +3,8 @@
 use crate::error::{code, est_error};
 use crate::report::{est_attitude_event, est_magnetic_status, est_validity};
 use crate::storage::{
-    check_out, init_slot, nav_mut, nav_ref, read_in, read_vec3, read_vec3_pair, slot_align,
-    slot_size, vec3, write_out, MAGIC_ATTITUDE,
+    init_nav, nav_mut, nav_ref, read_vec3, read_vec3_pair, slot_align, slot_size, vec3, write_out,
+    MAGIC_ATTITUDE,
 };
 use core::ffi::c_void;
 use estimator_core::eskf::{FilterConfig, ImuNoise};
@@ -326,18 +326,17 @@ pub unsafe extern "C" fn est_attitude_init(
     cfg: *const est_attitude_config,
     out: *mut *mut est_attitude,
 ) -> est_error {
-    let built = check_out(out).and_then(|()| {
-        // SAFETY: this function's # Safety section covers `cfg`.
-        let config = unsafe { read_in(cfg) }?.to_rust()?;
-        // SAFETY: this function's # Safety section covers `storage` and `size`.
-        unsafe {
-            init_slot::<Nav, est_attitude>(storage, size, MAGIC_ATTITUDE, || {
-                Nav::new(config).map_err(est_error::from)
-            })
-        }
-    });
-    // SAFETY: this function's # Safety section covers `out` (checked before anything was built).
-    code(built.and_then(|handle| unsafe { write_out(out, handle) }))
+    // SAFETY: this function's # Safety section covers `storage`, `size`, `cfg` and `out`.
+    unsafe {
+        init_nav(
+            storage,
+            size,
+            cfg,
+            out,
+            MAGIC_ATTITUDE,
+            |c: est_attitude_config| Nav::new(c.to_rust()?).map_err(est_error::from),
+        )
+    }
 }
 
 /// Takes one IMU sample at `t_ns`: `gyro` (rad/s) and `accel` (specific force, m/s²), body

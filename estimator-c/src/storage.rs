@@ -68,6 +68,31 @@ pub(crate) unsafe fn init_slot<N, H>(
     Ok(slot.cast::<H>())
 }
 
+/// The body of every `est_*_init`: `out` checked before anything is built, the configuration
+/// `cfg` read and turned into a navigator by `build`, built in `storage` with `magic`, and the
+/// handle written to `*out`.
+///
+/// # Safety
+/// As `est_*_init`: `storage` is null or points to `size` writable bytes; `cfg` is null or
+/// points to an initialized `C`; `out` is null or points to a writable `*mut H`.
+pub(crate) unsafe fn init_nav<C: Copy, N, H>(
+    storage: *mut c_void,
+    size: usize,
+    cfg: *const C,
+    out: *mut *mut H,
+    magic: u32,
+    build: impl FnOnce(C) -> Result<N, est_error>,
+) -> est_error {
+    let built = check_out(out).and_then(|()| {
+        // SAFETY: the # Safety section covers `cfg`.
+        let config = unsafe { read_in(cfg) }?;
+        // SAFETY: the # Safety section covers `storage` and `size`.
+        unsafe { init_slot::<N, H>(storage, size, magic, || build(config)) }
+    });
+    // SAFETY: the # Safety section covers `out` (checked before anything was built).
+    crate::error::code(built.and_then(|handle| unsafe { write_out(out, handle) }))
+}
+
 /// Checks a handle (non-null, aligned, its magic word set by the init of the same kind).
 ///
 /// # Safety

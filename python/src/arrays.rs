@@ -1,7 +1,10 @@
 //! Checked conversion of NumPy arguments: dtype, shape, length, finiteness and time order are
 //! all verified, and the first fault is reported with the argument's name and the index.
 
-use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use estimator_core::Real;
+use nalgebra::Vector3;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
@@ -172,4 +175,17 @@ pub fn nan_rows(
         out.push(Some(r));
     }
     Ok(out)
+}
+
+/// A checked `[f64; 3]` in the navigator's scalar.
+pub fn lit3<T: Real>(v: &[f64; 3]) -> Vector3<T> {
+    Vector3::new(T::lit(v[0]), T::lit(v[1]), T::lit(v[2]))
+}
+
+/// A `(len / cols, cols)` float64 array of an output, row by row.
+pub fn matrix<'py>(py: Python<'py>, v: Vec<f64>, cols: usize) -> PyResult<Bound<'py, PyAny>> {
+    let rows = v.len() / cols;
+    let a = Array2::from_shape_vec((rows, cols), v)
+        .map_err(|e| PyValueError::new_err(format!("output shape: {e}")))?;
+    Ok(a.into_pyarray(py).into_any())
 }

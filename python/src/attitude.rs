@@ -1,14 +1,12 @@
 //! The attitude navigator: sample by sample (`AttitudeNavigator`) and batched over arrays
 //! (`run_attitude`), fed and read exactly as `host-sim replay` feeds and reads it.
 
-use crate::arrays;
+use crate::arrays::{self, lit3, matrix};
 use crate::config::{self, Settings};
 use estimator_core::nav::{AttitudeNavigator, AttitudeReport, NavError, Reason, Validity};
 use estimator_core::Real;
 use host_sim::replay::navigator_config;
-use nalgebra::Vector3;
-use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1};
+use numpy::PyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -44,10 +42,6 @@ fn reason_code(v: Validity) -> u8 {
 
 pub(crate) fn nav_error(e: &NavError) -> PyErr {
     PyValueError::new_err(format!("refused by the navigator: {e}"))
-}
-
-fn lit3<T: Real>(v: &[f64; 3]) -> Vector3<T> {
-    Vector3::new(T::lit(v[0]), T::lit(v[1]), T::lit(v[2]))
 }
 
 /// The filter's state after the last call, as host-sim writes it to `estimate.csv`.
@@ -314,13 +308,6 @@ fn run<T: Real>(mut nav: AttitudeNavigator<T>, inp: &Inputs) -> Outputs {
         i += 1;
     }
     o
-}
-
-fn matrix<'py>(py: Python<'py>, v: Vec<f64>, cols: usize) -> PyResult<Bound<'py, PyAny>> {
-    let rows = v.len() / cols;
-    let a = Array2::from_shape_vec((rows, cols), v)
-        .map_err(|e| PyValueError::new_err(format!("output shape: {e}")))?;
-    Ok(a.into_pyarray(py).into_any())
 }
 
 /// `run_attitude(t, gyr, acc, mag=None, mag_t=None, **config)`: see the Python docstring.

@@ -1,13 +1,13 @@
 //! host-sim's dataset folder (EuRoC / ASL layout) from Python: read into arrays, simulated, and
 //! replayed by host-sim itself (the reference the batched functions are checked against).
 
+use crate::arrays::matrix;
 use crate::config::{object_to_py, settings_dict, to_py, Settings};
 use host_sim::dataset::read::{movement, Dataset, Event, TruthStream};
 use host_sim::output::Staging;
 use host_sim::replay::SensorParameters;
 use host_sim::scenario::Scenario;
-use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1};
+use numpy::PyArray1;
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -15,12 +15,6 @@ use std::path::{Path, PathBuf};
 
 fn err(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
-}
-
-fn matrix<'py>(py: Python<'py>, v: Vec<f64>, cols: usize) -> PyResult<Bound<'py, PyAny>> {
-    let rows = v.len() / cols;
-    let a = Array2::from_shape_vec((rows, cols), v).map_err(err)?;
-    Ok(a.into_pyarray(py).into_any())
 }
 
 fn times<'py>(py: Python<'py>, t: Vec<u64>) -> PyResult<Bound<'py, PyAny>> {

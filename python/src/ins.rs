@@ -1,22 +1,17 @@
 //! The INS navigator batched over arrays (`run_ins`), fed and read as `host-sim replay` feeds
 //! and reads it on a GNSS dataset.
 
-use crate::arrays;
+use crate::arrays::{self, lit3, matrix};
 use crate::attitude::{merged_settings, nav_error, vector};
 use crate::config::{self, Settings};
 use estimator_core::nav::{GnssFix, InsEstimate, InsReport, NavError, Validity};
 use estimator_core::Real;
 use host_sim::replay::{ins_config, ReplayInsNavigator as Nav, HORIZON_SAMPLES};
 use nalgebra::Vector3;
-use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1};
+use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-
-fn lit3<T: Real>(v: &[f64; 3]) -> Vector3<T> {
-    Vector3::new(T::lit(v[0]), T::lit(v[1]), T::lit(v[2]))
-}
 
 struct Fix {
     t: u64,
@@ -152,13 +147,6 @@ fn run<T: Real>(nav: &mut Nav<T>, inp: &Inputs) -> Outputs {
         }
     }
     o
-}
-
-fn matrix<'py>(py: Python<'py>, v: Vec<f64>, cols: usize) -> PyResult<Bound<'py, PyAny>> {
-    let rows = v.len() / cols;
-    let a = Array2::from_shape_vec((rows, cols), v)
-        .map_err(|e| PyValueError::new_err(format!("output shape: {e}")))?;
-    Ok(a.into_pyarray(py).into_any())
 }
 
 fn pair<'py>(

@@ -155,7 +155,9 @@ pub(crate) fn attitude_floor<T: Real>(a: &Matrix3<T>) -> T {
 /// when `a_kk` is the largest diagonal entry and `λ_min` far below the other two eigenvalues
 /// (the only case the floor is for); with `λ_min(S) ≥ det S / tr S`, `det S > 4 floor tr S`
 /// keeps `λ_min(A)` above the floor. Written without the division, with `M = a_kk S`:
-/// `det M > 4 floor a_kk tr M`. Inlined into [`attitude_floor`], a leaf: a call of its own
+/// `tr M > 0` and `det M > 4 floor a_kk tr M`; the trace test is what makes `det M > 0` mean
+/// two positive eigenvalues rather than two negative ones (a tilt of σ = 10⁻⁶ rad beside a
+/// heading of σ = 0.087 rad, rounded in `f32`, gave both entries of `M` below zero). Inlined into [`attitude_floor`], a leaf: a call of its own
 /// would add its frame at the deepest point of every update.
 #[inline(always)]
 fn schur_floor<T: Real>(a: &Matrix3<T>, floor: T) -> T {
@@ -170,8 +172,11 @@ fn schur_floor<T: Real>(a: &Matrix3<T>, floor: T) -> T {
     let m11 = d1 * p - c1 * c1;
     let m22 = d2 * p - c2 * c2;
     let m12 = c12 * p - c1 * c2;
-    // A block without a positive diagonal (or with a NaN) fails the comparison: floored.
-    if p > T::zero() && m11 * m22 - m12 * m12 > T::lit(4.0) * floor * p * (m11 + m22) {
+    let tr_m = m11 + m22;
+    // Both of M's eigenvalues are positive only if its trace and determinant are: a rounded M
+    // with two negative pivots has a positive determinant too. A block without a positive
+    // diagonal (or with a NaN) fails a comparison: floored.
+    if p > T::zero() && tr_m > T::zero() && m11 * m22 - m12 * m12 > T::lit(4.0) * floor * p * tr_m {
         T::zero()
     } else {
         floor
@@ -365,6 +370,38 @@ mod tests {
         // A known heading: no floor.
         let known = heading_and_tilt(nalgebra::Vector3::z(), 2e-2, 1e-2);
         assert_eq!(attitude_floor(&known), 0.0);
+    }
+
+    /// A fuzzing finding: the `f32` block of an alignment with a tilt of σ = 10⁻⁶ rad and a
+    /// heading of σ = 0.087 rad about the body axis (0, 0.87, −0.49) (its x axis nearly level).
+    /// Its Schur complement on the largest entry rounds to `M = [4·10⁻²², 0; 0, −9·10⁻¹³]`:
+    /// one entry below zero (the exact block is definite, but `f32` cannot hold the tilt next
+    /// to the heading), a positive-determinant `M` of two negative pivots for the other shape
+    /// of the same rounding. The block as stored is indefinite (smallest eigenvalue
+    /// −9·10⁻¹¹ rad², below the floor 1.5·10⁻⁸): it must be floored, and the floored block is
+    /// positive definite.
+    #[test]
+    fn a_tilt_lost_to_rounding_beside_the_heading_is_floored() {
+        let a = Matrix3::new(
+            1.006_996_4e-12f32,
+            7.654_305e-8,
+            -4.254_263_4e-8,
+            7.654_305e-8,
+            0.005_818_133_7,
+            -0.003_233_719_2,
+            -4.254_263_4e-8,
+            -0.003_233_719_2,
+            0.001_797_301_2,
+        );
+        let exact = a.cast::<f64>().symmetric_eigenvalues().min();
+        assert!(exact < 0.0, "the stored block is indefinite: {exact}");
+        assert_eq!(attitude_floor(&a), attitude_resolution(&a));
+        let floored = a + Matrix3::from_diagonal_element(attitude_floor(&a));
+        let smallest = floored.cast::<f64>().symmetric_eigenvalues().min();
+        assert!(
+            smallest > 0.5 * f64::from(attitude_resolution(&a)),
+            "{smallest}"
+        );
     }
 
     /// A start whose attitude block is singular to the pivot test but floored (heading unknown,

@@ -53,6 +53,15 @@
 //! ([`Event::NewHardIron`]) rather than being averaged with it: a magnet fixed to the board
 //! moves the offset at once, which the drift alone would follow only slowly.
 //!
+//! **An offset that goes.** A magnet taken away, or one that is a device switched off (a
+//! phone's vibration motor), leaves a learned offset that no longer exists; a body at rest
+//! never turns, so no window would measure the change. So every block is also judged without
+//! turning ([`HardIron::gone`]): when for `new_field_s / 16` s its mean field without the offset
+//! has the reference's norm and the field with it does not, the offset returns to its prior
+//! ([`Event::NewHardIron`]). One orientation suffices for this test, because it compares
+//! two explanations of the same norm: the zero offset, which a calibrated magnetometer starts
+//! from, and the learned one.
+//!
 //! [`Event::NewHardIron`]: super::report::Event::NewHardIron
 
 use super::config::MagneticConfig;
@@ -200,6 +209,9 @@ pub(super) struct HardIron<T: Real> {
     /// An offset beyond the calibration's residual has been learned (until then the offset
     /// is the prior's zero, and the magnetometer is taken as calibrated).
     learned: bool,
+    /// How long the blocks' fields have been explained by no offset and not by the learned
+    /// one, s ([`gone`](Self::gone)).
+    gone_s: T,
 }
 
 impl<T: Real> HardIron<T> {
@@ -213,6 +225,7 @@ impl<T: Real> HardIron<T> {
             window_s: T::zero(),
             next_try_s: T::zero(),
             learned: false,
+            gone_s: T::zero(),
         }
     }
 
@@ -323,6 +336,47 @@ impl<T: Real> HardIron<T> {
             self.next_try_s = T::zero();
         }
         outcome
+    }
+
+    /// The learned offset has gone (the magnet that made it was taken away or switched off):
+    /// for `new_field_s / 16` s of blocks in a row, the block's mean field without the
+    /// offset, `corrected + b`, has the reference's norm `F` and the field with it does not,
+    /// each judged to `δ = √(9σ_m²/n + (σ_β F)²)` (three of the block mean's white noise and
+    /// the calibration's residual, as the window's test). The offset then returns to its prior
+    /// (zero, `σ_β`) and `true` says so. A turning window would measure the change too, but a
+    /// body left at rest never turns: this test needs no turning, only one orientation.
+    pub(super) fn gone(
+        &mut self,
+        corrected: &Vector3<T>,
+        n: u32,
+        duration: T,
+        reference: Option<&Vector3<T>>,
+        config: &MagneticConfig<T>,
+    ) -> bool {
+        let norm = reference.map_or_else(T::zero, crate::kernels::mat3::norm);
+        if !(config.hard_iron && self.learned && crate::kernels::positive_finite(norm)) {
+            self.gone_s = T::zero();
+            return false;
+        }
+        let raw = corrected + self.offset();
+        let spread = config.hard_iron_sigma * norm;
+        let delta_sq =
+            T::lit(9.0) * config.sigma * config.sigma / T::from_count(n.max(1)) + spread * spread;
+        let off = |v: &Vector3<T>| {
+            let e = crate::kernels::mat3::norm(v) - norm;
+            e * e
+        };
+        if off(&raw) <= delta_sq && off(corrected) > delta_sq {
+            self.gone_s += duration;
+        } else {
+            self.gone_s = T::zero();
+        }
+        if self.gone_s >= config.new_field_s / T::lit(16.0) {
+            let scale = self.scale;
+            self.begin(scale, config);
+            return true;
+        }
+        false
     }
 
     /// `f = k + ‖β‖²`, at least a small fraction of the scale's square (a degenerate `k`).
@@ -575,5 +629,51 @@ mod tests {
         }
         assert!(unexplained >= 5, "{unexplained} windows unexplained");
         assert_eq!(hi.offset(), Vector3::zeros());
+    }
+
+    /// A learned offset whose magnet is taken away while the body rests: the blocks' raw
+    /// field has the reference's norm and the corrected one does not, and after
+    /// `new_field_s / 16` s (1.25 s) of such blocks the offset returns to its prior. While the
+    /// magnet stays, resting in any orientation, it is kept.
+    #[test]
+    fn an_offset_that_goes_away_at_rest_is_dropped_and_one_that_stays_is_kept() {
+        let c = config();
+        let reference = Vector3::new(0.0, 20.0, -40.0);
+        let offset = Vector3::new(8.0, -5.0, 30.0);
+        let learn = |hi: &mut HardIron<f64>| {
+            let _ = hi.end_block(0.25, Some(&reference), &c);
+            let mut k = 0;
+            for _ in 0..80 {
+                block(hi, &offset, k, 25, true);
+                k += 25;
+                let _ = hi.end_block(0.25, Some(&reference), &c);
+            }
+            assert!(hi.learned && (hi.offset() - offset).norm() < 3.0);
+        };
+        // The still body's mean field in the body, corrected by the estimate.
+        let still = |hi: &HardIron<f64>, present: &Vector3<f64>, k: usize| {
+            let r = So3::exp(&Vector3::new(0.3 * k as f64, -0.7, 0.2 * k as f64));
+            r.inverse().act(&reference) + present - hi.offset()
+        };
+        let mut kept = HardIron::new();
+        learn(&mut kept);
+        for k in 0..40 {
+            let m = still(&kept, &offset, k / 8);
+            assert!(!kept.gone(&m, 25, 0.25, Some(&reference), &c), "block {k}");
+        }
+        assert!(kept.learned);
+        let mut gone = HardIron::new();
+        learn(&mut gone);
+        let mut dropped_after = None;
+        for k in 0..40 {
+            let m = still(&gone, &Vector3::zeros(), 0);
+            if gone.gone(&m, 25, 0.25, Some(&reference), &c) {
+                dropped_after = Some(k + 1);
+                break;
+            }
+        }
+        assert_eq!(dropped_after, Some(5), "1.25 s of 0.25 s blocks");
+        assert_eq!(gone.offset(), Vector3::zeros());
+        assert!(!gone.learned);
     }
 }

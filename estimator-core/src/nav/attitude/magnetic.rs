@@ -360,13 +360,19 @@ impl<T: Real> Magnetic<T> {
         &mut self,
         filter: &mut AhrsAccelBias<T>,
         duration: T,
+        stats: Option<&MagStats<T>>,
         mag: &MagneticConfig<T>,
     ) -> Result<Option<Event>, NavError> {
         let before = self.hard_iron.offset();
         let outcome = self
             .hard_iron
             .end_block(duration, self.reference.as_ref(), mag);
-        if outcome != HardIronOutcome::Learned {
+        let gone = outcome != HardIronOutcome::Learned
+            && stats.is_some_and(|m| {
+                self.hard_iron
+                    .gone(&m.body, m.n, duration, self.reference.as_ref(), mag)
+            });
+        if outcome != HardIronOutcome::Learned && !gone {
             return Ok(None);
         }
         self.candidate = None;

@@ -696,7 +696,9 @@ impl<T: Real> AttitudeNavigator<T> {
             }
             Stage::HardIron => {
                 let learned = match (self.magnetic.as_mut(), self.config.magnetometer.as_ref()) {
-                    (Some(state), Some(mag)) => state.hard_iron_stage(filter, stats.duration, mag),
+                    (Some(state), Some(mag)) => {
+                        state.hard_iron_stage(filter, stats.duration, stats.mag.as_ref(), mag)
+                    }
                     _ => Ok(None),
                 };
                 match learned {

@@ -1030,3 +1030,61 @@ fn f32_filter_rebuilt_from_its_own_covariance_with_unknown_heading() {
         }
     }
 }
+
+/// A fuzzing finding: the velocity integrated block after block with the attitude unknown (a
+/// tilt and heading of σ ≈ 2.3 rad, the velocity bound rejected throughout) and a quiet
+/// accelerometer. Each block adds to the velocity a variance that comes wholly from the
+/// attitude (`[s]× R̂ P_θθ R̂ᵀ [s]×ᵀ`), so the velocity, given the attitude, is known to a
+/// fraction of its variance that shrinks block by block, down to the rounding of one block (a
+/// few `ε` of the variance): in `f32` the velocity's y and z came out correlated to
+/// `1 − 2·10⁻⁸` and `P` failed Cholesky. The growth floor of every prediction
+/// (`64 N ε` of each variance's growth and `2 ε` of the variance) keeps it positive definite.
+#[test]
+fn f32_velocity_integrated_under_an_unknown_attitude_keeps_covariance_positive_definite() {
+    let mut config = FilterConfig::<f32>::default();
+    config.imu_noise.accelerometer_noise_density = 1e-7;
+    config.imu_noise.gyroscope_noise_density = 1e-7;
+    let mut p = SMatrix::<f32, 12, 12>::identity() * 1e-2;
+    p[(3, 3)] = 7.6e-5;
+    p[(4, 4)] = 7.6e-5;
+    p[(5, 5)] = 7.6e-5;
+    let attitude = So3::exp(&Vector3::new(0.1f32, -0.1, 2.0));
+    let mut f = AhrsAccelBias::new(
+        AhrsAccelBiasState {
+            attitude,
+            ..AhrsAccelBiasState::identity()
+        },
+        p,
+        config,
+    )
+    .expect("valid start");
+    f.widen_attitude(2.3, 2.3).expect("widened");
+    // A body turning about a tipped axis, with a constant acceleration of its own.
+    let gyro = Vector3::new(0.3f32, -0.2, 0.5);
+    let (dt, steps) = (0.005f32, 50);
+    for block in 0..2000 {
+        let (mut s, mut frames) = (Vector3::zeros(), nalgebra::Matrix3::zeros());
+        for _ in 0..steps {
+            let accel = f
+                .state()
+                .attitude
+                .inverse()
+                .act(&Vector3::new(0.0f32, 0.0, 9.81))
+                + Vector3::new(2.0, 0.0, 0.0);
+            f.predict(&ImuSample { gyro, accel, dt })
+                .expect("prediction");
+            let r = f.state().attitude.rotation_matrix();
+            s += r
+                * (f.state()
+                    .attitude
+                    .inverse()
+                    .act(&Vector3::new(0.0f32, 0.0, 9.81))
+                    + Vector3::new(2.0, 0.0, 0.0))
+                * dt;
+            frames += r * dt;
+        }
+        f.integrate_velocity(&s, &frames, dt * steps as f32)
+            .expect("velocity integrated");
+        assert!(positive_definite(f.covariance()), "block {block}");
+    }
+}

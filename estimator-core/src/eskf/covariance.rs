@@ -246,14 +246,20 @@ pub(crate) fn floor_growth<T: Real, const N: usize, const K: usize>(
     p: &mut SMatrix<T, N, N>,
     before: &[T; K],
 ) {
-    let f = T::lit(GROWTH_FLOOR * T::EPSILON_F64 * N as f64);
-    let rounding = T::lit(GROWTH_ROUNDING * T::EPSILON_F64);
     for (k, own) in before.iter().enumerate() {
         if let Some(d) = p.get_mut((k, k)) {
-            let grown = *d - *own;
-            *d += larger(grown, T::zero()) * f + *d * rounding;
+            *d += growth_floor::<T, N>(*d, *own);
         }
     }
+}
+
+/// What [`floor_growth`] adds to one variance of a filter of `N` states that a prediction took
+/// from `before` to `after`: `f max(after − before, 0) + 2 ε after`.
+#[inline(always)]
+pub(crate) fn growth_floor<T: Real, const N: usize>(after: T, before: T) -> T {
+    let f = T::lit(GROWTH_FLOOR * T::EPSILON_F64 * N as f64);
+    let rounding = T::lit(GROWTH_ROUNDING * T::EPSILON_F64);
+    larger(after - before, T::zero()) * f + after * rounding
 }
 
 /// The mixing floor of the 15-state prediction: adds `64 ε M` to each velocity variance and

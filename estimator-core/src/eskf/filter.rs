@@ -3,7 +3,8 @@
 use super::align::{prior_attitude_covariance, Alignment, InitialSigmas};
 use super::config::{up_direction, FilterConfig, ImuSample};
 use super::covariance::{
-    attitude_floor, attitude_resolution, cap_attitude, check_start, floor_attitude, is_spd, sigmas,
+    attitude_floor, attitude_resolution, cap_attitude, check_start, floor_attitude, growth_floor,
+    is_spd, sigmas,
 };
 use super::error::{EskfError, UpdateOutcome};
 use super::state::{sealed::Sealed, AhrsAccelBiasState, AhrsState, ErrorState, InsState};
@@ -799,8 +800,8 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 12> {
     /// from `R f = R̂ Exp(δθ) f ≈ R̂f − [R̂f]× R̂δθ` (the right `⊕` of *Lie Groups and Smooth
     /// Manifolds for Robotic State Estimation*, eq. 4.5, with `R̂ δθ` the world-frame error,
     /// eq. 3.1's adjoint `Ad_R = R`), `N_a` the accelerometer noise density: `P⁺ = G P Gᵀ + Q`
-    /// with `G` the identity but for block row `v`, and the mixing floor of the 15-state
-    /// prediction on the velocity variances. `R̂ δθ` is taken at the block's end: the
+    /// with `G` the identity but for block row `v`, and the mixing and growth floors of the
+    /// 15-state prediction on the velocity variances. `R̂ δθ` is taken at the block's end: the
     /// world-frame attitude error moves inside the block only by the gyro bias error, so the
     /// approximation leaves out `½ g T² |δb_g|` (0.01 m/s for a 0.5 s block and a bias error
     /// of 0.01 rad/s).
@@ -852,6 +853,17 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 12> {
         let mixing = T::lit(super::covariance::GROWTH_MIXING * T::EPSILON_F64) * products;
         let n33 = (n33 + n33.transpose()) * half
             + Matrix3::from_diagonal_element(na * na * duration + mixing);
+        // And the growth floor of every prediction (`floor_growth`): the velocity's growth
+        // comes from the attitude and the bias and may be wholly correlated with them; block
+        // after block without a velocity update (the bound rejected, the attitude widened) its
+        // variance, given them, would fall below the rounding of the block.
+        let own = block(p, 3, 3);
+        let n33 = n33
+            + Matrix3::from_diagonal(&Vector3::new(
+                growth_floor::<T, 12>(n33.m11, own.m11),
+                growth_floor::<T, 12>(n33.m22, own.m22),
+                growth_floor::<T, 12>(n33.m33, own.m33),
+            ));
         let usable = (0..3).all(|k| n33.get((k, k)).is_some_and(|d| usable_variance(*d)))
             && all_finite(velocity.as_slice())
             && all_finite(c0.as_slice())

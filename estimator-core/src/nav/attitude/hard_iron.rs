@@ -209,9 +209,9 @@ pub(super) struct HardIron<T: Real> {
     /// An offset beyond the calibration's residual has been learned (until then the offset
     /// is the prior's zero, and the magnetometer is taken as calibrated).
     learned: bool,
-    /// How long the blocks' fields have been explained by no offset and not by the learned
-    /// one, s ([`gone`](Self::gone)).
-    gone_s: T,
+    /// How many blocks in a row have had fields explained by no offset and not by the learned
+    /// one ([`gone`](Self::gone)); in the padding after `learned`.
+    gone_blocks: u16,
 }
 
 impl<T: Real> HardIron<T> {
@@ -225,7 +225,7 @@ impl<T: Real> HardIron<T> {
             window_s: T::zero(),
             next_try_s: T::zero(),
             learned: false,
-            gone_s: T::zero(),
+            gone_blocks: 0,
         }
     }
 
@@ -339,7 +339,7 @@ impl<T: Real> HardIron<T> {
     }
 
     /// The learned offset has gone (the magnet that made it was taken away or switched off):
-    /// for `new_field_s / 16` s of blocks in a row, the block's mean field without the
+    /// for `new_field_s / 16` s of blocks in a row (blocks of `duration` s), the block's mean field without the
     /// offset, `corrected + b`, has the reference's norm `F` and the field with it does not,
     /// each judged to `δ = √(9σ_m²/n + (σ_β F)²)` (three of the block mean's white noise and
     /// the calibration's residual, as the window's test). The offset then returns to its prior
@@ -355,7 +355,7 @@ impl<T: Real> HardIron<T> {
     ) -> bool {
         let norm = reference.map_or_else(T::zero, crate::kernels::mat3::norm);
         if !(config.hard_iron && self.learned && crate::kernels::positive_finite(norm)) {
-            self.gone_s = T::zero();
+            self.gone_blocks = 0;
             return false;
         }
         let raw = corrected + self.offset();
@@ -366,12 +366,15 @@ impl<T: Real> HardIron<T> {
             let e = crate::kernels::mat3::norm(v) - norm;
             e * e
         };
-        if off(&raw) <= delta_sq && off(corrected) > delta_sq {
-            self.gone_s += duration;
+        self.gone_blocks = if off(&raw) <= delta_sq && off(corrected) > delta_sq {
+            self.gone_blocks.saturating_add(1)
         } else {
-            self.gone_s = T::zero();
-        }
-        if self.gone_s >= config.new_field_s / T::lit(16.0) {
+            0
+        };
+        // The blocks are of one length, `duration`.
+        if T::from_count(u32::from(self.gone_blocks)) * duration
+            >= config.new_field_s / T::lit(16.0)
+        {
             let scale = self.scale;
             self.begin(scale, config);
             return true;

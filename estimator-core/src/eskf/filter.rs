@@ -857,13 +857,13 @@ impl<T: Real> Filter<T, AhrsAccelBiasState<T>, 12> {
         // comes from the attitude and the bias and may be wholly correlated with them; block
         // after block without a velocity update (the bound rejected, the attitude widened) its
         // variance, given them, would fall below the rounding of the block.
-        let own = block(p, 3, 3);
-        let n33 = n33
-            + Matrix3::from_diagonal(&Vector3::new(
-                growth_floor::<T, 12>(n33.m11, own.m11),
-                growth_floor::<T, 12>(n33.m22, own.m22),
-                growth_floor::<T, 12>(n33.m33, own.m33),
-            ));
+        let mut n33 = n33;
+        for k in 0..3 {
+            let own = p.get((9 + k, 9 + k)).copied().unwrap_or_else(T::zero);
+            if let Some(d) = n33.get_mut((k, k)) {
+                *d += growth_floor::<T, 12>(*d, own);
+            }
+        }
         let usable = (0..3).all(|k| n33.get((k, k)).is_some_and(|d| usable_variance(*d)))
             && all_finite(velocity.as_slice())
             && all_finite(c0.as_slice())

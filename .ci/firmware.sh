@@ -151,6 +151,44 @@ else
     | grep -vE '^    (core::|_\$LT\$core|nalgebra::base::(ops|blas))' || true
   allowed nopanic-f64 || fail "no-panic check (f64 API, release)"
 fi
+step "other cores: the no-panic check and the navigators' footprints on the Cortex-M0+, M33 and RISC-V"
+# The Cortex-M0/M0+ (thumbv6m-none-eabi: ARMv6-M, no FPU, so f32 is soft-float), the Cortex-M33
+# (thumbv8m.main-none-eabihf: ARMv8-M Mainline, single-precision FPU) and RISC-V
+# (riscv32imac-unknown-none-elf: no FPU, riscv-rt): the whole public API (`nopanic`, f32) at
+# opt-level "s" and 3, and the two navigators' single-purpose firmware at "s", must link
+# without a panic path and without f64 soft-float. Their flash is in the Sizes table of
+# README.md. The f32 soft-float routines of the cores without an FPU (`__aeabi_fadd`,
+# `__addsf3` …) are expected; the f64 ones (`__aeabi_dadd`, `__adddf3` …) are not.
+OTHER_CORES="thumbv6m-none-eabi:m0 thumbv8m.main-none-eabihf:m33 riscv32imac-unknown-none-elf:rv32"
+for v in $OTHER_CORES; do
+  core_target=${v%%:*} core=${v#*:}
+  rustup target add "$core_target" > /dev/null 2>&1 || true
+  for b in nopanic:release-s nopanic:release fp_att_nav:release-s fp_ins_nav:release-s; do
+    bin=${b%%:*} profile=${b#*:}
+    elf="target/$core_target/$profile/$bin"
+    rm -f "$elf"
+    if cargo build --target "$core_target" --profile "$profile" --bin "$bin" \
+      2> "$OUT/$bin-$core-$profile.log"; then
+      echo "$bin ($core, $profile): links, no panic path reachable"
+    else
+      grep -E 'undefined symbol|referenced by|^error' "$OUT/$bin-$core-$profile.log" | sed -n '1,5p' || true
+      fail "$bin ($core_target, $profile) does not link"
+    fi
+  done
+done
+for v in $OTHER_CORES; do
+  core_target=${v%%:*} core=${v#*:}
+  if cargo build --target "$core_target" --profile release-s --bin nopanic --features selftest-panic \
+    --target-dir target/selftest 2> "$OUT/nopanic-$core-selftest.log"; then
+    fail "no-panic self-test on $core_target: a reachable panic linked"
+  elif grep -q __estimator_core_panic_path_reachable "$OUT/nopanic-$core-selftest.log"; then
+    echo "no-panic self-test ($core): a reachable panic fails the link, as it should"
+  else
+    tail -n 20 "$OUT/nopanic-$core-selftest.log"
+    fail "no-panic self-test on $core_target failed for another reason"
+  fi
+done
+
 # The same link-time check over the matrix of builds a user may choose: opt-levels 2, 3, "s"
 # and "z" (profiles release-2, release, release-s, release-z), each plain and tuned for the
 # Cortex-M4 (`-C target-cpu=cortex-m4`), each for the f32 and the f64 API. Library code has no
@@ -293,9 +331,9 @@ else
   fail "starter firmware"
 fi
 
-# Single-purpose firmware (attitude filter, inertial filter, PnP): each must link (no panic path)
-# at opt-level "s" and 3; their flash is budgeted below.
-for b in fp_ahrs fp_ins fp_pnp; do
+# Single-purpose firmware (attitude filter, inertial filter, PnP, and each navigator in a main
+# loop): each must link (no panic path) at opt-level "s" and 3; their flash is budgeted below.
+for b in fp_ahrs fp_ins fp_pnp fp_att_nav fp_ins_nav; do
   for profile in release-s release; do
     rm -f "target/$TARGET/$profile/$b"
     if cargo "$(build_for "$profile")" --profile "$profile" --bin "$b" 2> "$OUT/$b-$profile.log"; then
@@ -314,7 +352,15 @@ step "f32 paths free of f64 soft-float (symbols matching $F64_RE)"
 f64_found=0
 for elf in "$DEMO3" "$DEMOS" "target/$TARGET/release/nopanic" "target/$TARGET/release-s/nopanic" \
   "target/locate/$TARGET/release/nopanic" "target/locate/$TARGET/release-s/nopanic" \
-  target/$TARGET/release-s/fp_ahrs target/$TARGET/release-s/fp_ins target/$TARGET/release-s/fp_pnp; do
+  target/$TARGET/release-s/fp_ahrs target/$TARGET/release-s/fp_ins target/$TARGET/release-s/fp_pnp \
+  target/$TARGET/release-s/fp_att_nav target/$TARGET/release-s/fp_ins_nav \
+  target/$TARGET/release/fp_att_nav target/$TARGET/release/fp_ins_nav \
+  target/thumbv6m-none-eabi/release-s/nopanic target/thumbv6m-none-eabi/release/nopanic \
+  target/thumbv6m-none-eabi/release-s/fp_att_nav target/thumbv6m-none-eabi/release-s/fp_ins_nav \
+  target/thumbv8m.main-none-eabihf/release-s/nopanic target/thumbv8m.main-none-eabihf/release/nopanic \
+  target/thumbv8m.main-none-eabihf/release-s/fp_att_nav target/thumbv8m.main-none-eabihf/release-s/fp_ins_nav \
+  target/riscv32imac-unknown-none-elf/release-s/nopanic target/riscv32imac-unknown-none-elf/release/nopanic \
+  target/riscv32imac-unknown-none-elf/release-s/fp_att_nav target/riscv32imac-unknown-none-elf/release-s/fp_ins_nav; do
   [ -f "$elf" ] || continue
   syms=$(llvm-nm "$elf" | awk '{ print $NF }' | grep -E "$F64_RE" | sort -u | tr '\n' ' ' || true)
   if [ -n "$syms" ]; then
@@ -353,14 +399,29 @@ for v in demo3:$DEMO3 demo_s:$DEMOS nopanic3:target/$TARGET/release/nopanic \
   nopanic_s:target/$TARGET/release-s/nopanic \
   nopanic3:target/locate/$TARGET/release/nopanic nopanic_s:target/locate/$TARGET/release-s/nopanic \
   fp_ahrs_s:target/$TARGET/release-s/fp_ahrs fp_ins_s:target/$TARGET/release-s/fp_ins \
-  fp_pnp_s:target/$TARGET/release-s/fp_pnp; do
+  fp_pnp_s:target/$TARGET/release-s/fp_pnp \
+  fp_att_nav_s:target/$TARGET/release-s/fp_att_nav fp_att_nav3:target/$TARGET/release/fp_att_nav \
+  fp_ins_nav_s:target/$TARGET/release-s/fp_ins_nav fp_ins_nav3:target/$TARGET/release/fp_ins_nav \
+  nopanic_m0_s:target/thumbv6m-none-eabi/release-s/nopanic nopanic_m0_3:target/thumbv6m-none-eabi/release/nopanic \
+  fp_att_nav_m0_s:target/thumbv6m-none-eabi/release-s/fp_att_nav \
+  fp_ins_nav_m0_s:target/thumbv6m-none-eabi/release-s/fp_ins_nav \
+  nopanic_m33_s:target/thumbv8m.main-none-eabihf/release-s/nopanic \
+  nopanic_m33_3:target/thumbv8m.main-none-eabihf/release/nopanic \
+  fp_att_nav_m33_s:target/thumbv8m.main-none-eabihf/release-s/fp_att_nav \
+  fp_ins_nav_m33_s:target/thumbv8m.main-none-eabihf/release-s/fp_ins_nav \
+  nopanic_rv32_s:target/riscv32imac-unknown-none-elf/release-s/nopanic \
+  nopanic_rv32_3:target/riscv32imac-unknown-none-elf/release/nopanic \
+  fp_att_nav_rv32_s:target/riscv32imac-unknown-none-elf/release-s/fp_att_nav \
+  fp_ins_nav_rv32_s:target/riscv32imac-unknown-none-elf/release-s/fp_ins_nav; do
   name=${v%%:*} elf=${v#*:}
   [ -f "$elf" ] || continue
   grep -q "^flash.$name " "$OUT/extra.txt" && continue
   vt=$(sect "$elf" .vector_table) text=$(sect "$elf" .text) ro=$(sect "$elf" .rodata)
   data=$(sect "$elf" .data) bss=$(sect "$elf" .bss)
-  echo "$name: vector_table $vt text $text rodata $ro data $data bss $bss ($elf)"
-  echo "flash.$name $((vt + text + ro + data))" >> "$OUT/extra.txt"
+  # riscv-rt's start-up code and unwind tables (none on the Cortex-M builds).
+  init=$(sect "$elf" .init.rust) eh=$(sect "$elf" .eh_frame)
+  echo "$name: vector_table $vt text $text rodata $ro data $data bss $bss init $init eh_frame $eh ($elf)"
+  echo "flash.$name $((vt + text + ro + data + init + eh))" >> "$OUT/extra.txt"
   echo "bss.$name $((bss))" >> "$OUT/extra.txt"
   # Alignment padding between functions: the part of flash that moves with the checkout's path.
   echo "padding.$name $(python3 tools/text_padding.py "$elf")" >> "$OUT/extra.txt"

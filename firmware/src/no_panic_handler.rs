@@ -19,6 +19,6 @@ fn panic(_: &core::panic::PanicInfo) -> ! {
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
     loop {
-        cortex_m::asm::nop();
+        core::hint::spin_loop();
     }
 }

@@ -117,6 +117,14 @@ SIZES = {
     "`fp_ahrs`": ["flash.fp_ahrs_s"],
     "`fp_ins`": ["flash.fp_ins_s"],
     "`fp_pnp`": ["flash.fp_pnp_s"],
+    "`fp_att_nav`": ["flash.fp_att_nav_s", "flash.fp_att_nav3"],
+    "`fp_ins_nav`": ["flash.fp_ins_nav_s", "flash.fp_ins_nav3"],
+    "`nopanic` on the Cortex-M0+": ["flash.nopanic_m0_s", "flash.nopanic_m0_3"],
+    "`fp_att_nav` / `fp_ins_nav` on the Cortex-M0+": ["flash.fp_att_nav_m0_s", "flash.fp_ins_nav_m0_s"],
+    "`nopanic` on the Cortex-M33": ["flash.nopanic_m33_s", "flash.nopanic_m33_3"],
+    "`fp_att_nav` / `fp_ins_nav` on the Cortex-M33": ["flash.fp_att_nav_m33_s", "flash.fp_ins_nav_m33_s"],
+    "`nopanic` on RISC-V": ["flash.nopanic_rv32_s", "flash.nopanic_rv32_3"],
+    "`fp_att_nav` / `fp_ins_nav` on RISC-V": ["flash.fp_att_nav_rv32_s", "flash.fp_ins_nav_rv32_s"],
     "`demo`, opt \"s\" / opt 3": ["flash.demo_s", "flash.demo3", "bss.demo_s"],
 }
 

@@ -45,7 +45,7 @@
 //! | `tilt_valid_sigma`, `heading_valid_sigma` (5°, 10°) | when the report calls a quantity valid | what the application can use |
 //!
 //! Chosen by data, not by a sensor property: `heading_noise` and `gyro_scale_sigma` (the
-//! result moves 11–37 % for a factor of two), and `velocity_sigma`, `motion_memory_s` (flat
+//! result moves 11–38 % for a factor of two), and `velocity_sigma`, `motion_memory_s` (flat
 //! within 3 % from half to twice). They are cross-validated on 14 real recordings (BROAD):
 //! chosen on one half, scored on the other (`tools/cross_validate.py`, the table in
 //! `docs/FIGURES.md`). Each half chooses the first two defaults for itself; the halves'

@@ -24,6 +24,7 @@
 #![allow(unused_must_use)] // results are kept alive with black_box, not inspected
 
 use core::hint::black_box as bb;
+#[cfg(target_arch = "arm")]
 use cortex_m_rt::entry;
 use estimator_core::eskf::{
     align_at_rest, AccelerometerAtRest, Ahrs, AhrsAccelBias, AhrsAccelBiasState, AhrsState,
@@ -48,6 +49,8 @@ use nalgebra::{
     Matrix2, Matrix3, Matrix4, Quaternion, SMatrix, SVector, UnitQuaternion, Vector1, Vector2,
     Vector3, Vector6,
 };
+#[cfg(target_arch = "riscv32")]
+use riscv_rt::entry;
 
 /// The numbers every input is built from, read through a `black_box`ed reference (see [`api`]):
 /// the optimizer never sees them.
@@ -578,13 +581,14 @@ fn main() -> ! {
     #[cfg(feature = "f64")]
     api::<f64>();
     loop {
-        cortex_m::asm::nop();
+        core::hint::spin_loop();
     }
 }
 
 #[path = "../no_panic_handler.rs"]
 mod no_panic_handler;
 
+#[cfg(target_arch = "arm")]
 #[path = "../vectors.rs"]
 mod vectors;
 

@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Checks the measured tables of firmware/README.md against what this run measured.
 
-  readme_figures.py README OPT3_TABLE OPTS_TABLE
+  readme_figures.py README OPT3_TABLE OPTS_TABLE [M33_TABLE]
 
 OPT3_TABLE, OPTS_TABLE: the output of tools/check_budgets.py at opt-level 3 (with the flash
-figures of .ci/firmware.sh) and at opt-level "s" (`figure measured target ceiling verdict`).
+figures of .ci/firmware.sh) and at opt-level "s" (`figure measured target ceiling verdict`);
+M33_TABLE: the same for the Cortex-M33 demo at opt-level 3 (the README's Cortex-M33 table).
 
 Every row of "Instructions and peak stack per call" and "Sizes" is tied below to the figures it
 shows; a row the map does not know, or a figure the run did not produce, fails the check, so the
@@ -223,9 +224,24 @@ def main():
                   f"not the committed ones): {shown}")
             continue
         compare(row[0], numbers(row[1]), keys, opt3, rel)
+    other = 0
+    if len(sys.argv) > 4:
+        m33 = measured(sys.argv[4])
+        rows = table(lines, "| call, Cortex-M33 (mps2-an505), opt 3 |")
+        if not rows:
+            failures.append("no Cortex-M33 table")
+        for row in rows:
+            entry = lookup(row[0], CALLS)
+            if entry is None:
+                failures.append(f"Cortex-M33 row not tied to a figure: {row[0]}")
+                continue
+            icount, stack = (entry, entry) if isinstance(entry[0], str) else entry
+            compare(f"{row[0]} / Cortex-M33", numbers(row[1]), [f"icount.{k}" for k in icount], m33, tolerance)
+            compare(f"{row[0]} / stack Cortex-M33", numbers(row[2]), [f"stack.{k}" for k in stack], m33, tolerance)
+        other = len(rows)
     for f in failures:
         print("  " + f)
-    print(f"firmware/README.md: {len(calls) + len(sizes)} rows, {len(failures)} disagree")
+    print(f"firmware/README.md: {len(calls) + len(sizes) + other} rows, {len(failures)} disagree")
     return 1 if failures else 0
 
 

@@ -1005,7 +1005,11 @@ fn run_benchmarks(w: &scenario::Workload<f32>) -> Benchmarks {
 
 #[entry]
 fn main() -> ! {
-    hprintln!("estimator-core firmware demo (thumbv7em-none-eabihf, f32)");
+    hprintln!(concat!(
+        "estimator-core firmware demo (",
+        env!("FIRMWARE_TARGET"),
+        ", f32)"
+    ));
     let (outcome, work) = scenario::run::<f32>();
     let mut c = Checker { failures: 0 };
     check_outcome(&mut c, &outcome);

@@ -196,19 +196,27 @@ def main():
                       f"the {slack} B of alignment padding between functions, whose layout "
                       "follows the checkout's path)")
 
+    def call_keys(label):
+        """The icount and stack figures of a per-call row, or None (a failure) if unknown."""
+        entry = lookup(label, CALLS)
+        if entry is None:
+            failures.append(f"row not tied to a figure: {label}")
+            return None
+        icount, stack = (entry, entry) if isinstance(entry[0], str) else entry
+        return [f"icount.{k}" for k in icount], [f"stack.{k}" for k in stack]
+
     calls = table(lines, "| call | instructions, opt 3 |")
     if not calls:
         failures.append("no 'Instructions and peak stack per call' table")
     for row in calls:
-        entry = lookup(row[0], CALLS)
-        if entry is None:
-            failures.append(f"row not tied to a figure: {row[0]}")
+        keys = call_keys(row[0])
+        if keys is None:
             continue
-        icount, stack = (entry, entry) if isinstance(entry[0], str) else entry
-        compare(f"{row[0]} / opt 3", numbers(row[1]), [f"icount.{k}" for k in icount], opt3, tolerance)
-        compare(f"{row[0]} / opt s", numbers(row[3]), [f"icount.{k}" for k in icount], opts, tolerance)
-        compare(f"{row[0]} / stack opt 3", numbers(row[4]), [f"stack.{k}" for k in stack], opt3, tolerance)
-        compare(f"{row[0]} / stack opt s", numbers(row[5]), [f"stack.{k}" for k in stack], opts, tolerance)
+        icount, stack = keys
+        compare(f"{row[0]} / opt 3", numbers(row[1]), icount, opt3, tolerance)
+        compare(f"{row[0]} / opt s", numbers(row[3]), icount, opts, tolerance)
+        compare(f"{row[0]} / stack opt 3", numbers(row[4]), stack, opt3, tolerance)
+        compare(f"{row[0]} / stack opt s", numbers(row[5]), stack, opts, tolerance)
     sizes = table(lines, "| figure | bytes | budget |")
     if not sizes:
         failures.append("no 'Sizes' table")
@@ -231,13 +239,12 @@ def main():
         if not rows:
             failures.append("no Cortex-M33 table")
         for row in rows:
-            entry = lookup(row[0], CALLS)
-            if entry is None:
-                failures.append(f"Cortex-M33 row not tied to a figure: {row[0]}")
+            keys = call_keys(row[0])
+            if keys is None:
                 continue
-            icount, stack = (entry, entry) if isinstance(entry[0], str) else entry
-            compare(f"{row[0]} / Cortex-M33", numbers(row[1]), [f"icount.{k}" for k in icount], m33, tolerance)
-            compare(f"{row[0]} / stack Cortex-M33", numbers(row[2]), [f"stack.{k}" for k in stack], m33, tolerance)
+            icount, stack = keys
+            compare(f"{row[0]} / Cortex-M33", numbers(row[1]), icount, m33, tolerance)
+            compare(f"{row[0]} / stack Cortex-M33", numbers(row[2]), stack, m33, tolerance)
         other = len(rows)
     for f in failures:
         print("  " + f)

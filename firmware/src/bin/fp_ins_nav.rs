@@ -8,14 +8,10 @@
 #[path = "../footprint/mod.rs"]
 mod footprint;
 
-#[cfg(target_arch = "arm")]
-use cortex_m_rt::entry;
 use estimator_core::eskf::FilterConfig;
 use estimator_core::nav::{AttitudeConfig, GnssFix, InsConfig, InsNavigator, MagneticConfig};
-use footprint::{input, input3, keep};
+use footprint::{entry, input, input3, keep};
 use nalgebra::Vector3;
-#[cfg(target_arch = "riscv32")]
-use riscv_rt::entry;
 
 #[entry]
 fn main() -> ! {

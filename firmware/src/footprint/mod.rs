@@ -9,6 +9,15 @@
 
 use core::hint::black_box;
 
+/// The run-time's entry attribute of the core the binary is built for (the navigators'
+/// footprints are also built for RISC-V; the filters' and PnP's only for Cortex-M).
+#[cfg(target_arch = "arm")]
+#[allow(unused_imports)]
+pub use cortex_m_rt::entry;
+#[cfg(target_arch = "riscv32")]
+#[allow(unused_imports)]
+pub use riscv_rt::entry;
+
 /// An opaque `f32`: the optimizer knows nothing of it (a sensor register, in real firmware).
 #[inline(always)]
 pub fn input(i: usize) -> f32 {
